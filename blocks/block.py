@@ -1,0 +1,165 @@
+"""The block contract: declared ports, parameters and feedthrough; state lives outside.
+
+A block object is configuration only. The executor owns the state: it calls
+``initial_state()`` once, then ``output`` and ``update`` at every sample hit (and the
+optional ``advance`` fast path for runs of hits with held inputs). Because nothing
+mutable is kept on the block, one block object can serve many runs, and a run can be
+checkpointed or batched by copying its state.
+"""
+
+from __future__ import annotations
+
+import inspect
+from fractions import Fraction
+from typing import Any, ClassVar, Mapping
+
+import numpy as np
+
+Signal = np.ndarray
+"""A port value: a 1-D float64 array of the port's declared width."""
+
+
+class BlockError(Exception):
+    """Raised by a block during a run; ``port`` names the offending signal if there is one."""
+
+    def __init__(self, message: str, port: str | None = None):
+        super().__init__(message)
+        self.port = port
+
+
+class Block:
+    """Base class of every block.
+
+    Subclasses set, usually in ``__init__`` from their parameters:
+
+    - ``inputs`` / ``outputs``: port name -> width. ``None`` means "same width as the
+      other ``None`` ports of this block, inferred from the connections".
+    - ``input_defaults``: inputs that may stay unconnected, with the value they then hold.
+    - ``feedthrough``: ``True`` if every output reads every input at the same hit,
+      ``False`` if no output does, or a mapping output -> set of inputs it reads.
+    - ``time_varying``: the outputs depend on ``t`` itself (sources such as Step).
+
+    and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
+    Parameters are the keyword arguments of ``__init__``; ``param_docs`` documents them.
+    """
+
+    type_name: ClassVar[str | None] = None
+    param_docs: ClassVar[dict[str, str]] = {}
+    time_varying: ClassVar[bool] = False
+
+    inputs: dict[str, int | None] = {}
+    outputs: dict[str, int | None] = {}
+    input_defaults: dict[str, Signal] = {}
+    feedthrough: bool | Mapping[str, frozenset[str] | set[str]] = True
+    period: Fraction | None = None
+
+    # -- configuration hooks, called by the diagram loader -------------------------
+
+    def bind(self, period: Fraction | None) -> None:
+        """Receive the sample period (``None`` when inherited). Override to precompute."""
+        self.period = period
+
+    def set_width(self, width: int) -> None:
+        """Give every port declared with width ``None`` the inferred ``width``."""
+        self.inputs = {p: (width if w is None else w) for p, w in self.inputs.items()}
+        self.outputs = {p: (width if w is None else w) for p, w in self.outputs.items()}
+
+    # -- the run-time contract ------------------------------------------------------
+
+    def initial_state(self) -> Any:
+        """State at t = 0; ``None`` for a stateless block (its ``update`` is never called)."""
+        return None
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        """Outputs at a sample hit.
+
+        ``inputs`` are read-only. Returned arrays are handed to other blocks by reference,
+        so the block must not mutate them afterwards (return copies of state arrays).
+        """
+        raise NotImplementedError(f"{type(self).__name__}.output")
+
+    def update(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> Any:
+        """Next state after a sample hit (inputs are those seen by ``output`` at this hit).
+
+        The executor keeps no reference to the previous state, so a block may update
+        the given state in place and return it.
+        """
+        return state
+
+    def advance(self, t: float, state: Any, inputs: Mapping[str, Signal], n: int):
+        """Fast path: ``n`` updates with held inputs, the first at time ``t``.
+
+        Returns ``(state_after_n_updates, outputs)`` where ``outputs[port]`` is an
+        ``(n, width)`` array of the outputs at the ``n`` following hits
+        (``t + period`` ... ``t + n * period``). Only used for blocks without
+        feedthrough. This default is the reference loop; a block overrides it with
+        something faster (a compiled kernel, a closed form) and the executor then uses it.
+        """
+        dt = float(self.period) if self.period is not None else 0.0
+        rows: dict[str, list[Signal]] = {p: [] for p in self.outputs}
+        for i in range(n):
+            state = self.update(t + i * dt, state, inputs)
+            out = self.output(t + (i + 1) * dt, state, inputs)
+            for p in rows:
+                rows[p].append(out[p])
+        return state, {p: np.asarray(v, dtype=float).reshape(n, self.outputs[p]) for p, v in rows.items()}
+
+    # -- introspection helpers used by the loader, the scheduler and the CLI --------
+
+    @classmethod
+    def registered_name(cls) -> str:
+        return cls.type_name or cls.__name__
+
+    @classmethod
+    def parameters(cls) -> dict[str, inspect.Parameter]:
+        """The block's parameters: the keyword arguments of its ``__init__``."""
+        sig = inspect.signature(cls.__init__)
+        return {
+            name: p
+            for name, p in sig.parameters.items()
+            if name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
+        }
+
+    def is_stateful(self) -> bool:
+        return self.initial_state() is not None
+
+    def has_fast_advance(self) -> bool:
+        return type(self).advance is not Block.advance
+
+    def reads(self, output_port: str) -> frozenset[str]:
+        """The input ports that ``output_port`` depends on at the same hit."""
+        ft = self.feedthrough
+        if ft is True:
+            return frozenset(self.inputs)
+        if ft is False:
+            return frozenset()
+        return frozenset(ft.get(output_port, ()))
+
+    def has_feedthrough(self) -> bool:
+        return any(self.reads(p) for p in self.outputs)
+
+
+def as_vector(value: Any, name: str) -> Signal:
+    """A parameter as a 1-D float64 array (a scalar becomes width 1)."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = arr.reshape(1)
+    if arr.ndim != 1:
+        raise ValueError(f"parameter '{name}' must be a scalar or a vector, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"parameter '{name}' must be finite")
+    return arr
+
+
+def as_matrix(value: Any, name: str) -> np.ndarray:
+    """A parameter as a 2-D float64 array (a scalar becomes 1x1, a list a row)."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = arr.reshape(1, 1)
+    elif arr.ndim == 1:
+        arr = arr.reshape(1, -1)
+    if arr.ndim != 2:
+        raise ValueError(f"parameter '{name}' must be a matrix, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"parameter '{name}' must be finite")
+    return arr

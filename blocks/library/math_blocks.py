@@ -1,0 +1,185 @@
+"""Memoryless arithmetic blocks: gain, signed sum, saturation."""
+
+from __future__ import annotations
+
+from functools import partial
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from blocks.block import Block, Signal
+
+# Python-float scalars cost an extra conversion inside every ufunc call; 0-d arrays
+# multiply and compare against a small vector about a third faster, so scalar
+# parameters are stored as 0-d float64 arrays.
+
+
+def _real_array(value: Any, name: str, allow_inf: bool = False) -> np.ndarray:
+    """A parameter as a float64 array, rejecting NaN (and infinities unless allowed)."""
+    try:
+        arr = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"parameter '{name}' must be numeric, got {value!r}") from None
+    bad = np.isnan(arr) if allow_inf else ~np.isfinite(arr)
+    if np.any(bad):
+        raise ValueError(f"parameter '{name}' must be {'not NaN' if allow_inf else 'finite'}")
+    if arr.size == 0:
+        raise ValueError(f"parameter '{name}' must not be empty")
+    return arr
+
+
+class Gain(Block):
+    """Multiplies the input by ``k``: scalar, elementwise vector, or matrix (y = K @ u)."""
+
+    param_docs = {
+        "k": "gain: a scalar (any width), a vector (elementwise) or a matrix (y = K @ u)",
+    }
+
+    def __init__(self, k: Any = 1.0):
+        arr = _real_array(k, "k")
+        if arr.ndim > 2:
+            raise ValueError(f"parameter 'k' must be a scalar, vector or matrix, got shape {arr.shape}")
+        self.k = arr
+        self._matrix = arr.ndim == 2
+        if arr.ndim == 0:
+            self.inputs, self.outputs = {"u": None}, {"y": None}
+        elif arr.ndim == 1:
+            self.inputs, self.outputs = {"u": arr.size}, {"y": arr.size}
+        else:
+            self.inputs, self.outputs = {"u": arr.shape[1]}, {"y": arr.shape[0]}
+        self.feedthrough = True
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        if self._matrix:
+            return {"y": self.k.dot(inputs["u"])}
+        return {"y": inputs["u"] * self.k}
+
+
+def _sum_p(i: Mapping[str, Signal]) -> Signal:
+    return i["u0"].copy()
+
+
+def _sum_m(i: Mapping[str, Signal]) -> Signal:
+    return -i["u0"]
+
+
+def _sum_pp(i: Mapping[str, Signal]) -> Signal:
+    return i["u0"] + i["u1"]
+
+
+def _sum_pm(i: Mapping[str, Signal]) -> Signal:
+    return i["u0"] - i["u1"]
+
+
+def _sum_mp(i: Mapping[str, Signal]) -> Signal:
+    return i["u1"] - i["u0"]
+
+
+def _sum_mm(i: Mapping[str, Signal]) -> Signal:
+    r = i["u0"] + i["u1"]
+    return np.negative(r, out=r)
+
+
+def _sum_ppp(i: Mapping[str, Signal]) -> Signal:
+    r = i["u0"] + i["u1"]
+    r += i["u2"]
+    return r
+
+
+def _sum_ppm(i: Mapping[str, Signal]) -> Signal:
+    r = i["u0"] + i["u1"]
+    r -= i["u2"]
+    return r
+
+
+def _sum_pmm(i: Mapping[str, Signal]) -> Signal:
+    r = i["u0"] - i["u1"]
+    r -= i["u2"]
+    return r
+
+
+def _sum_general(plus: tuple[str, ...], minus: tuple[str, ...], i: Mapping[str, Signal]) -> Signal:
+    """Any sign pattern: start from the first '+' input (or minus the first '-')."""
+    if plus:
+        r = i[plus[0]].copy()
+        rest = minus
+    else:
+        r = -i[minus[0]]
+        rest = minus[1:]
+    for p in plus[1:]:
+        r += i[p]
+    for p in rest:
+        r -= i[p]
+    return r
+
+
+_SUM_KERNELS: dict[str, Callable[[Mapping[str, Signal]], Signal]] = {
+    "+": _sum_p,
+    "-": _sum_m,
+    "++": _sum_pp,
+    "+-": _sum_pm,
+    "-+": _sum_mp,
+    "--": _sum_mm,
+    "+++": _sum_ppp,
+    "++-": _sum_ppm,
+    "+--": _sum_pmm,
+}
+
+
+class Sum(Block):
+    """Signed sum of the inputs ``u0, u1, ...``, one sign character per input."""
+
+    param_docs = {
+        "signs": "one '+' or '-' per input, in port order u0, u1, ... (e.g. '+-' gives u0 - u1)",
+    }
+
+    def __init__(self, signs: str = "++"):
+        if not isinstance(signs, str) or not signs or set(signs) - {"+", "-"}:
+            raise ValueError(f"parameter 'signs' must be a non-empty string of '+' and '-', got {signs!r}")
+        self.signs = signs
+        ports = tuple(f"u{j}" for j in range(len(signs)))
+        self.inputs = {p: None for p in ports}
+        self.outputs = {"y": None}
+        self.feedthrough = True
+        kernel = _SUM_KERNELS.get(signs)
+        if kernel is None:
+            plus = tuple(p for p, s in zip(ports, signs) if s == "+")
+            minus = tuple(p for p, s in zip(ports, signs) if s == "-")
+            kernel = partial(_sum_general, plus, minus)
+        self._kernel = kernel
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        return {"y": self._kernel(inputs)}
+
+
+class Saturation(Block):
+    """Clips the input to ``[lower, upper]`` elementwise."""
+
+    param_docs = {
+        "lower": "lower limit, a scalar (any width) or a vector; -inf for no lower limit",
+        "upper": "upper limit, a scalar (any width) or a vector; inf for no upper limit",
+    }
+
+    def __init__(self, lower: Any = -1.0, upper: Any = 1.0):
+        lo = _real_array(lower, "lower", allow_inf=True)
+        hi = _real_array(upper, "upper", allow_inf=True)
+        for name, arr in (("lower", lo), ("upper", hi)):
+            if arr.ndim > 1:
+                raise ValueError(f"parameter '{name}' must be a scalar or a vector, got shape {arr.shape}")
+        if lo.ndim == 1 and hi.ndim == 1 and lo.size != hi.size and 1 not in (lo.size, hi.size):
+            raise ValueError(
+                f"parameters 'lower' and 'upper' must have one width, got {lo.size} and {hi.size}"
+            )
+        if np.any(lo > hi):
+            raise ValueError(f"parameter 'lower' must be <= 'upper', got lower={lower!r}, upper={upper!r}")
+        if lo.ndim == 0 and hi.ndim == 0:
+            width = None
+        else:
+            width = max(lo.size, hi.size)
+            lo, hi = np.broadcast_to(lo, (width,)).copy(), np.broadcast_to(hi, (width,)).copy()
+        self.lower, self.upper = lo, hi
+        self.inputs, self.outputs = {"u": width}, {"y": width}
+        self.feedthrough = True
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        return {"y": np.minimum(np.maximum(inputs["u"], self.lower), self.upper)}

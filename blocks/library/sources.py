@@ -1,0 +1,102 @@
+"""Source blocks: signals that depend only on time (or on nothing at all)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+
+from blocks.block import Block, Signal, as_vector
+
+
+def _finite_scalar(value: Any, name: str) -> float:
+    """A parameter that must be one finite real number."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"parameter '{name}' must be a finite scalar, got {value!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"parameter '{name}' must be a finite scalar, got {value!r}")
+    return x
+
+
+def broadcast_vectors(**params: Any) -> dict[str, Signal]:
+    """Parameters as vectors of one common width; a width-1 value is repeated to fit.
+
+    Raises ValueError naming the parameters when two of them have different widths > 1.
+    """
+    vectors = {name: as_vector(value, name) for name, value in params.items()}
+    for name, v in vectors.items():
+        if v.size == 0:
+            raise ValueError(f"parameter '{name}' must not be empty")
+    widths = {name: v.size for name, v in vectors.items() if v.size != 1}
+    if len(set(widths.values())) > 1:
+        desc = ", ".join(f"'{n}' has width {w}" for n, w in widths.items())
+        raise ValueError(f"parameters must be scalars or vectors of one width: {desc}")
+    width = next(iter(widths.values()), 1)
+    return {name: np.repeat(v, width) if v.size != width else v for name, v in vectors.items()}
+
+
+class Constant(Block):
+    """Outputs a fixed value at every hit."""
+
+    param_docs = {"value": "the output value, a scalar or a vector"}
+
+    def __init__(self, value: Any):
+        self.value = as_vector(value, "value")
+        if self.value.size == 0:
+            raise ValueError("parameter 'value' must not be empty")
+        self.inputs = {}
+        self.outputs = {"y": self.value.size}
+        self.feedthrough = False
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        return {"y": self.value.copy()}
+
+
+class Step(Block):
+    """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time)."""
+
+    param_docs = {
+        "time": "switching time in seconds; the output is 'after' from this time on",
+        "before": "output before the switching time, a scalar or a vector",
+        "after": "output from the switching time on, a scalar or a vector",
+    }
+    time_varying = True
+
+    def __init__(self, time: float, before: Any = 0.0, after: Any = 1.0):
+        self.time = _finite_scalar(time, "time")
+        vectors = broadcast_vectors(before=before, after=after)
+        self.before, self.after = vectors["before"], vectors["after"]
+        self.inputs = {}
+        self.outputs = {"y": self.before.size}
+        self.feedthrough = False
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        return {"y": (self.before if t < self.time else self.after).copy()}
+
+
+class Ramp(Block):
+    """Outputs ``initial + slope * max(0, t - start)``: flat until ``start``, then linear."""
+
+    param_docs = {
+        "slope": "rate of change after the start time (units per second), scalar or vector",
+        "start": "time in seconds at which the ramp starts rising",
+        "initial": "output value up to the start time, scalar or vector",
+    }
+    time_varying = True
+
+    def __init__(self, slope: Any = 1.0, start: float = 0.0, initial: Any = 0.0):
+        self.start = _finite_scalar(start, "start")
+        vectors = broadcast_vectors(slope=slope, initial=initial)
+        self.slope, self.initial = vectors["slope"], vectors["initial"]
+        self.inputs = {}
+        self.outputs = {"y": self.slope.size}
+        self.feedthrough = False
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        elapsed = t - self.start
+        if elapsed <= 0.0:
+            return {"y": self.initial.copy()}
+        return {"y": self.initial + self.slope * elapsed}

@@ -1,0 +1,133 @@
+"""Logged signals of a run, their files (signals.npz, signals.csv, run.json) and reloading.
+
+Each signal keeps its own sample times. Files are written atomically (temporary file in
+the same folder, then rename), so a reader never sees half a file, and a failed run's
+partial results are saved the same way with a status saying where it stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+SIGNALS_NPZ = "signals.npz"
+SIGNALS_CSV = "signals.csv"
+RUN_JSON = "run.json"
+TIME_PREFIX = "time:"
+
+
+class ResultsError(Exception):
+    """A results folder that cannot be read."""
+
+
+class Results:
+    """Logged signals by name ``block.port``: ``results[name] -> (t, values)``.
+
+    ``values`` has shape (samples, width); ``info`` holds what run.json records
+    (status, diagram, parameters, timing). ``complete`` is False for a failed run,
+    whose signals stop where the failure happened.
+    """
+
+    def __init__(self, signals: dict[str, tuple[np.ndarray, np.ndarray]], info: dict):
+        self.signals = signals
+        self.info = info
+
+    def __getitem__(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        try:
+            return self.signals[name]
+        except KeyError:
+            raise KeyError(f"signal '{name}' was not logged; logged signals: "
+                           f"{', '.join(self.signals) or 'none'}") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.signals
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.signals)
+
+    def __len__(self) -> int:
+        return len(self.signals)
+
+    @property
+    def status(self) -> str:
+        return self.info.get("status", "complete")
+
+    @property
+    def complete(self) -> bool:
+        return self.status == "complete"
+
+    def value_at(self, name: str, t: float) -> np.ndarray:
+        """The held (zero-order hold) value of a signal at time ``t``."""
+        times, values = self[name]
+        i = np.searchsorted(times, t, side="right") - 1
+        if i < 0:
+            raise ValueError(f"signal '{name}' has no sample at or before t = {t}")
+        return values[i]
+
+    # -- files ---------------------------------------------------------------------
+
+    def save(self, directory: str | Path, csv: bool = False) -> Path:
+        """Write signals.npz and run.json (and signals.csv) into ``directory``."""
+        directory = Path(directory)
+        directory.mkdir(parents=True, exist_ok=True)
+        arrays = {}
+        for name, (t, v) in self.signals.items():
+            arrays[name] = v
+            arrays[TIME_PREFIX + name] = t
+        _atomic_write(directory / SIGNALS_NPZ, lambda f: np.savez(f, **arrays))
+        if csv:
+            _atomic_write(directory / SIGNALS_CSV, lambda f: self.write_csv(f))
+        info = dict(self.info)
+        info["signals"] = {n: {"width": int(v.shape[1]), "samples": int(v.shape[0])}
+                           for n, (t, v) in self.signals.items()}
+        text = json.dumps(info, indent=2, default=str) + "\n"
+        _atomic_write(directory / RUN_JSON, lambda f: f.write(text.encode("utf-8")))
+        return directory
+
+    def write_csv(self, f) -> None:
+        """Columns ``time`` (every logged sample time) and each signal held at those times."""
+        if not self.signals:
+            f.write(b"time\n")
+            return
+        grid = np.unique(np.concatenate([t for t, _ in self.signals.values()]))
+        columns, header = [grid[:, None]], ["time"]
+        for name, (t, v) in self.signals.items():
+            idx = np.searchsorted(t, grid, side="right") - 1
+            held = np.where((idx >= 0)[:, None], v[np.clip(idx, 0, None)], np.nan) if len(t) else \
+                np.full((grid.size, v.shape[1]), np.nan)
+            columns.append(held)
+            header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
+        np.savetxt(f, np.hstack(columns), delimiter=",", header=",".join(header), comments="",
+                   fmt="%.17g")
+
+    @classmethod
+    def load(cls, directory: str | Path) -> "Results":
+        """Read a results folder written by ``save`` (or ``hierhand run``)."""
+        directory = Path(directory)
+        npz, meta = directory / SIGNALS_NPZ, directory / RUN_JSON
+        if not npz.is_file():
+            raise ResultsError(f"{directory}: no {SIGNALS_NPZ} here; is this the -o folder of a run?")
+        try:
+            info = json.loads(meta.read_text(encoding="utf-8")) if meta.is_file() else {}
+            with np.load(npz, allow_pickle=False) as data:
+                signals = {k: (data[TIME_PREFIX + k], data[k]) for k in data.files
+                           if not k.startswith(TIME_PREFIX)}
+        except (OSError, ValueError, KeyError) as exc:
+            raise ResultsError(f"{directory}: cannot read results: {exc}") from None
+        return cls(signals, info)
+
+
+def _atomic_write(path: Path, write) -> None:
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

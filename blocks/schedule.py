@@ -1,0 +1,319 @@
+"""Rates to an integer tick plan: firing table, evaluation order and algebraic-loop check.
+
+Everything that can be decided before a run is decided here, once:
+
+- the base tick (gcd of all periods and offsets) and the hyperperiod (lcm of periods);
+- which blocks fire at each tick of the hyperperiod; inherited periods are the union of
+  the blocks feeding them;
+- *lazy* blocks: stateless pure functions with an inherited period and no delayed input.
+  Their output only changes when an input changes, so they are evaluated on demand at
+  the ticks where a firing block reads them, which gives the same values as evaluating
+  them at every source hit while keeping them from forcing extra events;
+- *advanced* blocks: blocks with a fast ``advance`` and no feedthrough whose hits include
+  every event tick (and more). Between two events nothing else fires, so they are
+  stepped over the whole span in one call;
+- for each distinct firing pattern, an ``EventProgram``: the output phase in feedthrough
+  order, the update phase, delayed-connection sampling and the advances.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from fractions import Fraction
+from functools import reduce
+
+import networkx as nx
+import numpy as np
+
+from .diagram import Connection, Diagram, DiagramError, Issue
+from .timebase import format_duration, fraction_gcd
+
+MAX_HYPERPERIOD_TICKS = 10_000_000
+
+
+@dataclass(frozen=True)
+class EventProgram:
+    """What the executor does at one kind of event tick, in order."""
+
+    firing: frozenset[str]
+    evaluate: tuple[tuple[str, tuple[str, ...] | None], ...]
+    update: tuple[str, ...]
+    sample: tuple[int, ...]
+    advance: tuple[str, ...]
+    final: bool = False
+
+    def describe(self) -> str:
+        def step(b: str, ports: tuple[str, ...] | None) -> str:
+            return b if ports is None else f"{b}[{','.join(ports)}]"
+
+        parts = [f"outputs: {', '.join(step(b, p) for b, p in self.evaluate) or '-'}"]
+        if not self.final:
+            parts.append(f"updates: {', '.join(self.update) or '-'}")
+            if self.advance:
+                parts.append(f"advance to next event: {', '.join(self.advance)}")
+        return "; ".join(parts)
+
+
+@dataclass
+class Schedule:
+    """The tick plan of a diagram for a run of ``n_ticks`` base ticks (None: unknown yet)."""
+
+    base_tick: Fraction
+    hyperperiod: int
+    n_ticks: int | None
+    period_ticks: dict[str, int | None]
+    offset_ticks: dict[str, int]
+    masks: dict[str, np.ndarray]
+    fires_at_zero: dict[str, bool]
+    lazy: frozenset[str]
+    advanced: frozenset[str]
+    event_ticks: np.ndarray
+    event_programs: list[int]
+    programs: list[EventProgram]
+    initial: EventProgram
+    delayed: list[Connection] = field(default_factory=list)
+    final: EventProgram | None = None
+
+    def hits(self, block: str, n_ticks: int) -> np.ndarray:
+        """All ticks in [0, n_ticks] at which ``block`` fires (its sample times / base tick)."""
+        mask = self.masks[block]
+        rel = np.flatnonzero(mask)
+        cycles = n_ticks // self.hyperperiod + 1
+        ticks = (rel[None, :] + self.hyperperiod * np.arange(cycles)[:, None]).ravel()
+        ticks = ticks[ticks <= n_ticks]
+        if self.fires_at_zero[block] and (ticks.size == 0 or ticks[0] != 0):
+            ticks = np.concatenate(([0], ticks))
+        return ticks.astype(np.int64)
+
+    def rate_text(self, block: str) -> str:
+        p = self.period_ticks[block]
+        if p is not None:
+            text = format_duration(p * self.base_tick)
+            if self.offset_ticks[block]:
+                text += f" + {format_duration(self.offset_ticks[block] * self.base_tick)}"
+            return text
+        if not self.masks[block].any():
+            return "t = 0 only (inherited)"
+        return "inherited" + (", lazy" if block in self.lazy else "")
+
+
+def build_schedule(diagram: Diagram, t_end: Fraction | None) -> Schedule:
+    """Plan a run of ``diagram`` to ``t_end`` (None: check everything that does not need it)."""
+    return _Planner(diagram).plan(t_end)
+
+
+class _Planner:
+    def __init__(self, diagram: Diagram):
+        self.d = diagram
+        self.order = {name: i for i, name in enumerate(diagram.blocks)}
+        self.sources: dict[str, set[str]] = {b: set() for b in diagram.blocks}
+        for c in diagram.connections:
+            self.sources[c.dst_block].add(c.src_block)
+
+    def fail(self, line: int | None, message: str, hint: str = "") -> None:
+        raise DiagramError([Issue(self.d.file, line, message, hint)])
+
+    def plan(self, t_end: Fraction | None) -> Schedule:
+        d = self.d
+        explicit = {n: s for n, s in d.blocks.items() if s.period is not None}
+        for name, spec in d.blocks.items():
+            if spec.period is None and spec.block.time_varying and not self.sources[name]:
+                self.fail(spec.line, f"block '{name}' ({spec.type_name}) changes with time and has no "
+                          "inputs to inherit a period from", f"give block '{name}' a period")
+        times = [s.period for s in explicit.values()] + [s.offset for s in explicit.values() if s.offset]
+        if times:
+            base = fraction_gcd(times)
+        else:
+            base = t_end if t_end else Fraction(1)
+        period_ticks = {n: (int(s.period / base) if s.period is not None else None) for n, s in d.blocks.items()}
+        offset_ticks = {n: int(s.offset / base) for n, s in d.blocks.items()}
+        hyper = reduce(math.lcm, (p for p in period_ticks.values() if p), 1)
+        if hyper > MAX_HYPERPERIOD_TICKS:
+            self.fail(None, f"the hyperperiod is {hyper} base ticks of {format_duration(base)}: the "
+                      "periods are too incommensurate", "choose periods that are simple multiples of "
+                      "each other (e.g. 0.1 ms, 1 ms, 10 ms)")
+        n_ticks = None
+        if t_end is not None:
+            ratio = t_end / base
+            if ratio.denominator != 1:
+                self.fail(d.t_end_line, f"t_end = {format_duration(t_end)} is not a multiple of the base "
+                          f"tick {format_duration(base)}",
+                          f"use a multiple of {format_duration(base)}, e.g. "
+                          f"{format_duration(math.ceil(ratio) * base)}")
+            n_ticks = int(ratio)
+        masks, at_zero = self.fire_sets(period_ticks, offset_ticks, hyper)
+        logged = {e.block for e in d.log}
+        delayed_into = {c.dst_block for c in d.connections if c.delay}
+        lazy = frozenset(
+            n for n, s in d.blocks.items()
+            if s.period is None and not s.block.is_stateful() and not s.block.time_varying
+            and n not in delayed_into and n not in logged and masks[n].any())
+        advanced = self.advanced_blocks(masks, period_ticks, offset_ticks, lazy, delayed_into, n_ticks)
+        events = np.zeros(hyper, dtype=bool)
+        for n in d.blocks:
+            if n not in lazy and n not in advanced:
+                events |= masks[n]
+        event_ticks = np.flatnonzero(events)
+        programs: list[EventProgram] = []
+        index: dict[frozenset[str], int] = {}
+        event_programs = []
+        for r in event_ticks:
+            firing = frozenset(n for n in d.blocks if n not in lazy and masks[n][r])
+            if firing not in index:
+                index[firing] = len(programs)
+                programs.append(self.program(firing, lazy, advanced, final=False))
+            event_programs.append(index[firing])
+        firing0 = frozenset(n for n in d.blocks if n not in lazy and (masks[n][0] or at_zero[n]))
+        initial = self.program(firing0, lazy, advanced, final=n_ticks == 0, initial=True)
+        final = None
+        if n_ticks:
+            firing_n = frozenset(n for n in d.blocks if n not in lazy and masks[n][n_ticks % hyper])
+            final = self.program(firing_n, lazy, advanced, final=True)
+        return Schedule(base, hyper, n_ticks, period_ticks, offset_ticks, masks, at_zero, lazy,
+                        advanced, event_ticks, event_programs, programs, initial,
+                        [c for c in d.connections if c.delay], final)
+
+    def fire_sets(self, period_ticks, offset_ticks, hyper):
+        """Periodic firing mask over one hyperperiod, and 'fires at t = 0', for every block."""
+        masks: dict[str, np.ndarray] = {}
+        at_zero: dict[str, bool] = {}
+        for n in self.d.blocks:
+            mask = np.zeros(hyper, dtype=bool)
+            if period_ticks[n] is not None:
+                mask[offset_ticks[n]::period_ticks[n]] = True
+                at_zero[n] = offset_ticks[n] == 0
+            else:
+                at_zero[n] = True
+            masks[n] = mask
+        inherited = [n for n in self.d.blocks if period_ticks[n] is None]
+        changed = True
+        while changed:
+            changed = False
+            for n in inherited:
+                srcs = self.sources[n]
+                if not srcs:
+                    continue
+                mask = masks[n] | reduce(np.logical_or, (masks[s] for s in srcs))
+                zero = any(at_zero[s] for s in srcs)
+                if not np.array_equal(mask, masks[n]):
+                    masks[n] = mask
+                    changed = True
+                at_zero[n] = zero
+        return masks, at_zero
+
+    def advanced_blocks(self, masks, period_ticks, offset_ticks, lazy, delayed_into, n_ticks):
+        d = self.d
+        candidates = [
+            n for n, s in d.blocks.items()
+            if s.block.has_fast_advance() and not s.block.has_feedthrough() and period_ticks[n]
+            and offset_ticks[n] == 0 and s.block.is_stateful() and n not in delayed_into
+            and (n_ticks is None or n_ticks % period_ticks[n] == 0)]
+        chosen: list[str] = []
+        for n in candidates:
+            upstream = self.upstream_through(n, lazy)
+            if n in upstream or upstream.intersection(chosen):
+                continue
+            chosen.append(n)
+        while True:
+            events = np.zeros_like(next(iter(masks.values())))
+            for n in d.blocks:
+                if n not in lazy and n not in chosen:
+                    events |= masks[n]
+            bad = [n for n in chosen if np.any(events & ~masks[n])]
+            if not bad:
+                return frozenset(n for n in chosen if not np.array_equal(events, masks[n]))
+            chosen = [n for n in chosen if n not in bad]
+
+    def upstream_through(self, block: str, lazy: frozenset[str]) -> set[str]:
+        """Non-lazy blocks whose outputs reach ``block``'s inputs directly or via lazy blocks."""
+        seen: set[str] = set()
+        stack = list(self.sources[block])
+        out: set[str] = set()
+        while stack:
+            s = stack.pop()
+            if s in seen:
+                continue
+            seen.add(s)
+            if s in lazy:
+                stack.extend(self.sources[s])
+            else:
+                out.add(s)
+        return out
+
+    def program(self, firing: frozenset[str], lazy, advanced, final: bool,
+                initial: bool = False) -> EventProgram:
+        d = self.d
+        stepped = firing - advanced if not initial else firing
+        readers = firing if final else firing | advanced
+        demanded: set[str] = set()
+        stack = [c.src_block for c in d.connections if c.dst_block in readers]
+        while stack:
+            s = stack.pop()
+            if s in lazy and s not in demanded:
+                demanded.add(s)
+                stack.extend(c.src_block for c in d.connections if c.dst_block == s)
+        evaluate = self.order_outputs(set(stepped) | demanded)
+        by_order = sorted(firing, key=self.order.get)
+        if final:
+            return EventProgram(firing, evaluate, (), (), (), final=True)
+        update = tuple(n for n in by_order if n not in advanced and d.blocks[n].block.is_stateful())
+        sample = tuple(i for i, c in enumerate(d.connections) if c.delay and c.dst_block in firing)
+        sample = tuple(sorted(sample))
+        adv = tuple(n for n in by_order if n in advanced)
+        return EventProgram(firing, evaluate, update, sample, adv)
+
+    def feeds(self, nodes: set[str]):
+        """Same-tick dependencies among ``nodes``: (src, dst, connection) where dst reads src now."""
+        for c in self.d.connections:
+            if c.delay or c.src_block not in nodes or c.dst_block not in nodes:
+                continue
+            dst = self.d.blocks[c.dst_block].block
+            if any(c.dst_port in dst.reads(p) for p in dst.outputs):
+                yield c
+
+    def order_outputs(self, nodes: set[str]) -> tuple[tuple[str, tuple[str, ...] | None], ...]:
+        graph = nx.DiGraph()
+        graph.add_nodes_from(nodes)
+        graph.add_edges_from((c.src_block, c.dst_block) for c in self.feeds(nodes))
+        if nx.is_directed_acyclic_graph(graph):
+            order = nx.lexicographical_topological_sort(graph, key=self.order.get)
+            return tuple((n, None) for n in order)
+        return self.order_ports(nodes)
+
+    def order_ports(self, nodes: set[str]) -> tuple[tuple[str, tuple[str, ...] | None], ...]:
+        """Port-level order for blocks whose outputs have different feedthrough."""
+        graph = nx.DiGraph()
+        wires: dict[tuple, Connection] = {}
+        for n in nodes:
+            blk = self.d.blocks[n].block
+            for p in blk.outputs:
+                graph.add_node(("o", n, p))
+                for q in blk.reads(p):
+                    graph.add_edge(("i", n, q), ("o", n, p))
+        for c in self.d.connections:
+            if not c.delay and c.src_block in nodes and c.dst_block in nodes:
+                edge = (("o", c.src_block, c.src_port), ("i", c.dst_block, c.dst_port))
+                graph.add_edge(*edge)
+                wires[edge] = c
+        try:
+            cycle = nx.find_cycle(graph)
+        except nx.NetworkXNoCycle:
+            cycle = None
+        if cycle:
+            start = next(i for i, e in enumerate(cycle) if e[0][0] == "o")
+            cycle = cycle[start:] + cycle[:start]
+            chain = [f"{cycle[0][0][1]}.{cycle[0][0][2]}"] + [f"{v[1]}.{v[2]}" for _, v in cycle]
+            line = next((wires[e].line for e in cycle if e in wires), None)
+            self.fail(line, f"algebraic loop: {' -> '.join(chain)}",
+                      "break it with a block without feedthrough (e.g. UnitDelay) or add "
+                      "'delay: 1' to one connection")
+        out_nodes = [v for v in nx.lexicographical_topological_sort(
+            graph, key=lambda v: (self.order[v[1]], v[0] == "o", v[2])) if v[0] == "o"]
+        steps: list[tuple[str, list[str]]] = []
+        for _, n, p in out_nodes:
+            if steps and steps[-1][0] == n:
+                steps[-1][1].append(p)
+            else:
+                steps.append((n, [p]))
+        return tuple((n, tuple(ps)) for n, ps in steps)

@@ -1,0 +1,366 @@
+"""The multirate executor: runs a Diagram's Schedule and returns Results.
+
+Per event tick the executor runs a precompiled program: outputs of the firing blocks in
+feedthrough order, then their updates, then the sampling of delayed connections, then
+the advanced blocks stepped to the next event. Outputs are passed by reference from a
+block's return value into the persistent input mappings of the blocks it feeds (no
+per-tick dictionaries or copies); between hits values hold. Time is ``k * base_tick``
+from the integer tick ``k``.
+"""
+
+from __future__ import annotations
+
+import functools
+import platform
+import time
+from fractions import Fraction
+from importlib import metadata
+from typing import Any, Callable
+
+import numpy as np
+
+from .block import BlockError
+from .diagram import Diagram, DiagramError
+from .results import Results
+from .schedule import EventProgram, Schedule, build_schedule
+from .timebase import DurationError, format_duration, parse_duration
+
+ADVANCE_CHUNK = 4096
+"""At most this many hits per ``advance`` call, so output buffers stay small."""
+
+ProgressCallback = Callable[[float, float], None]
+"""Called as ``progress(fraction_done, elapsed_wall_seconds)`` during a run."""
+
+
+class SimulationError(Exception):
+    """A block failed during a run; ``results`` holds everything computed before."""
+
+    def __init__(self, message: str, results: Results, block: str, time: float, port: str | None):
+        super().__init__(message)
+        self.results = results
+        self.block = block
+        self.time = time
+        self.port = port
+
+
+class _StepFailure(Exception):
+    def __init__(self, block: str, phase: str, tick: int, error: BaseException):
+        super().__init__(str(error))
+        self.block, self.phase, self.tick, self.error = block, phase, tick, error
+
+
+def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | None = None,
+             raise_on_failure: bool = False) -> Results:
+    """Run ``diagram`` to ``t_end`` (default: the diagram's ``time.t_end``).
+
+    A block failure does not lose the run: the returned Results carry the signals up to
+    the failure and ``status`` 'failed at t=...: ...' (or raise ``SimulationError``
+    holding them when ``raise_on_failure``).
+    """
+    if t_end is None:
+        t_end = diagram.t_end
+        if t_end is None:
+            raise DiagramError([diagram.issue(None, "no end time given",
+                                              "set time: {t_end: 1 s} in the diagram or pass t_end")])
+    else:
+        try:
+            t_end = parse_duration(t_end)
+        except DurationError as exc:
+            raise DiagramError([diagram.issue(None, f"t_end: {exc}")]) from None
+        if t_end <= 0:
+            raise DiagramError([diagram.issue(None, f"t_end must be positive, got {t_end}")])
+    schedule = build_schedule(diagram, t_end)
+    results, failure = _Run(diagram, schedule, t_end).execute(progress)
+    if failure is not None and raise_on_failure:
+        raise failure
+    return results
+
+
+class _Logger:
+    """Preallocated samples of one logged signal, honouring its decimation."""
+
+    __slots__ = ("name", "buf", "pos", "hits", "decimate")
+
+    def __init__(self, name: str, width: int, count: int, decimate: int):
+        self.name = name
+        self.buf = np.empty((count, width))
+        self.pos = 0
+        self.hits = 0
+        self.decimate = decimate
+
+    def add(self, value: np.ndarray) -> None:
+        if self.hits % self.decimate == 0:
+            self.buf[self.pos] = value
+            self.pos += 1
+        self.hits += 1
+
+    def add_rows(self, rows: np.ndarray) -> None:
+        n, d = len(rows), self.decimate
+        if d == 1:
+            self.buf[self.pos:self.pos + n] = rows
+            self.pos += n
+        else:
+            first = (-self.hits) % d
+            picked = rows[first::d]
+            self.buf[self.pos:self.pos + len(picked)] = picked
+            self.pos += len(picked)
+        self.hits += n
+
+
+class _Run:
+    """The mutable side of one run: states, input mappings, held outputs and logs."""
+
+    def __init__(self, diagram: Diagram, schedule: Schedule, t_end: Fraction):
+        self.d = diagram
+        self.s = schedule
+        self.t_end = t_end
+        self.n_ticks = schedule.n_ticks
+        self.names = list(diagram.blocks)
+        self.index = {n: i for i, n in enumerate(self.names)}
+        self.states: list[Any] = [diagram.blocks[n].block.initial_state() for n in self.names]
+        self.held: dict[str, dict[str, np.ndarray]] = {
+            n: {p: np.zeros(w) for p, w in diagram.blocks[n].block.outputs.items()} for n in self.names}
+        self.inputs: dict[str, dict[str, np.ndarray]] = {}
+        for n in self.names:
+            blk = diagram.blocks[n].block
+            self.inputs[n] = {p: np.array(blk.input_defaults[p], dtype=float) if p in blk.input_defaults
+                              else np.zeros(w) for p, w in blk.inputs.items()}
+        self.fanout: dict[str, list[tuple[dict, str, str]]] = {n: [] for n in self.names}
+        for c in diagram.connections:
+            if c.delay:
+                width = diagram.blocks[c.dst_block].block.inputs[c.dst_port]
+                init = np.zeros(width) if c.initial is None else np.broadcast_to(
+                    np.asarray(c.initial, dtype=float), (width,)).copy()
+                self.inputs[c.dst_block][c.dst_port] = init
+            else:
+                self.fanout[c.src_block].append((self.inputs[c.dst_block], c.dst_port, c.src_port))
+        self.hit_ticks: dict[str, np.ndarray] = {}
+        self.loggers: dict[str, list[_Logger]] = {n: [] for n in self.names}
+        self.all_loggers: list[_Logger] = []
+        for e in diagram.log:
+            if e.block not in self.hit_ticks:
+                self.hit_ticks[e.block] = schedule.hits(e.block, self.n_ticks)
+            count = -(-len(self.hit_ticks[e.block]) // e.decimate)
+            lg = _Logger(e.signal, diagram.blocks[e.block].block.outputs[e.port], count, e.decimate)
+            self.loggers[e.block].append(lg)
+            self.all_loggers.append(lg)
+        self.checked: set[str] = set()
+
+    # -- building the per-event programs ------------------------------------------------
+
+    def compile(self, program: EventProgram) -> Callable[[int, int], None]:
+        tick = self.s.base_tick
+        num, den = tick.numerator, tick.denominator
+        last_step = {b: i for i, (b, _) in enumerate(program.evaluate)}
+        outputs = [self.output_op(b, ports, log=(b in program.firing and last_step[b] == i))
+                   for i, (b, ports) in enumerate(program.evaluate)]
+        updates = [self.update_op(b) for b in program.update]
+        samples = [self.sample_op(self.d.connections[i]) for i in program.sample]
+        advances = [self.advance_op(b) for b in program.advance]
+
+        def run(k: int, next_k: int) -> None:
+            t = k * num / den
+            for op in outputs:
+                op(k, t)
+            for op in updates:
+                op(k, t)
+            for op in samples:
+                op()
+            for op in advances:
+                op(k, t, next_k)
+
+        return run
+
+    def output_op(self, name: str, ports: tuple[str, ...] | None, log: bool):
+        blk = self.d.blocks[name].block
+        output, i, inp, states = blk.output, self.index[name], self.inputs[name], self.states
+        publish = tuple(blk.outputs) if ports is None else ports
+        held = self.held[name]
+        targets = [(held, p, p) for p in publish] + [f for f in self.fanout[name] if f[2] in publish]
+        loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]] if log else []
+        checked = self.checked
+
+        def op(k: int, t: float) -> None:
+            try:
+                out = output(t, states[i], inp)
+                if name not in checked:
+                    self.check_outputs(name, out, publish)
+                for d, dp, sp in targets:
+                    d[dp] = out[sp]
+                for lg, p in loggers:
+                    lg.add(out[p])
+            except Exception as exc:
+                raise _StepFailure(name, "output", k, exc) from exc
+
+        return op
+
+    def update_op(self, name: str):
+        update, i, inp, states = self.d.blocks[name].block.update, self.index[name], self.inputs[name], self.states
+
+        def op(k: int, t: float) -> None:
+            try:
+                states[i] = update(t, states[i], inp)
+            except Exception as exc:
+                raise _StepFailure(name, "update", k, exc) from exc
+
+        return op
+
+    def sample_op(self, c):
+        src, dst, sp, dp = self.held[c.src_block], self.inputs[c.dst_block], c.src_port, c.dst_port
+
+        def op() -> None:
+            dst[dp] = src[sp]
+
+        return op
+
+    def advance_op(self, name: str):
+        blk = self.d.blocks[name].block
+        advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
+        period, dt = self.s.period_ticks[name], float(blk.period)
+        ports = tuple(blk.outputs)
+        held = self.held[name]
+        targets = [(held, p, p) for p in ports] + self.fanout[name]
+        loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
+
+        def op(k: int, t: float, next_k: int) -> None:
+            n = (next_k - k) // period
+            try:
+                while n > 0:
+                    m = min(n, ADVANCE_CHUNK)
+                    states[i], rows = advance(t, states[i], inp, m)
+                    if name + ":advance" not in self.checked:
+                        self.check_rows(name, rows, ports, m)
+                    for lg, p in loggers:
+                        lg.add_rows(rows[p])
+                    n -= m
+                    t += m * dt
+                for d, dp, sp in targets:
+                    d[dp] = rows[sp][-1]
+            except Exception as exc:
+                raise _StepFailure(name, "advance", k, exc) from exc
+
+        return op
+
+    def check_outputs(self, name: str, out: Any, ports: tuple[str, ...]) -> None:
+        blk = self.d.blocks[name].block
+        if not isinstance(out, dict):
+            raise BlockError(f"output() returned {type(out).__name__}, expected a dict of port arrays")
+        for p in ports:
+            v = out.get(p)
+            if not (isinstance(v, np.ndarray) and v.shape == (blk.outputs[p],) and v.dtype == np.float64):
+                got = f"shape {v.shape} {v.dtype}" if isinstance(v, np.ndarray) else repr(type(v).__name__)
+                raise BlockError(f"output '{p}' must be a float64 array of shape ({blk.outputs[p]},), got {got}",
+                                 port=p)
+        self.checked.add(name)
+
+    def check_rows(self, name: str, rows: Any, ports: tuple[str, ...], n: int) -> None:
+        blk = self.d.blocks[name].block
+        for p in ports:
+            v = rows.get(p) if isinstance(rows, dict) else None
+            if not (isinstance(v, np.ndarray) and v.shape == (n, blk.outputs[p])):
+                raise BlockError(f"advance() output '{p}' must have shape ({n}, {blk.outputs[p]})", port=p)
+        self.checked.add(name + ":advance")
+
+    # -- running ----------------------------------------------------------------------
+
+    def events(self):
+        """Event ticks after 0 with their programs, in order, without end."""
+        ticks = [int(x) for x in self.s.event_ticks]
+        if not ticks:
+            return
+        compiled = [self.compile(p) for p in self.s.programs]
+        progs = [compiled[j] for j in self.s.event_programs]
+        hyper, cycle = self.s.hyperperiod, 0
+        pairs = list(zip(ticks, progs))
+        if ticks[0] == 0:
+            pairs = pairs[1:] + [(ticks[0] + hyper, progs[0])]
+        while True:
+            base = cycle * hyper
+            for k, prog in pairs:
+                yield base + k, prog
+            cycle += 1
+
+    def execute(self, progress: ProgressCallback | None) -> tuple[Results, SimulationError | None]:
+        n = self.n_ticks
+        wall0 = time.perf_counter()
+        failure: _StepFailure | None = None
+        interrupted = False
+        k = 0
+        stream = self.events()
+        initial = self.compile(self.s.initial)
+        final = self.compile(self.s.final)
+        try:
+            nk, nprog = next(stream, (n, None))
+            nk = min(nk, n)
+            initial(0, nk)
+            count = 0
+            while nk < n:
+                k, prog = nk, nprog
+                nk, nprog = next(stream)
+                if nk > n:
+                    nk = n
+                prog(k, nk)
+                count += 1
+                if progress is not None and count & 255 == 0:
+                    progress(k / n, time.perf_counter() - wall0)
+            k = n
+            final(n, n)
+        except _StepFailure as exc:
+            failure = exc
+        except KeyboardInterrupt:
+            interrupted = True
+        wall = time.perf_counter() - wall0
+        if progress is not None and failure is None and not interrupted:
+            progress(1.0, wall)
+        t_fail = float(k * self.s.base_tick)
+        if failure is not None:
+            err = failure.error
+            port = getattr(err, "port", None)
+            spec = self.d.blocks[failure.block]
+            signal = f", signal {failure.block}.{port}" if port else ""
+            status = (f"failed at t={t_fail:.9g} s: block '{failure.block}' ({spec.type_name}){signal} "
+                      f"{failure.phase}: {err}")
+        elif interrupted:
+            status = f"interrupted at t={t_fail:.9g} s"
+        else:
+            status = "complete"
+        results = Results(self.collect(), self.info(status, wall, t_fail if status != "complete" else None))
+        if failure is not None:
+            return results, SimulationError(status, results, failure.block, t_fail, port)
+        return results, None
+
+    def collect(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        tick = self.s.base_tick
+        signals = {}
+        for e, lg in zip(self.d.log, self.all_loggers):
+            ticks = self.hit_ticks[e.block][::e.decimate][:lg.pos]
+            signals[e.signal] = (ticks * tick.numerator / tick.denominator, lg.buf[:lg.pos].copy())
+        return signals
+
+    def info(self, status: str, wall: float, t_stop: float | None) -> dict:
+        simulated = float(self.t_end) if t_stop is None else t_stop
+        return {
+            "diagram": self.d.name,
+            "diagram_file": self.d.file,
+            "diagram_hash": self.d.source_hash,
+            "status": status,
+            "t_end": float(self.t_end),
+            "t_end_exact": str(self.t_end),
+            "base_tick": format_duration(self.s.base_tick),
+            "wall_time_s": wall,
+            "real_time_factor": simulated / wall if wall > 0 else None,
+            "parameters": self.d.parameters(),
+            "versions": dict(package_versions()),
+        }
+
+
+@functools.cache
+def package_versions() -> dict[str, str]:
+    """Versions of Python and the packages that shape a run's numbers."""
+    versions = {"python": platform.python_version()}
+    for dist in ("hierhand", "numpy", "networkx", "control", "numba", "fmpy"):
+        try:
+            versions[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            pass
+    return versions

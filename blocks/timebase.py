@@ -1,0 +1,72 @@
+"""Exact time: durations as rationals parsed from decimal text, ticks as integers.
+
+Periods, offsets and end times are ``fractions.Fraction`` seconds, parsed from the
+decimal text the user wrote (``"0.1 ms"``, ``"100us"``, ``0.5``), never through a
+binary float, so that 0.1 ms is exactly 1/10000 s and rate coincidences are exact.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from fractions import Fraction
+from functools import reduce
+
+_UNITS = {"s": Fraction(1), "ms": Fraction(1, 1000), "us": Fraction(1, 10**6),
+          "µs": Fraction(1, 10**6), "ns": Fraction(1, 10**9)}
+_DURATION = re.compile(
+    r"^\s*(?P<num>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<unit>s|ms|us|µs|ns)?\s*$")
+
+
+class DurationError(ValueError):
+    """A duration text that is not a number with an optional unit."""
+
+
+def parse_duration(value: object) -> Fraction:
+    """Seconds as an exact Fraction from ``"1 ms"``, ``"100us"``, ``0.5`` or ``2``.
+
+    A float is read through its shortest decimal representation (``repr``), which
+    is the text the user typed for every value a YAML or Python literal can hold.
+    """
+    if isinstance(value, bool):
+        raise DurationError(f"expected a duration, got {value!r}")
+    if isinstance(value, int):
+        return Fraction(value)
+    if isinstance(value, Fraction):
+        return value
+    if isinstance(value, float):
+        if not math.isfinite(value):
+            raise DurationError(f"expected a finite duration, got {value!r}")
+        return Fraction(repr(value))
+    if isinstance(value, str):
+        m = _DURATION.match(value)
+        if m:
+            return Fraction(m["num"]) * _UNITS[m["unit"] or "s"]
+    raise DurationError(
+        f"cannot read {value!r} as a duration; write a number of seconds or a number "
+        "with a unit: s, ms, us, ns (e.g. '0.1 ms')")
+
+
+def format_duration(seconds: Fraction) -> str:
+    """Short human text for an exact duration, in the largest unit giving a clean number."""
+    if seconds == 0:
+        return "0 s"
+    for unit in ("s", "ms", "us", "ns"):
+        value = seconds / _UNITS[unit]
+        if abs(value) >= 1 or unit == "ns":
+            if value.denominator == 1:
+                return f"{value.numerator} {unit}"
+            return f"{float(value):g} {unit}"
+    raise AssertionError("unreachable")
+
+
+def fraction_gcd(values: list[Fraction]) -> Fraction:
+    """Greatest common divisor of positive rationals: gcd(numerators)/lcm(denominators)."""
+    num = reduce(math.gcd, (v.numerator for v in values))
+    den = reduce(math.lcm, (v.denominator for v in values))
+    return Fraction(num, den)
+
+
+def tick_time(k: int, tick: Fraction) -> float:
+    """The float nearest to ``k * tick``: one integer product, one correctly rounded division."""
+    return k * tick.numerator / tick.denominator

@@ -1,0 +1,50 @@
+"""Human-readable description of a block type: summary, parameters and ports."""
+
+from __future__ import annotations
+
+import inspect
+
+from .block import Block
+
+
+def summary(cls: type[Block]) -> str:
+    doc = inspect.getdoc(cls) or ""
+    return doc.splitlines()[0] if doc else ""
+
+
+def describe_type(cls: type[Block]) -> str:
+    """Text for ``hierhand blocks``: name, summary, parameters with defaults, ports."""
+    lines = [f"{cls.registered_name()}  ({cls.__module__}.{cls.__qualname__})"]
+    if summary(cls):
+        lines.append(f"  {summary(cls)}")
+    params = cls.parameters()
+    if params:
+        lines.append("  parameters:")
+        for name, p in params.items():
+            default = "required" if p.default is p.empty else f"default {p.default!r}"
+            doc = cls.param_docs.get(name, "")
+            lines.append(f"    {name} ({default})" + (f": {doc}" if doc else ""))
+    try:
+        block = cls()
+    except Exception:
+        lines.append("  ports: depend on the parameters")
+    else:
+        def ports(d: dict) -> str:
+            return ", ".join(f"{p}[{'n' if w is None else w}]" for p, w in d.items()) or "none"
+
+        optional = f" (optional: {', '.join(block.input_defaults)})" if block.input_defaults else ""
+        lines.append(f"  inputs: {ports(block.inputs)}{optional}")
+        lines.append(f"  outputs: {ports(block.outputs)}")
+        lines.append(f"  feedthrough: {_feedthrough(block)}")
+    if cls.time_varying:
+        lines.append("  time-varying source: needs a period")
+    return "\n".join(lines)
+
+
+def _feedthrough(block: Block) -> str:
+    ft = block.feedthrough
+    if ft is True:
+        return "yes"
+    if ft is False:
+        return "no"
+    return "; ".join(f"{o} <- {', '.join(sorted(i)) or 'none'}" for o, i in ft.items())

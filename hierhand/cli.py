@@ -1,0 +1,306 @@
+"""The ``hierhand`` command line: run, validate, graph, plot and list blocks.
+
+Exit codes: 0 ok, 2 bad input (a one-line message per problem, no traceback), 1 a failure
+during a simulation (the message names block, time and signal; partial results are kept).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+from typing import Any, Sequence
+
+import yaml
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+class UsageError(Exception):
+    """Bad command-line input, reported as one line with exit code 2."""
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    from blocks import DiagramError, ResultsError
+
+    try:
+        return args.handler(args)
+    except DiagramError as exc:
+        for issue in exc.issues:
+            print(str(issue), file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except (UsageError, ResultsError) as exc:
+        print(f"hierhand: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("hierhand: interrupted", file=sys.stderr)
+        return 130
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="hierhand",
+        description="Multirate block-diagram co-simulation: run YAML diagrams, inspect and plot them.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    run = sub.add_parser("run", help="simulate a diagram and write its results",
+                         description="Simulate DIAGRAM and write signals.npz and run.json to the output folder.")
+    _diagram_args(run)
+    run.add_argument("-o", "--output", type=Path, help="results folder (default: runs/<diagram name>)")
+    run.add_argument("--csv", action="store_true", help="also write signals.csv")
+    run.add_argument("--plot", action="store_true", help="also plot the logged signals to <output>/plots/")
+    run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary line")
+    run.set_defaults(handler=cmd_run)
+
+    validate = sub.add_parser("validate", help="check a diagram and print its schedule",
+                              description="Check DIAGRAM and print blocks, periods, base tick, "
+                                          "hyperperiod and execution order.")
+    _diagram_args(validate)
+    validate.set_defaults(handler=cmd_validate)
+
+    graph = sub.add_parser("graph", help="draw the wiring of a diagram (DOT, SVG or PNG)")
+    _diagram_args(graph)
+    graph.add_argument("-o", "--output", type=Path,
+                       help="file to write: .dot, .svg or .png (default: DOT text on stdout)")
+    graph.set_defaults(handler=cmd_graph)
+
+    plot = sub.add_parser("plot", help="plot logged signals of a run",
+                          description="Plot signals of a results folder, one axis per signal.")
+    plot.add_argument("run_dir", type=Path, metavar="RUN_DIR", help="results folder of 'hierhand run'")
+    plot.add_argument("-s", "--signal", action="append", dest="signals", metavar="BLOCK.PORT",
+                      help="signal to plot (repeatable; default: all logged signals)")
+    plot.add_argument("-o", "--output", type=Path, help="PNG file (default: RUN_DIR/plots/signals.png)")
+    plot.set_defaults(handler=cmd_plot)
+
+    types = sub.add_parser("blocks", help="list block types with their ports and parameters")
+    types.add_argument("types", nargs="*", metavar="TYPE", help="only these types")
+    types.set_defaults(handler=cmd_blocks)
+    return parser
+
+
+def _diagram_args(p: argparse.ArgumentParser) -> None:
+    p.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
+    p.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
+                   help="override a parameter (value read as YAML; repeatable), e.g. --set prop.k=2")
+    p.add_argument("--t-end", "--stop-time", dest="t_end", metavar="T",
+                   help="end time, e.g. 2, '0.5 s' or '300 ms' (default: the diagram's time.t_end)")
+    p.add_argument("--trust", action="store_true",
+                   help="allow 'python:module:Class' block types, which import code named in the diagram")
+
+
+def _version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("hierhand")
+    except metadata.PackageNotFoundError:
+        return "(not installed)"
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``["plant.k=2", "ctrl.gains=[1, 2]"]`` -> {"plant.k": 2, "ctrl.gains": [1, 2]}."""
+    overrides: dict[str, Any] = {}
+    for item in items:
+        key, eq, text = item.partition("=")
+        key = key.strip()
+        if not eq or "." not in key or not all(key.split(".")):
+            raise UsageError(f"--set {item!r}: expected BLOCK.PARAM=VALUE, e.g. --set prop.k=2")
+        try:
+            overrides[key] = yaml.safe_load(text) if text.strip() else None
+        except yaml.YAMLError as exc:
+            first = str(exc).splitlines()[0]
+            raise UsageError(f"--set {item!r}: the value is not valid YAML ({first})") from None
+        if overrides[key] is None:
+            raise UsageError(f"--set {item!r}: no value after '='")
+    return overrides
+
+
+def load(args: argparse.Namespace):
+    from blocks import load_diagram
+
+    return load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
+
+
+def end_time(args: argparse.Namespace, diagram):
+    from blocks import DiagramError
+    from blocks.timebase import DurationError, parse_duration
+
+    if args.t_end is None:
+        if diagram.t_end is None:
+            raise DiagramError([diagram.issue(None, "no end time", "add time: {t_end: 1 s} to the "
+                                              "diagram or pass --t-end")])
+        return diagram.t_end
+    try:
+        t_end = parse_duration(args.t_end)
+    except DurationError as exc:
+        raise UsageError(f"--t-end: {exc}") from None
+    if t_end <= 0:
+        raise UsageError(f"--t-end must be positive, got {args.t_end!r}")
+    return t_end
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr, shown only on a terminal and after one second."""
+
+    def __init__(self, t_end: float, enabled: bool):
+        self.t_end = t_end
+        self.enabled = enabled and sys.stderr.isatty()
+        self.shown = False
+
+    def __call__(self, fraction: float, elapsed: float) -> None:
+        if not self.enabled or (elapsed < 1.0 and not self.shown):
+            return
+        self.shown = True
+        width = 30
+        filled = int(width * fraction)
+        eta = elapsed * (1 - fraction) / fraction if fraction > 0 else float("nan")
+        sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
+                         f"t = {fraction * self.t_end:.4g} / {self.t_end:.4g} s  eta {eta:5.1f} s ")
+        sys.stderr.flush()
+
+    def close(self) -> None:
+        if self.shown:
+            sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from blocks import simulate
+    from blocks.plot import plot_signals
+
+    diagram = load(args)
+    t_end = end_time(args, diagram)
+    out = args.output or Path("runs") / diagram.name
+    bar = ProgressBar(float(t_end), enabled=not args.quiet)
+    try:
+        results = simulate(diagram, t_end=t_end, progress=bar)
+    finally:
+        bar.close()
+    results.save(out, csv=args.csv)
+    plots = []
+    if args.plot and len(results):
+        plots = plot_signals(results, out / "plots" / "signals.png")
+    if not results.complete:
+        print(f"hierhand: {diagram.file}: {results.status}", file=sys.stderr)
+        print(f"hierhand: partial results (marked incomplete) saved in {out}", file=sys.stderr)
+        return EXIT_FAILED
+    if not args.quiet:
+        info = results.info
+        rtf = info.get("real_time_factor")
+        print(f"{diagram.name}: {float(t_end):g} s simulated in {info['wall_time_s']:.3g} s"
+              + (f" ({rtf:.3g}x real time)" if rtf else "") + f"; results in {out}"
+              + (f", plots: {', '.join(str(p) for p in plots)}" if plots else ""))
+    return EXIT_OK
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from blocks import build_schedule
+    from blocks.timebase import format_duration
+
+    diagram = load(args)
+    t_end = end_time(args, diagram) if (args.t_end or diagram.t_end) else None
+    s = build_schedule(diagram, t_end)
+    print(f"diagram {diagram.name!r} ({diagram.file}): valid")
+    if diagram.description:
+        print(f"  {diagram.description}")
+    print(f"base tick: {format_duration(s.base_tick)}; hyperperiod: {s.hyperperiod} ticks "
+          f"({format_duration(s.hyperperiod * s.base_tick)})"
+          + (f"; t_end: {format_duration(t_end)} = {s.n_ticks} ticks" if t_end else ""))
+    print("blocks:")
+    wn = max(len(n) for n in diagram.blocks)
+    wt = max(len(b.type_name) for b in diagram.blocks.values())
+    for name, spec in diagram.blocks.items():
+        blk = spec.block
+        ins = ", ".join(f"{p}[{w}]" for p, w in blk.inputs.items()) or "-"
+        outs = ", ".join(f"{p}[{w}]" for p, w in blk.outputs.items()) or "-"
+        notes = []
+        if name in s.advanced:
+            notes.append("advanced between events")
+        if blk.has_feedthrough():
+            notes.append("feedthrough")
+        print(f"  {name:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
+              + (f"  ({', '.join(notes)})" if notes else ""))
+    print("execution order:")
+    print(f"  t = 0: {s.initial.describe()}")
+    seen: dict[int, list[int]] = {}
+    for r, j in zip(s.event_ticks, s.event_programs):
+        seen.setdefault(j, []).append(int(r))
+    for j, ticks in seen.items():
+        at = ", ".join(format_duration(r * s.base_tick) for r in ticks[:6]) + (", ..." if len(ticks) > 6 else "")
+        print(f"  at {at} (mod {format_duration(s.hyperperiod * s.base_tick)}): {s.programs[j].describe()}")
+    if not s.event_ticks.size and s.advanced:
+        print(f"  no other events: {', '.join(sorted(s.advanced))} advanced from t = 0 to t_end")
+    return EXIT_OK
+
+
+def cmd_graph(args: argparse.Namespace) -> int:
+    from blocks import build_schedule
+    from blocks.graph import render, to_dot
+
+    diagram = load(args)
+    schedule = build_schedule(diagram, None)
+    out = args.output
+    if out is None:
+        sys.stdout.write(to_dot(diagram, schedule))
+        return EXIT_OK
+    suffix = out.suffix.lower()
+    if suffix in (".dot", ".gv"):
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(to_dot(diagram, schedule), encoding="utf-8")
+    elif suffix in (".svg", ".png", ".pdf"):
+        render(diagram, schedule, out)
+    else:
+        raise UsageError(f"-o {out}: unknown format {suffix or '(none)'!r}; use .dot, .svg or .png")
+    print(f"wrote {out}")
+    return EXIT_OK
+
+
+def cmd_plot(args: argparse.Namespace) -> int:
+    from blocks import Results
+    from blocks.plot import plot_signals
+
+    results = Results.load(args.run_dir)
+    out = args.output or args.run_dir / "plots" / "signals.png"
+    try:
+        written = plot_signals(results, out, args.signals)
+    except (KeyError, ValueError) as exc:
+        raise UsageError(str(exc).strip("'\"")) from None
+    for path in written:
+        print(f"wrote {path}")
+    return EXIT_OK
+
+
+def cmd_blocks(args: argparse.Namespace) -> int:
+    from blocks.registry import block_types
+    from blocks.typeinfo import describe_type
+
+    types = block_types()
+    wanted = args.types or sorted(types)
+    unknown = [t for t in wanted if t not in types]
+    if unknown:
+        raise UsageError(f"unknown block type(s): {', '.join(unknown)}; known: {', '.join(sorted(types))}")
+    print("\n\n".join(describe_type(types[name]) for name in wanted))
+    return EXIT_OK
+
+
+def entry() -> None:
+    """Console-script entry point."""
+    if os.environ.get("HIERHAND_DEBUG"):
+        sys.exit(main())
+    try:
+        sys.exit(main())
+    except BrokenPipeError:  # e.g. 'hierhand blocks | head': the reader has gone, nothing to report
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        sys.exit(EXIT_OK)
+    except Exception as exc:  # an internal error still gets one line and a way to see more
+        print(f"hierhand: internal error: {type(exc).__name__}: {exc} "
+              "(set HIERHAND_DEBUG=1 for the traceback, and please report it)", file=sys.stderr)
+        sys.exit(EXIT_FAILED)
+
+
+if __name__ == "__main__":
+    entry()

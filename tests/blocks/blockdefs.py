@@ -1,0 +1,77 @@
+"""Small blocks used by the executor tests (loaded with ``python:`` types and trust)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from blocks import Block, BlockError
+
+
+class Accumulator(Block):
+    """x[k+1] = x[k] + u; y = x. No feedthrough; reference-loop advance only."""
+
+    def __init__(self, width: int = 1):
+        self.inputs = {"u": width}
+        self.outputs = {"y": width}
+        self.feedthrough = False
+        self.width = width
+
+    def initial_state(self):
+        return np.zeros(self.width)
+
+    def output(self, t, state, inputs):
+        return {"y": state.copy()}
+
+    def update(self, t, state, inputs):
+        return state + inputs["u"]
+
+
+class FastAccumulator(Accumulator):
+    """The same equations with an overridden (closed-form) ``advance``."""
+
+    def advance(self, t, state, inputs, n):
+        steps = np.arange(1, n + 1)[:, None]
+        rows = state[None, :] + steps * inputs["u"][None, :]
+        return rows[-1].copy(), {"y": rows}
+
+
+class SplitFeedthrough(Block):
+    """Two outputs: ``direct`` = u (feedthrough), ``held`` = state (none); state <- u."""
+
+    def __init__(self):
+        self.inputs = {"u": 1}
+        self.outputs = {"direct": 1, "held": 1}
+        self.feedthrough = {"direct": {"u"}, "held": set()}
+
+    def initial_state(self):
+        return np.array([1.0])
+
+    def output(self, t, state, inputs):
+        return {"direct": inputs["u"].copy(), "held": state.copy()}
+
+    def update(self, t, state, inputs):
+        return inputs["u"].copy()
+
+
+class FailAfter(Block):
+    """Passes u through until ``t_fail``, then raises a BlockError on port y."""
+
+    def __init__(self, t_fail: float = 0.005):
+        self.inputs = {"u": 1}
+        self.outputs = {"y": 1}
+        self.t_fail = t_fail
+
+    def output(self, t, state, inputs):
+        if t >= self.t_fail:
+            raise BlockError("value out of range", port="y")
+        return {"y": inputs["u"].copy()}
+
+
+class Clock(Block):
+    """y = t, so tests can see exactly when a block fired."""
+
+    time_varying = True
+    outputs = {"y": 1}
+
+    def output(self, t, state, inputs):
+        return {"y": np.array([t])}

@@ -1,0 +1,287 @@
+"""Semantics of the multirate executor against hand-written loops and closed forms."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import blocks
+from blocks import loads_diagram, simulate
+
+ROOT = Path(__file__).resolve().parents[2]
+DEFS = "python:tests.blocks.blockdefs"
+
+
+def run(text: str, t_end=None, trust: bool = True):
+    return simulate(loads_diagram(text, filename="test.yaml", trust=trust), t_end=t_end)
+
+
+def toy_hand_loop(n_ticks: int) -> np.ndarray:
+    """The toy diagram written out: plant every tick, integ every 10, prop every 100 ticks."""
+    xp = xi = yprop = u = 0.0
+    out = np.empty(n_ticks + 1)
+    for k in range(n_ticks + 1):
+        out[k] = xp
+        if k == n_ticks:
+            break
+        if k % 10 == 0:
+            e = 1.0 - xp
+            yi = xi
+            if k % 100 == 0:
+                yprop = 5.0 * e
+            u = yi + yprop
+            xi += 0.02 * e
+        xp = 0.999 * xp + 1.0e-4 * u
+    return out
+
+
+def test_toy_multirate_equals_hand_written_loop():
+    diagram = blocks.load_diagram(ROOT / "diagrams" / "toy.yaml")
+    results = simulate(diagram)
+    t, y = results["plant.y"]
+    ref = toy_hand_loop(10000)
+    assert results.complete
+    assert y.shape == (10001, 1)
+    np.testing.assert_allclose(y[:, 0], ref, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(t, np.arange(10001) / 10000)
+
+
+def test_toy_logging_an_inherited_signal_changes_nothing():
+    """Logging err makes it fire at every plant hit instead of on demand, so every tick is
+    an event and the plant is stepped one hit at a time: the same plant.y up to rounding."""
+    text = (ROOT / "diagrams" / "toy.yaml").read_text()
+    base = simulate(loads_diagram(text))
+    logged_diagram = loads_diagram(text.replace("log: [plant.y]", "log: [plant.y, err.y]"))
+    assert not blocks.build_schedule(logged_diagram, logged_diagram.t_end).advanced
+    logged = simulate(logged_diagram)
+    np.testing.assert_allclose(base["plant.y"][1], logged["plant.y"][1], rtol=1e-12, atol=0)
+    t_err, err = logged["err.y"]
+    assert len(t_err) == 10001
+    np.testing.assert_allclose(err[:, 0], 1.0 - logged["plant.y"][1][:, 0], atol=1e-15)
+
+
+def test_offset_block_fires_at_exact_offsets():
+    res = run(f"""
+time: {{t_end: 5 ms}}
+blocks:
+  clk: {{type: "{DEFS}:Clock", period: 1 ms, offset: 0.5 ms}}
+  fast: {{type: "{DEFS}:Clock", period: 0.25 ms}}
+log: [clk.y, fast.y]
+""")
+    t, y = res["clk.y"]
+    np.testing.assert_array_equal(t, [0.0005, 0.0015, 0.0025, 0.0035, 0.0045])
+    np.testing.assert_array_equal(y[:, 0], t)
+    tf, _ = res["fast.y"]
+    assert len(tf) == 21 and tf[2] == 0.0005 and tf[-1] == 0.005
+
+
+def test_step_switches_exactly_at_a_decimal_time():
+    """0.3 s is not a binary float, but k * tick is computed so the hit at 0.3 s sees t >= 0.3."""
+    res = run("""
+time: {t_end: 0.5 s}
+blocks:
+  s: {type: Step, period: 0.1 ms, params: {time: 0.3}}
+log: [s.y]
+""")
+    t, y = res["s.y"]
+    first = int(np.argmax(y[:, 0] > 0.5))
+    assert first == 3000 and t[first] == 0.3
+
+
+def test_inherited_block_fires_when_any_source_fires():
+    res = run(f"""
+time: {{t_end: 6 ms}}
+blocks:
+  a: {{type: "{DEFS}:Clock", period: 2 ms}}
+  b: {{type: "{DEFS}:Clock", period: 3 ms}}
+  s: {{type: Sum, params: {{signs: "++"}}}}
+connections: [a.y -> s.u0, b.y -> s.u1]
+log: [s.y]
+""")
+    t, y = res["s.y"]
+    np.testing.assert_allclose(t, [0, 0.002, 0.003, 0.004, 0.006])
+    # held values: a at 0,2,4,6 ms; b at 0,3,6 ms
+    np.testing.assert_allclose(y[:, 0], [0, 0.002, 0.005, 0.007, 0.012])
+
+
+def test_constant_source_feeds_a_fast_block():
+    res = run("""
+time: {t_end: 2 ms}
+blocks:
+  c: {type: Constant, params: {value: [1.5, -2.0]}}
+  g: {type: Gain, period: 0.1 ms, params: {k: 2.0}}
+connections: [c.y -> g.u]
+log: [g.y, c.y]
+""")
+    t, y = res["g.y"]
+    assert len(t) == 21
+    np.testing.assert_array_equal(y, np.tile([3.0, -4.0], (21, 1)))
+    tc, yc = res["c.y"]
+    np.testing.assert_array_equal(tc, [0.0])
+
+
+def test_value_logged_at_t_end_is_the_state_after_the_last_update():
+    res = run(f"""
+time: {{t_end: 10 ms}}
+blocks:
+  one: {{type: Constant, params: {{value: 1.0}}}}
+  acc: {{type: "{DEFS}:Accumulator", period: 1 ms}}
+connections: [one.y -> acc.u]
+log: [acc.y]
+""")
+    t, y = res["acc.y"]
+    np.testing.assert_array_equal(t, np.arange(11) / 1000)
+    np.testing.assert_array_equal(y[:, 0], np.arange(11))
+
+
+def test_delay_one_sample_of_the_destination_rate():
+    res = run(f"""
+time: {{t_end: 5 ms}}
+blocks:
+  clk: {{type: "{DEFS}:Clock", period: 0.5 ms}}
+  g: {{type: Gain, period: 1 ms, params: {{k: 1.0}}}}
+connections:
+  - {{from: clk.y, to: g.u, delay: 1, initial: -1.0}}
+log: [g.y]
+""")
+    t, y = res["g.y"]
+    np.testing.assert_allclose(t, np.arange(6) / 1000)
+    # at g's hit j it sees clk as sampled at g's hit j-1
+    np.testing.assert_allclose(y[:, 0], [-1.0, 0.0, 0.001, 0.002, 0.003, 0.004])
+
+
+def test_delay_breaks_an_algebraic_loop():
+    """y[k] = 0.5 * y[k-1] + 1 through a delayed feedback wire: the closed form 2 - 2^-k."""
+    res = run("""
+time: {t_end: 10 ms}
+blocks:
+  one: {type: Constant, params: {value: 1.0}}
+  s: {type: Sum, period: 1 ms, params: {signs: "++"}}
+  g: {type: Gain, params: {k: 0.5}}
+connections:
+  - one.y -> s.u0
+  - s.y -> g.u
+  - {from: g.y, to: s.u1, delay: 1}
+log: [s.y]
+""")
+    t, y = res["s.y"]
+    k = np.arange(11)
+    expected = np.concatenate(([1.0], 2 - 0.5 ** k[1:] * 1.0))
+    expected = 2 - 0.5 ** k
+    np.testing.assert_allclose(y[:, 0], expected, atol=1e-15)
+
+
+def test_zero_order_hold_between_rates_both_ways():
+    res = run(f"""
+time: {{t_end: 4 ms}}
+blocks:
+  slow: {{type: "{DEFS}:Clock", period: 1 ms}}
+  up: {{type: Gain, period: 0.25 ms, params: {{k: 1.0}}}}
+  fast: {{type: "{DEFS}:Clock", period: 0.25 ms}}
+  down: {{type: ZeroOrderHold, period: 1 ms}}
+connections: [slow.y -> up.u, fast.y -> down.u]
+log: [up.y, down.y]
+""")
+    t, y = res["up.y"]
+    np.testing.assert_allclose(y[:, 0], np.floor(t * 1000 + 1e-9) / 1000)
+    td, yd = res["down.y"]
+    np.testing.assert_allclose(yd[:, 0], td)
+
+
+def test_fast_advance_gives_the_same_result_as_stepping():
+    text = """
+time: {{t_end: 20 ms}}
+blocks:
+  src: {{type: "{defs}:Clock", period: 1 ms}}
+  acc: {{type: "{defs}:{kind}", period: 0.1 ms}}
+  g: {{type: Gain, params: {{k: -0.01}}}}
+  s: {{type: Sum, params: {{signs: "++"}}}}
+connections: [src.y -> s.u0, acc.y -> g.u, g.y -> s.u1, s.y -> acc.u]
+log: [acc.y, {{signal: src.y, decimate: 3}}]
+"""
+    slow = loads_diagram(text.format(defs=DEFS, kind="Accumulator"), trust=True)
+    fast = loads_diagram(text.format(defs=DEFS, kind="FastAccumulator"), trust=True)
+    # acc feeds itself through g and s, so it cannot be advanced; make the loop slow instead
+    assert not blocks.build_schedule(fast, fast.t_end).advanced
+    text_open = text.replace("acc.y -> g.u, g.y -> s.u1", "src.y -> g.u, g.y -> s.u1")
+    slow = loads_diagram(text_open.format(defs=DEFS, kind="Accumulator"), trust=True)
+    fast = loads_diagram(text_open.format(defs=DEFS, kind="FastAccumulator"), trust=True)
+    assert blocks.build_schedule(fast, fast.t_end).advanced == {"acc"}
+    assert not blocks.build_schedule(slow, slow.t_end).advanced
+    r_slow, r_fast = simulate(slow), simulate(fast)
+    for name in ("acc.y", "src.y"):
+        np.testing.assert_array_equal(r_slow[name][0], r_fast[name][0])
+        np.testing.assert_allclose(r_slow[name][1], r_fast[name][1], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(r_fast["src.y"][0], np.arange(0, 21, 3) / 1000)
+
+
+def test_per_port_feedthrough_allows_a_loop_through_the_non_feedthrough_port():
+    """held -> gain -> u is no algebraic loop because only 'direct' reads u."""
+    res = run(f"""
+time: {{t_end: 5 ms}}
+blocks:
+  b: {{type: "{DEFS}:SplitFeedthrough", period: 1 ms}}
+  g: {{type: Gain, params: {{k: 2.0}}}}
+connections: [b.held -> g.u, g.y -> b.u]
+log: [b.direct, b.held]
+""")
+    _, direct = res["b.direct"]
+    _, held = res["b.held"]
+    # held[k] = 2^k (state <- 2 * held), direct[k] = 2 * held[k]
+    np.testing.assert_allclose(held[:, 0], 2.0 ** np.arange(6))
+    np.testing.assert_allclose(direct[:, 0], 2.0 ** np.arange(1, 7))
+
+
+def test_failure_keeps_partial_results():
+    res = run(f"""
+time: {{t_end: 10 ms}}
+blocks:
+  clk: {{type: "{DEFS}:Clock", period: 1 ms}}
+  f: {{type: "{DEFS}:FailAfter", params: {{t_fail: 0.0045}}}}
+connections: [clk.y -> f.u]
+log: [clk.y, f.y]
+""")
+    assert not res.complete
+    assert res.status.startswith("failed at t=0.005 s") and "'f'" in res.status and "f.y" in res.status
+    t, y = res["f.y"]
+    np.testing.assert_allclose(t, [0, 0.001, 0.002, 0.003, 0.004])
+    assert res["clk.y"][0][-1] == 0.005
+
+
+def test_failure_can_raise_with_results():
+    diagram = loads_diagram(f"""
+time: {{t_end: 10 ms}}
+blocks:
+  clk: {{type: "{DEFS}:Clock", period: 1 ms}}
+  f: {{type: "{DEFS}:FailAfter", params: {{t_fail: 0.003}}}}
+connections: [clk.y -> f.u]
+log: [f.y]
+""", trust=True)
+    with pytest.raises(blocks.SimulationError) as info:
+        simulate(diagram, raise_on_failure=True)
+    assert info.value.block == "f" and info.value.port == "y" and info.value.time == 0.003
+    assert len(info.value.results["f.y"][0]) == 3
+
+
+def test_progress_reaches_one():
+    calls = []
+    simulate(blocks.load_diagram(ROOT / "diagrams" / "toy.yaml"), t_end="0.5 s",
+             progress=lambda f, e: calls.append(f))
+    assert calls[-1] == 1.0 and all(0 <= f <= 1 for f in calls)
+    assert calls == sorted(calls)
+
+
+def test_simulate_end_time_override_must_fit_the_base_tick():
+    diagram = blocks.load_diagram(ROOT / "diagrams" / "toy.yaml")
+    with pytest.raises(blocks.DiagramError, match="not a multiple of the base tick"):
+        simulate(diagram, t_end="0.00005")
+    assert simulate(diagram, t_end="2 ms")["plant.y"][0][-1] == 0.002
+
+
+def test_a_diagram_object_is_reusable():
+    diagram = blocks.load_diagram(ROOT / "diagrams" / "toy.yaml")
+    a = simulate(diagram, t_end=0.1)
+    b = simulate(diagram, t_end=0.1)
+    np.testing.assert_array_equal(a["plant.y"][1], b["plant.y"][1])
