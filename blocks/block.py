@@ -9,6 +9,7 @@ checkpointed or batched by copying its state.
 
 from __future__ import annotations
 
+import functools
 import inspect
 from fractions import Fraction
 from typing import Any, ClassVar, Mapping
@@ -113,12 +114,12 @@ class Block:
     @classmethod
     def parameters(cls) -> dict[str, inspect.Parameter]:
         """The block's parameters: the keyword arguments of its ``__init__``."""
-        sig = inspect.signature(cls.__init__)
-        return {
-            name: p
-            for name, p in sig.parameters.items()
-            if name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)
-        }
+        return _init_parameters(cls.__init__)
+
+    @classmethod
+    def accepts_any_parameter(cls) -> bool:
+        """True when ``__init__`` takes ``**kwargs`` (parameters are then not checked by name)."""
+        return any(p.kind == p.VAR_KEYWORD for p in inspect.signature(cls.__init__).parameters.values())
 
     def is_stateful(self) -> bool:
         return self.initial_state() is not None
@@ -137,6 +138,13 @@ class Block:
 
     def has_feedthrough(self) -> bool:
         return any(self.reads(p) for p in self.outputs)
+
+
+@functools.cache
+def _init_parameters(init) -> dict[str, inspect.Parameter]:
+    sig = inspect.signature(init)
+    return {name: p for name, p in sig.parameters.items()
+            if name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
 
 
 def as_vector(value: Any, name: str) -> Signal:

@@ -9,7 +9,6 @@ from __future__ import annotations
 import copy
 import difflib
 import hashlib
-import inspect
 import json
 import re
 from dataclasses import dataclass, field
@@ -29,6 +28,7 @@ TIME_KEYS = ("t_end",)
 BLOCK_KEYS = ("type", "period", "offset", "params", "params_file", "description")
 CONNECTION_KEYS = ("from", "to", "delay", "initial")
 LOG_KEYS = ("signal", "decimate")
+MAX_PORT_WIDTH = 1_000_000
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
 
@@ -120,6 +120,8 @@ class Diagram:
     source_hash: str
     t_end_line: int | None = None
     base_dir: Path = field(default_factory=Path.cwd)
+    plans: dict = field(default_factory=dict, repr=False, compare=False)
+    """Schedules already built for this diagram, by end time (derived data, see build_schedule)."""
 
     def issue(self, line: int | None, message: str, hint: str = "") -> Issue:
         return Issue(self.file, line, message, hint)
@@ -231,7 +233,7 @@ class _Loader:
             raise DiagramError([Issue(self.file, exc.line, exc.message,
                                       "check indentation, colons and brackets near that line")]) from None
         if not isinstance(data, LineDict):
-            raise DiagramError([Issue(self.file, line_of(data, None, 1) if data is not None else 1,
+            raise DiagramError([Issue(self.file, getattr(data, "line", 1) or 1,
                                       "a diagram must be a YAML mapping",
                                       f"top-level keys are: {_known(TOP_KEYS)}")])
         self.check_keys(data, TOP_KEYS, "top-level key")
@@ -359,7 +361,7 @@ class _Loader:
                 self.error(spec.line_of("offset"), f"block '{name}': offset must be in [0, period)",
                            "an offset is a phase within one period")
                 return None
-        params = self.params(name, spec, cls)
+        params = self.params(name, spec, cls, line)
         if params is None:
             return None
         try:
@@ -373,14 +375,14 @@ class _Loader:
         for kind in ("inputs", "outputs"):
             ports = getattr(block, kind)
             if not isinstance(ports, Mapping) or not all(
-                    isinstance(p, str) and (w is None or (isinstance(w, int) and w > 0))
+                    isinstance(p, str) and (w is None or (isinstance(w, int) and 0 < w <= MAX_PORT_WIDTH))
                     for p, w in ports.items()):
                 self.error(line, f"block '{name}' ({type_name}) declares invalid {kind}: {ports!r}",
-                           "ports map names to positive integer widths (or None to infer)")
+                           f"ports map names to integer widths from 1 to {MAX_PORT_WIDTH} (or None to infer)")
                 return None
         return BlockSpec(name, cls.registered_name(), block, period, offset or Fraction(0), params, line)
 
-    def params(self, name: str, spec: LineDict, cls: type[Block]) -> dict | None:
+    def params(self, name: str, spec: LineDict, cls: type[Block], line: int) -> dict | None:
         params: dict = {}
         if "params_file" in spec:
             loaded = self.params_file(spec, name)
@@ -395,8 +397,7 @@ class _Loader:
             return None
         params = deep_merge(params, inline)
         declared = cls.parameters()
-        accepts_any = any(p.kind == p.VAR_KEYWORD for p in
-                          inspect.signature(cls.__init__).parameters.values())
+        accepts_any = cls.accepts_any_parameter()
         ok = True
         for key in list(inline):
             if key not in declared and not accepts_any:
@@ -432,7 +433,7 @@ class _Loader:
                 target[parts[-1]] = value
         missing = [p for p, d in declared.items() if d.default is d.empty and p not in params]
         if missing:
-            self.error(spec.line_of("params") if "params" in spec else spec.line,
+            self.error(spec.line_of("params") if "params" in spec else line,
                        f"block '{name}' ({cls.registered_name()}) is missing parameter(s) "
                        f"{', '.join(missing)}", f"add them under params: of block '{name}'")
             ok = False

@@ -86,6 +86,13 @@ class Schedule:
             ticks = np.concatenate(([0], ticks))
         return ticks.astype(np.int64)
 
+    def hit_count(self, block: str, n_ticks: int) -> int:
+        """How many ticks in [0, n_ticks] ``block`` fires at, without listing them."""
+        mask = self.masks[block]
+        cycles, rest = divmod(n_ticks, self.hyperperiod)
+        count = cycles * int(mask.sum()) + int(mask[:rest + 1].sum())
+        return count + (1 if self.fires_at_zero[block] and not mask[0] else 0)
+
     def rate_text(self, block: str) -> str:
         p = self.period_ticks[block]
         if p is not None:
@@ -99,8 +106,14 @@ class Schedule:
 
 
 def build_schedule(diagram: Diagram, t_end: Fraction | None) -> Schedule:
-    """Plan a run of ``diagram`` to ``t_end`` (None: check everything that does not need it)."""
-    return _Planner(diagram).plan(t_end)
+    """Plan a run of ``diagram`` to ``t_end`` (None: check everything that does not need it).
+
+    A Diagram is not changed after loading, so its plans are kept on it by end time.
+    """
+    plan = diagram.plans.get(t_end)
+    if plan is None:
+        plan = diagram.plans[t_end] = _Planner(diagram).plan(t_end)
+    return plan
 
 
 class _Planner:
@@ -164,6 +177,7 @@ class _Planner:
                 index[firing] = len(programs)
                 programs.append(self.program(firing, lazy, advanced, final=False))
             event_programs.append(index[firing])
+        self.check_loops(masks, lazy)
         firing0 = frozenset(n for n in d.blocks if n not in lazy and (masks[n][0] or at_zero[n]))
         initial = self.program(firing0, lazy, advanced, final=n_ticks == 0, initial=True)
         final = None
@@ -173,6 +187,16 @@ class _Planner:
         return Schedule(base, hyper, n_ticks, period_ticks, offset_ticks, masks, at_zero, lazy,
                         advanced, event_ticks, event_programs, programs, initial,
                         [c for c in d.connections if c.delay], final)
+
+    def check_loops(self, masks, lazy) -> None:
+        """Reject algebraic loops among all blocks that fire together, lazy ones included
+        (a loop of lazy blocks nobody reads is never evaluated, but is still an error)."""
+        if not lazy:
+            return
+        patterns = {frozenset(n for n in self.d.blocks if masks[n][r])
+                    for r in np.flatnonzero(reduce(np.logical_or, (masks[n] for n in lazy)))}
+        for together in patterns:
+            self.order_outputs(set(together))
 
     def fire_sets(self, period_ticks, offset_ticks, hyper):
         """Periodic firing mask over one hyperperiod, and 'fires at t = 0', for every block."""
@@ -209,10 +233,10 @@ class _Planner:
             if s.block.has_fast_advance() and not s.block.has_feedthrough() and period_ticks[n]
             and offset_ticks[n] == 0 and s.block.is_stateful() and n not in delayed_into
             and (n_ticks is None or n_ticks % period_ticks[n] == 0)]
+        upstream = {n: self.upstream_through(n, lazy) for n in candidates}
         chosen: list[str] = []
         for n in candidates:
-            upstream = self.upstream_through(n, lazy)
-            if n in upstream or upstream.intersection(chosen):
+            if n in upstream[n] or upstream[n].intersection(chosen) or any(n in upstream[c] for c in chosen):
                 continue
             chosen.append(n)
         while True:

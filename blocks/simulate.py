@@ -28,6 +28,9 @@ from .timebase import DurationError, format_duration, parse_duration
 ADVANCE_CHUNK = 4096
 """At most this many hits per ``advance`` call, so output buffers stay small."""
 
+MAX_LOG_BYTES = 4 * 2**30
+"""A run refuses to start if its logs would need more memory than this."""
+
 ProgressCallback = Callable[[float, float], None]
 """Called as ``progress(fraction_done, elapsed_wall_seconds)`` during a run."""
 
@@ -70,6 +73,13 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
         if t_end <= 0:
             raise DiagramError([diagram.issue(None, f"t_end must be positive, got {t_end}")])
     schedule = build_schedule(diagram, t_end)
+    log_bytes = sum(8 * diagram.width(e.signal) * -(-schedule.hit_count(e.block, schedule.n_ticks) // e.decimate)
+                    for e in diagram.log)
+    if log_bytes > MAX_LOG_BYTES:
+        raise DiagramError([diagram.issue(None, f"the logged signals would take {log_bytes / 2**30:.3g} GiB "
+                                          f"over t_end = {format_duration(t_end)}",
+                                          "log fewer signals, add 'decimate: N' to log entries or "
+                                          "shorten t_end")])
     results, failure = _Run(diagram, schedule, t_end).execute(progress)
     if failure is not None and raise_on_failure:
         raise failure

@@ -18,8 +18,20 @@ _DURATION = re.compile(
     r"^\s*(?P<num>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<unit>s|ms|us|µs|ns)?\s*$")
 
 
+MIN_DURATION = Fraction(1, 10**12)
+MAX_DURATION = Fraction(10**9)
+"""Nonzero durations outside [1 ps, 1e9 s] are rejected: they are typos, and exact ticks
+of such spans would not fit the executor's integer and float arithmetic."""
+
+
 class DurationError(ValueError):
     """A duration text that is not a number with an optional unit."""
+
+
+def _in_range(seconds: Fraction, text: object) -> Fraction:
+    if seconds != 0 and not MIN_DURATION <= abs(seconds) <= MAX_DURATION:
+        raise DurationError(f"duration {text!r} is out of range (1e-12 s to 1e9 s)")
+    return seconds
 
 
 def parse_duration(value: object) -> Fraction:
@@ -31,17 +43,20 @@ def parse_duration(value: object) -> Fraction:
     if isinstance(value, bool):
         raise DurationError(f"expected a duration, got {value!r}")
     if isinstance(value, int):
-        return Fraction(value)
+        return _in_range(Fraction(value), value)
     if isinstance(value, Fraction):
-        return value
+        return _in_range(value, value)
     if isinstance(value, float):
         if not math.isfinite(value):
             raise DurationError(f"expected a finite duration, got {value!r}")
-        return Fraction(repr(value))
+        return _in_range(Fraction(repr(value)), value)
     if isinstance(value, str):
         m = _DURATION.match(value)
         if m:
-            return Fraction(m["num"]) * _UNITS[m["unit"] or "s"]
+            mantissa, _, exponent = m["num"].lower().partition("e")
+            if exponent and abs(int(exponent)) > 30:
+                raise DurationError(f"duration {value!r} is out of range (1e-12 s to 1e9 s)")
+            return _in_range(Fraction(m["num"]) * _UNITS[m["unit"] or "s"], value)
     raise DurationError(
         f"cannot read {value!r} as a duration; write a number of seconds or a number "
         "with a unit: s, ms, us, ns (e.g. '0.1 ms')")

@@ -17,6 +17,10 @@ _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 """libyaml's parser when PyYAML was built with it (about 10x faster), else pure Python."""
 
 
+_SEQ_TAG = "tag:yaml.org,2002:seq"
+_MAP_TAG = "tag:yaml.org,2002:map"
+
+
 class YamlSourceError(Exception):
     """A YAML text that cannot be read; ``line`` is 1-based, or None when unknown."""
 
@@ -81,6 +85,8 @@ def _build(loader: yaml.SafeLoader, node: yaml.Node, active: set[int]) -> Any:
         raise YamlSourceError("recursive YAML alias", line)
     active.add(id(node))
     try:
+        if node.tag not in (_SEQ_TAG, _MAP_TAG):
+            raise YamlSourceError(f"unsupported YAML tag {node.tag!r}", line)
         if isinstance(node, yaml.SequenceNode):
             out = LineList(_build(loader, item, active) for item in node.value)
             out.line = line

@@ -285,3 +285,20 @@ def test_a_diagram_object_is_reusable():
     a = simulate(diagram, t_end=0.1)
     b = simulate(diagram, t_end=0.1)
     np.testing.assert_array_equal(a["plant.y"][1], b["plant.y"][1])
+
+
+def test_chained_fast_blocks_are_not_both_advanced():
+    """b reads a's output, which changes at every hit of a: only one of them may be advanced."""
+    text = f"""
+time: {{t_end: 5 ms}}
+blocks:
+  src: {{type: "{DEFS}:Clock", period: 1 ms}}
+  b: {{type: "{DEFS}:FastAccumulator", period: 0.1 ms}}
+  a: {{type: "{DEFS}:FastAccumulator", period: 0.1 ms}}
+connections: [src.y -> a.u, a.y -> b.u]
+log: [b.y]
+"""
+    diagram = loads_diagram(text, trust=True)
+    assert len(blocks.build_schedule(diagram, diagram.t_end).advanced) <= 1
+    reference = loads_diagram(text.replace("FastAccumulator", "Accumulator"), trust=True)
+    np.testing.assert_allclose(simulate(diagram)["b.y"][1], simulate(reference)["b.y"][1], rtol=1e-12)

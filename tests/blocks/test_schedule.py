@@ -1,0 +1,98 @@
+"""The tick plan: base tick, hyperperiod, firing sets, lazy and advanced blocks, loops."""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import blocks
+from blocks import build_schedule, loads_diagram
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def toy():
+    return blocks.load_diagram(ROOT / "diagrams" / "toy.yaml")
+
+
+def test_toy_plan():
+    s = build_schedule(toy(), Fraction(1))
+    assert s.base_tick == Fraction(1, 10000) and s.hyperperiod == 100 and s.n_ticks == 10000
+    assert s.lazy == {"err", "u"}
+    assert s.advanced == {"plant"}
+    np.testing.assert_array_equal(s.event_ticks, np.arange(0, 100, 10))
+    outputs = [b for b, _ in s.programs[s.event_programs[0]].evaluate]
+    assert outputs.index("err") < outputs.index("u")
+    assert "plant" not in outputs  # its output at an event comes from the previous advance
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.tuples(st.integers(1, 12), st.integers(0, 11)), min_size=1, max_size=4),
+       st.integers(1, 400))
+def test_hit_count_matches_the_listed_hits(rates, n_ticks):
+    lines = ["blocks:"]
+    for i, (p, o) in enumerate(rates):
+        lines.append(f"  b{i}: {{type: Ramp, period: {p} ms, offset: {o % p} ms}}")
+    lines.append("  s: {type: Sum, params: {signs: '" + "+" * len(rates) + "'}}")
+    lines.append("connections: [" + ", ".join(f"b{i}.y -> s.u{i}" for i in range(len(rates))) + "]")
+    d = loads_diagram("\n".join(lines))
+    s = build_schedule(d, n_ticks * build_schedule(d, None).base_tick)
+    for name in d.blocks:
+        hits = s.hits(name, s.n_ticks)
+        assert s.hit_count(name, s.n_ticks) == len(hits)
+        assert np.all(np.diff(hits) > 0) and (hits.size == 0 or hits[-1] <= s.n_ticks)
+    # an inherited block fires exactly when one of its sources does
+    union = np.unique(np.concatenate([s.hits(f"b{i}", s.n_ticks) for i in range(len(rates))]))
+    np.testing.assert_array_equal(s.hits("s", s.n_ticks), union)
+
+
+def test_algebraic_loop_through_inherited_blocks_names_the_chain():
+    with pytest.raises(blocks.DiagramError) as info:
+        loads_diagram("""
+blocks:
+  src: {type: Ramp, period: 1 ms}
+  a: {type: Sum, params: {signs: "++"}}
+  b: {type: Gain, params: {k: 0.5}}
+connections:
+  - src.y -> a.u0
+  - a.y -> b.u
+  - b.y -> a.u1
+""", filename="loop.yaml")
+    (issue,) = info.value.issues
+    assert issue.message == "algebraic loop: a.y -> b.u -> b.y -> a.u1 -> a.y"
+    assert issue.line in (8, 9)
+
+
+def test_blocks_that_never_fire_together_form_no_algebraic_loop():
+    d = loads_diagram("""
+time: {t_end: 4 ms}
+blocks:
+  src: {type: Ramp, period: 2 ms}
+  a: {type: Sum, period: 2 ms, params: {signs: "++"}}
+  b: {type: Gain, period: 2 ms, offset: 1 ms, params: {k: 0.5}}
+connections: [src.y -> a.u0, a.y -> b.u, b.y -> a.u1]
+log: [a.y, b.y]
+""")
+    r = blocks.simulate(d)
+    np.testing.assert_allclose(r["a.y"][1][:, 0], [0.0, 0.002, 0.005])
+    np.testing.assert_allclose(r["b.y"][1][:, 0], [0.0, 0.001])
+
+
+def test_incommensurate_periods_are_refused():
+    with pytest.raises(blocks.DiagramError, match="hyperperiod"):
+        loads_diagram("""
+blocks:
+  a: {type: Ramp, period: 0.000997 s}
+  b: {type: Ramp, period: 0.001009 s}
+  c: {type: Ramp, period: 0.0001013 s}
+""")
+
+
+def test_huge_logs_are_refused_before_the_run():
+    with pytest.raises(blocks.DiagramError, match="GiB"):
+        blocks.simulate(toy(), t_end="1e6 s")
