@@ -1,0 +1,340 @@
+"""The hand file: YAML (or a dict) describing three fingers, the object and the contact law.
+
+Loading is strict so that a typo never silently becomes a default: unknown keys are
+rejected and every field is checked, and all problems of a file are reported at once,
+each naming its field (``fingers[1].links[2].mass must be > 0``). Top-level sections are
+optional and default to the shipped hand (``default_hand.yaml`` beside this module);
+``object`` and ``contact`` may be partial, their missing keys taken from the default.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, Mapping
+
+import yaml
+
+DEFAULT_HAND_FILE = Path(__file__).with_name("default_hand.yaml")
+
+N_FINGERS = 3
+N_LINKS = 3
+
+SECTIONS = ("gravity", "fingers", "object", "contact")
+FINGER_KEYS = ("name", "base", "base_angle", "links", "damping", "armature", "tip_radius", "q0")
+LINK_KEYS = ("length", "mass", "com", "inertia")
+OBJECT_KEYS = ("mass", "inertia", "size", "pos", "angle", "surface_spacing")
+OBJECT_OPTIONAL = ("inertia",)
+CONTACT_KEYS = ("k_n", "c_n", "k_t", "c_t", "mu_s", "mu_d")
+
+
+class HandFileError(ValueError):
+    """A hand file (or the plant's parameters) is invalid; ``errors`` lists every problem."""
+
+    def __init__(self, errors: list[str], source: str | None = None):
+        self.errors = list(errors)
+        self.source = source
+        where = f" {source}" if source else ""
+        lines = "\n".join(f"  - {e}" for e in self.errors)
+        super().__init__(f"invalid hand file{where}:\n{lines}")
+
+
+@dataclass(frozen=True)
+class LinkParams:
+    """One link: length to the next joint (or to the tip centre), mass, COM and inertia."""
+
+    length: float
+    mass: float
+    com_along: float
+    com_across: float
+    inertia: float
+
+
+@dataclass(frozen=True)
+class FingerParams:
+    name: str
+    base: tuple[float, float]
+    base_angle: float
+    links: tuple[LinkParams, LinkParams, LinkParams]
+    damping: tuple[float, float, float]
+    armature: tuple[float, float, float]
+    tip_radius: float
+    q0: tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class ObjectParams:
+    """The grasped square: its inertia defaults to a uniform plate, m (a^2 + b^2) / 12."""
+
+    mass: float
+    inertia: float
+    size: tuple[float, float]
+    pos: tuple[float, float]
+    angle: float
+    surface_spacing: float
+
+
+@dataclass(frozen=True)
+class ContactParams:
+    k_n: float
+    c_n: float
+    k_t: float
+    c_t: float
+    mu_s: float
+    mu_d: float
+
+
+@dataclass(frozen=True)
+class HandParams:
+    """A validated hand file."""
+
+    gravity: tuple[float, float]
+    fingers: tuple[FingerParams, FingerParams, FingerParams]
+    object: ObjectParams
+    contact: ContactParams
+
+    def to_dict(self) -> dict[str, Any]:
+        """The hand file form of these parameters (``com`` always as ``[along, across]``)."""
+        d = asdict(self)
+        for finger in d["fingers"]:
+            for link in finger["links"]:
+                link["com"] = [link.pop("com_along"), link.pop("com_across")]
+        return _lists(d)
+
+
+def _lists(x: Any) -> Any:
+    if isinstance(x, dict):
+        return {k: _lists(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_lists(v) for v in x]
+    return x
+
+
+def default_hand_dict() -> dict[str, Any]:
+    """The shipped default hand file as a plain dict (a fresh copy)."""
+    with open(DEFAULT_HAND_FILE, encoding="utf-8") as fh:
+        return yaml.safe_load(fh)
+
+
+def read_hand_file(path: str | Path) -> dict[str, Any]:
+    """A hand file's raw content (YAML safe loading); it must be a mapping."""
+    with open(path, encoding="utf-8") as fh:
+        data = yaml.safe_load(fh)
+    if data is None:
+        data = {}
+    if not isinstance(data, dict):
+        raise HandFileError(["the file must be a mapping of sections " + ", ".join(SECTIONS)], str(path))
+    return data
+
+
+def merge_with_default(sections: Mapping[str, Any]) -> dict[str, Any]:
+    """Fill the sections not given (``None`` counts as not given) from the default hand.
+
+    ``gravity`` and ``fingers`` replace the default as a whole; ``object`` and ``contact``
+    are merged key by key, except that a given ``object`` without ``inertia`` gets the plate
+    inertia of its own mass and size rather than the default's number.
+    """
+    merged = default_hand_dict()
+    for key, value in sections.items():
+        if value is None:
+            continue
+        if key in ("object", "contact") and isinstance(value, Mapping):
+            base = dict(merged[key])
+            if key == "object" and "inertia" not in value:
+                base.pop("inertia", None)
+            base.update(value)
+            merged[key] = base
+        else:
+            merged[key] = value
+    return merged
+
+
+def parse_hand(data: Mapping[str, Any], source: str | None = None) -> HandParams:
+    """Validate a complete hand dict (every section present) into ``HandParams``."""
+    check = _Checker()
+    if not isinstance(data, Mapping):
+        raise HandFileError(["the hand must be a mapping of sections " + ", ".join(SECTIONS)], source)
+    check.unknown_keys(data, SECTIONS, "")
+    for key in SECTIONS:
+        if key not in data:
+            check.error(f"{key} is missing")
+    if check.errors:
+        raise HandFileError(check.errors, source)
+
+    gravity = check.vector(data["gravity"], "gravity", 2)
+    fingers = _parse_fingers(check, data["fingers"])
+    obj = _parse_object(check, data["object"])
+    contact = _parse_contact(check, data["contact"])
+    if fingers is not None and obj is not None and not check.errors:
+        smallest = min(f.tip_radius for f in fingers)
+        if obj.surface_spacing >= smallest:
+            check.error(
+                f"object.surface_spacing must be smaller than the smallest tip_radius "
+                f"({smallest:g} m), got {obj.surface_spacing:g}"
+            )
+    if check.errors:
+        raise HandFileError(check.errors, source)
+    return HandParams(gravity=gravity, fingers=fingers, object=obj, contact=contact)
+
+
+def _parse_fingers(check: "_Checker", raw: Any) -> tuple[FingerParams, ...] | None:
+    if not isinstance(raw, list) or len(raw) != N_FINGERS:
+        check.error(f"fingers must be a list of exactly {N_FINGERS} fingers (thumb, fore, middle)")
+        return None
+    fingers = []
+    names: set[str] = set()
+    for i, f in enumerate(raw):
+        path = f"fingers[{i}]"
+        if not isinstance(f, Mapping):
+            check.error(f"{path} must be a mapping with keys " + ", ".join(FINGER_KEYS))
+            fingers.append(None)
+            continue
+        if not check.keys(f, FINGER_KEYS, path):
+            fingers.append(None)
+            continue
+        name = f["name"]
+        if not isinstance(name, str) or not name.strip():
+            check.error(f"{path}.name must be a non-empty string")
+        elif name in names:
+            check.error(f"{path}.name '{name}' is used by another finger")
+        names.add(str(name))
+        links = _parse_links(check, f["links"], f"{path}.links")
+        fingers.append(
+            FingerParams(
+                name=str(name),
+                base=check.vector(f["base"], f"{path}.base", 2),
+                base_angle=check.number(f["base_angle"], f"{path}.base_angle"),
+                links=links,
+                damping=check.vector(f["damping"], f"{path}.damping", N_LINKS, minimum=0.0),
+                armature=check.vector(f["armature"], f"{path}.armature", N_LINKS, minimum=0.0),
+                tip_radius=check.number(f["tip_radius"], f"{path}.tip_radius", positive=True),
+                q0=check.vector(f["q0"], f"{path}.q0", N_LINKS),
+            )
+        )
+    return None if any(f is None for f in fingers) else tuple(fingers)
+
+
+def _parse_links(check: "_Checker", raw: Any, path: str) -> tuple[LinkParams, ...] | None:
+    if not isinstance(raw, list) or len(raw) != N_LINKS:
+        check.error(f"{path} must be a list of exactly {N_LINKS} links (proximal to distal)")
+        return None
+    links = []
+    for j, link in enumerate(raw):
+        lpath = f"{path}[{j}]"
+        if not isinstance(link, Mapping):
+            check.error(f"{lpath} must be a mapping with keys " + ", ".join(LINK_KEYS))
+            continue
+        if not check.keys(link, LINK_KEYS, lpath):
+            continue
+        length = check.number(link["length"], f"{lpath}.length", positive=True)
+        com = link["com"]
+        if isinstance(com, (list, tuple)):
+            along, across = check.vector(com, f"{lpath}.com", 2)
+        else:
+            along, across = check.number(com, f"{lpath}.com"), 0.0
+        links.append(
+            LinkParams(
+                length=length,
+                mass=check.number(link["mass"], f"{lpath}.mass", positive=True),
+                com_along=along,
+                com_across=across,
+                inertia=check.number(link["inertia"], f"{lpath}.inertia", positive=True),
+            )
+        )
+    return tuple(links) if len(links) == N_LINKS else None
+
+
+def _parse_object(check: "_Checker", raw: Any) -> ObjectParams | None:
+    if not isinstance(raw, Mapping):
+        check.error("object must be a mapping with keys " + ", ".join(OBJECT_KEYS))
+        return None
+    if not check.keys(raw, OBJECT_KEYS, "object", optional=OBJECT_OPTIONAL):
+        return None
+    mass = check.number(raw["mass"], "object.mass", positive=True)
+    size = check.vector(raw["size"], "object.size", 2, positive=True)
+    if "inertia" in raw:
+        inertia = check.number(raw["inertia"], "object.inertia", positive=True)
+    else:
+        inertia = mass * (size[0] ** 2 + size[1] ** 2) / 12.0
+    spacing = check.number(raw["surface_spacing"], "object.surface_spacing", positive=True)
+    if spacing > 0 and min(size) > 0 and spacing > min(size) / 4:
+        check.error(f"object.surface_spacing must be at most a quarter of the smallest side, got {spacing:g}")
+    return ObjectParams(
+        mass=mass,
+        inertia=inertia,
+        size=size,
+        pos=check.vector(raw["pos"], "object.pos", 2),
+        angle=check.number(raw["angle"], "object.angle"),
+        surface_spacing=spacing,
+    )
+
+
+def _parse_contact(check: "_Checker", raw: Any) -> ContactParams | None:
+    if not isinstance(raw, Mapping):
+        check.error("contact must be a mapping with keys " + ", ".join(CONTACT_KEYS))
+        return None
+    if not check.keys(raw, CONTACT_KEYS, "contact"):
+        return None
+    c = ContactParams(
+        k_n=check.number(raw["k_n"], "contact.k_n", positive=True),
+        c_n=check.number(raw["c_n"], "contact.c_n", minimum=0.0),
+        k_t=check.number(raw["k_t"], "contact.k_t", positive=True),
+        c_t=check.number(raw["c_t"], "contact.c_t", minimum=0.0),
+        mu_s=check.number(raw["mu_s"], "contact.mu_s", minimum=0.0),
+        mu_d=check.number(raw["mu_d"], "contact.mu_d", minimum=0.0),
+    )
+    if c.mu_d > c.mu_s:
+        check.error(f"contact.mu_d must be <= contact.mu_s (a sliding contact cannot carry more), got {c.mu_d:g} > {c.mu_s:g}")
+    return c
+
+
+class _Checker:
+    """Collects field errors; each check returns a usable value (0.0) even when it fails."""
+
+    def __init__(self) -> None:
+        self.errors: list[str] = []
+
+    def error(self, message: str) -> None:
+        self.errors.append(message)
+
+    def unknown_keys(self, d: Mapping[str, Any], allowed: tuple[str, ...], path: str) -> None:
+        for key in d:
+            if key not in allowed:
+                where = f"{path}.{key}" if path else str(key)
+                self.error(f"{where} is not a known key (allowed: {', '.join(allowed)})")
+
+    def keys(self, d: Mapping[str, Any], allowed: tuple[str, ...], path: str, optional: tuple[str, ...] = ()) -> bool:
+        """Check for unknown and missing keys; ``False`` if a required key is missing."""
+        self.unknown_keys(d, allowed, path)
+        missing = [k for k in allowed if k not in d and k not in optional]
+        for k in missing:
+            self.error(f"{path}.{k} is missing")
+        return not missing
+
+    def number(self, value: Any, path: str, positive: bool = False, minimum: float | None = None) -> float:
+        # PyYAML reads 1e-4 (no dot) as a string, so numeric strings are accepted too.
+        if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+            self.error(f"{path} must be a number, got {value!r}")
+            return 0.0
+        try:
+            x = float(value)
+        except ValueError:
+            self.error(f"{path} must be a number, got {value!r}")
+            return 0.0
+        if not math.isfinite(x):
+            self.error(f"{path} must be finite, got {value!r}")
+            return 0.0
+        if positive and not x > 0:
+            self.error(f"{path} must be > 0, got {x:g}")
+        if minimum is not None and x < minimum:
+            self.error(f"{path} must be >= {minimum:g}, got {x:g}")
+        return x
+
+    def vector(self, value: Any, path: str, n: int, positive: bool = False, minimum: float | None = None) -> tuple[float, ...]:
+        if not isinstance(value, (list, tuple)) or len(value) != n:
+            self.error(f"{path} must be a list of {n} numbers, got {value!r}")
+            return (0.0,) * n
+        return tuple(
+            self.number(v, f"{path}[{i}]", positive=positive, minimum=minimum) for i, v in enumerate(value)
+        )

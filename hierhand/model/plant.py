@@ -1,0 +1,261 @@
+"""``HandPlant``: the hand/object plant as a block (penalty contact, 0.1 ms typical).
+
+The state is one flat float64 vector (layout in ``layout.py``): joint angles and rates,
+object pose and velocity, and the contact bookkeeping (per finger and surface point an
+in-contact flag and an anchor). Copying it checkpoints a run. ``views(state)`` names its
+parts. All physics runs in the compiled kernels of ``kernel.py``; ``advance`` does n steps
+in one call and equals n times ``update`` then ``output``, bit for bit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+from blocks.block import Block, BlockError
+
+from .contact import W_FN, W_FN_PX, W_FN_PY, W_FT, W_OBJ_FX, W_OBJ_FY, W_OBJ_M, W_TIP_M, N_WRENCH
+from .hand import Hand
+from .handfile import merge_with_default, parse_hand
+from .kernel import advance_kernel, contact_kernel, output_kernel, step_kernel
+from .layout import (
+    B_DT,
+    ERR_F_EXT,
+    ERR_OBJ,
+    ERR_OBJ_VEL,
+    ERR_PENETRATION,
+    ERR_Q,
+    ERR_QD,
+    ERR_TAU,
+    N_OUTPUTS,
+    OUTPUT_PORTS,
+    S_OBJ,
+    S_OBJ_VEL,
+    S_Q,
+    S_QD,
+    S_TOUCH,
+    S_WINDOW,
+    anchor_offset,
+    state_size,
+)
+
+_PORT_SLICES = []  # (port, its columns in an output row)
+_offset = 0
+for _name, _width in OUTPUT_PORTS:
+    _PORT_SLICES.append((_name, slice(_offset, _offset + _width)))
+    _offset += _width
+assert _offset == N_OUTPUTS
+_PORT_COLUMNS = [(name, (slice(None), sl)) for name, sl in _PORT_SLICES]  # ready-made 2-D indices
+_F64 = np.dtype(np.float64)
+
+
+@dataclass(frozen=True)
+class StateViews:
+    """Named views into a plant state vector (writing through them changes the state)."""
+
+    q: np.ndarray  # (9,)
+    qd: np.ndarray  # (9,)
+    obj: np.ndarray  # (3,) x, y, theta
+    obj_vel: np.ndarray  # (3,) vx, vy, omega
+    window: np.ndarray  # (3, 4, 2) per finger and edge: first, last point that may touch
+    touching: np.ndarray  # (3, n_points) 1.0 where the point holds an anchor on the tip
+    anchor: np.ndarray  # (3, n_points, 2) anchors in the link-3 frame, from the tip centre
+
+
+@dataclass(frozen=True)
+class ContactWrenches:
+    """Contact forces of a state, per finger (rows thumb, fore, middle)."""
+
+    on_object: np.ndarray  # (3, 2) force the fingertip applies to the object
+    object_moment: np.ndarray  # (3,) its moment about the object's centre
+    on_finger: np.ndarray  # (3, 2) force the object applies to the fingertip
+    finger_moment: np.ndarray  # (3,) its moment about the tip centre
+    point: np.ndarray  # (3, 2) normal-force-weighted contact point (NaN without contact)
+    fn: np.ndarray  # (3,) summed normal force
+    ft: np.ndarray  # (3,) summed tangential force
+    tip: np.ndarray  # (3, 3) tip centre x, y and link-3 angle
+
+
+class HandPlant(Block):
+    """Three-fingered planar hand grasping a square object, with the paper's contact law.
+
+    Parameters are the hand file's sections (``gravity``, ``fingers``, ``object``,
+    ``contact``), each defaulting to the shipped hand. The period is the integration step
+    of a semi-implicit Euler scheme (see ``kernel.py`` for why not explicit Euler).
+
+    Inputs: ``tau`` (9 joint torques), ``f_ext`` (fx, fy, torque on the object; zero when
+    unconnected). Outputs of the state at a hit: ``q``, ``qd``, ``tip`` (x, y, phi per
+    finger, phi the absolute angle of link 3), ``fn`` and ``ft`` (per finger, the normal
+    and tangential forces of its contact points summed, as a fingertip force sensor
+    reports them; ``ft`` is the force on the object along the tip's counter-clockwise
+    tangent), ``ratio`` (|ft| / fn, 0 without contact), ``contact`` (1.0 while fn > 0),
+    ``obj`` (x, y, theta), ``obj_vel``. Summing per point keeps ``ratio <= mu_s`` exact.
+    """
+
+    type_name = "HandPlant"
+    param_docs = {
+        "gravity": "[gx, gy] in m/s^2 (default [0, -9.81])",
+        "fingers": "list of three fingers: base, base_angle, links, damping, armature, tip_radius, q0",
+        "object": "mass, inertia, size, pos, angle, surface_spacing (keys not given keep the default)",
+        "contact": "k_n, c_n, k_t, c_t, mu_s, mu_d (keys not given keep the default)",
+    }
+    feedthrough = False
+
+    def __init__(self, gravity=None, fingers=None, object=None, contact=None):  # noqa: A002 - hand file name
+        sections = {"gravity": gravity, "fingers": fingers, "object": object, "contact": contact}
+        self.hand = Hand(parse_hand(merge_with_default(sections), "HandPlant parameters"))
+        self.inputs = {"tau": 9, "f_ext": 3}
+        self.input_defaults = {"f_ext": np.zeros(3)}
+        self.outputs = dict(OUTPUT_PORTS)
+        self.n_points = self.hand.n_points
+        self._state_shape = (state_size(self.n_points),)
+        self._body = self.hand.body.copy()
+        self.dt: float | None = None
+
+    @classmethod
+    def from_hand(cls, hand: Hand) -> "HandPlant":
+        """A plant for an already loaded ``Hand``."""
+        return cls(**hand.params.to_dict())
+
+    def bind(self, period) -> None:
+        if period is None:
+            raise ValueError("HandPlant needs an explicit period (its integration step, e.g. '0.1 ms')")
+        dt = float(period)
+        if not dt > 0:
+            raise ValueError(f"HandPlant period must be > 0, got {period}")
+        self.period = period
+        self.dt = dt
+        self._body[B_DT] = dt
+
+    # -- state ------------------------------------------------------------------------
+
+    def initial_state(self) -> np.ndarray:
+        state = np.zeros(state_size(self.n_points))
+        v = self.views(state)
+        v.q[:] = self.hand.q0
+        v.obj[:] = self.hand.object_pose0
+        v.window[:, :, 1] = -1.0
+        return state
+
+    def views(self, state: np.ndarray) -> StateViews:
+        n = self.n_points
+        a = anchor_offset(n)
+        return StateViews(
+            q=state[S_Q : S_Q + 9],
+            qd=state[S_QD : S_QD + 9],
+            obj=state[S_OBJ : S_OBJ + 3],
+            obj_vel=state[S_OBJ_VEL : S_OBJ_VEL + 3],
+            window=state[S_WINDOW:S_TOUCH].reshape(3, 4, 2),
+            touching=state[S_TOUCH:a].reshape(3, n),
+            anchor=state[a : a + 6 * n].reshape(3, n, 2),
+        )
+
+    # -- the block contract -------------------------------------------------------------
+
+    def output(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        self._check_state(state)
+        row = np.empty(N_OUTPUTS)
+        code, which = output_kernel(state, self.hand.fingers, self._body, self.hand.edges, row)
+        if code:
+            raise self._error(code, which, t)
+        return {name: row[sl] for name, sl in _PORT_SLICES}
+
+    def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
+        self._check_state(state)
+        tau, f_ext = self._inputs(inputs)
+        code, done, which = step_kernel(state, tau, f_ext, self.hand.fingers, self._body, self.hand.edges)
+        if code:
+            raise self._error(code, which, t + done * self.dt)
+        return state
+
+    def advance(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray], n: int):
+        self._check_state(state)
+        tau, f_ext = self._inputs(inputs)
+        rows = np.empty((n, N_OUTPUTS))
+        code, done, which = advance_kernel(state, tau, f_ext, self.hand.fingers, self._body, self.hand.edges, rows)
+        if code:
+            raise self._error(code, which, t + done * self.dt)
+        return state, {name: rows[index] for name, index in _PORT_COLUMNS}
+
+    # -- inspection -------------------------------------------------------------------
+
+    def contact_wrenches(self, state: np.ndarray) -> ContactWrenches:
+        """The contact forces of ``state`` (the same evaluation the step uses)."""
+        self._check_state(state)
+        tips = np.empty((3, 3))
+        w = np.empty((3, N_WRENCH))
+        code, which = contact_kernel(state, self.hand.fingers, self._body, self.hand.edges, tips, w)
+        if code:
+            raise self._error(code, which, None)
+        on_obj = w[:, [W_OBJ_FX, W_OBJ_FY]].copy()
+        fn = w[:, W_FN].copy()
+        with np.errstate(invalid="ignore", divide="ignore"):
+            point = np.where(fn[:, None] > 0, w[:, [W_FN_PX, W_FN_PY]] / fn[:, None], np.nan)
+        return ContactWrenches(
+            on_object=on_obj,
+            object_moment=w[:, W_OBJ_M].copy(),
+            on_finger=-on_obj,
+            finger_moment=-w[:, W_TIP_M],
+            point=point,
+            fn=fn,
+            ft=w[:, W_FT].copy(),
+            tip=tips,
+        )
+
+    # -- helpers ----------------------------------------------------------------------
+
+    def _check_state(self, state: Any) -> None:
+        if not (state.__class__ is np.ndarray and state.dtype is _F64 and state.shape == self._state_shape):
+            if not (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.shape == self._state_shape):
+                raise BlockError(
+                    f"HandPlant state must be the float64 vector of shape {self._state_shape} made by initial_state()"
+                )
+        if self.dt is None:
+            raise BlockError("HandPlant is not bound to a period; call bind(period) first")
+
+    @staticmethod
+    def _inputs(inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        tau = inputs["tau"]
+        f_ext = inputs.get("f_ext")
+        if f_ext is None:
+            f_ext = _ZERO3
+        if not (tau.__class__ is np.ndarray and tau.dtype is _F64 and tau.shape == (9,)):
+            tau = _port_vector(tau, 9, "tau")
+        if not (f_ext.__class__ is np.ndarray and f_ext.dtype is _F64 and f_ext.shape == (3,)):
+            f_ext = _port_vector(f_ext, 3, "f_ext")
+        return tau, f_ext
+
+    def _error(self, code: int, which: int, t: float | None) -> BlockError:
+        names = self.hand.names
+        when = "in the given state" if t is None else f"at t={t:.10g} s"
+        if code == ERR_PENETRATION:
+            r = self.hand.tip_radius[which]
+            return BlockError(
+                f"HandPlant: contact penetration deeper than the fingertip radius {when}: "
+                f"the {names[which]} tip centre is inside the object (radius {r * 1e3:g} mm); "
+                "the contact is too soft for the forces or the step too large",
+                port="contact",
+            )
+        joint = f"{names[which // 3]} joint {which % 3 + 1}" if code in (ERR_Q, ERR_QD, ERR_TAU) else ""
+        what = {
+            ERR_Q: ("q", f"joint angle q[{which}] ({joint})"),
+            ERR_QD: ("qd", f"joint velocity qd[{which}] ({joint})"),
+            ERR_OBJ: ("obj", f"object pose obj[{which}] ({('x', 'y', 'theta')[which % 3]})"),
+            ERR_OBJ_VEL: ("obj_vel", f"object velocity obj_vel[{which}] ({('vx', 'vy', 'omega')[which % 3]})"),
+            ERR_TAU: ("tau", f"input torque tau[{which}] ({joint})"),
+            ERR_F_EXT: ("f_ext", f"input f_ext[{which}]"),
+        }
+        port, quantity = what[code]
+        return BlockError(f"HandPlant: non-finite value {when}: {quantity} is not finite", port=port)
+
+
+_ZERO3 = np.zeros(3)
+
+
+def _port_vector(x: Any, n: int, name: str) -> np.ndarray:
+    arr = np.ascontiguousarray(x, dtype=np.float64)
+    if arr.shape != (n,):
+        raise BlockError(f"HandPlant input '{name}' must have width {n}, got shape {arr.shape}", port=name)
+    return arr
