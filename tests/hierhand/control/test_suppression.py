@@ -1,0 +1,103 @@
+"""The suppresser's gain: stable sigmoid, magnitude and signed modes, limits."""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from hierhand.control import sigmoid, suppress
+
+finite = st.floats(-1e6, 1e6)
+
+
+def test_sigmoid_is_stable_far_out():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with np.errstate(over="raise", invalid="raise", divide="raise", under="ignore"):
+            assert sigmoid(1000.0) == 1.0
+            assert sigmoid(-1000.0) == 0.0
+            assert sigmoid(-745.0) > 0.0
+            np.testing.assert_array_equal(sigmoid(np.array([-1e308, 0.0, 1e308])), [0.0, 0.5, 1.0])
+
+
+@given(st.floats(-30, 30))
+def test_sigmoid_matches_the_logistic_formula(x):
+    assert sigmoid(x) == pytest.approx(1.0 / (1.0 + math.exp(-x)), rel=1e-14)
+
+
+@given(finite)
+def test_sigmoid_is_symmetric(x):
+    assert sigmoid(-x) == pytest.approx(1.0 - sigmoid(x), abs=1e-15)
+
+
+def test_sigmoid_keeps_shape_and_returns_floats_for_scalars():
+    assert isinstance(sigmoid(0.3), float)
+    assert sigmoid(np.zeros((2, 3))).shape == (2, 3)
+
+
+@given(st.floats(-5, 5), st.floats(0, 50), st.floats(-1, 1))
+def test_magnitude_mode_at_zero_manipulation_torque(tau_g, s_a, s_b):
+    expected = tau_g / (1.0 + math.exp(-s_a * s_b))
+    assert suppress(tau_g, 0.0, s_a, s_b) == pytest.approx(expected, rel=1e-13, abs=1e-300)
+
+
+@pytest.mark.parametrize("tau_m", [-10.0, 10.0, -1e6, 1e6])
+def test_magnitude_mode_suppresses_large_torques_of_either_sign(tau_m):
+    out = suppress(np.array([0.3, -0.2, 1.0]), np.full(3, tau_m), 50.0, 0.05)
+    np.testing.assert_allclose(out, 0.0, atol=1e-9)
+
+
+def test_signed_mode_passes_large_negative_torques_and_suppresses_positive_ones():
+    tau_g = np.array([0.3, -0.2, 1.0])
+    np.testing.assert_allclose(suppress(tau_g, np.full(3, -10.0), 50.0, 0.05, mode="signed"), tau_g, rtol=1e-12)
+    np.testing.assert_allclose(suppress(tau_g, np.full(3, 10.0), 50.0, 0.05, mode="signed"), 0.0, atol=1e-9)
+
+
+@given(st.floats(-5, 5), st.floats(0, 1e3), st.floats(0, 50), st.floats(-1, 1))
+def test_modes_agree_for_non_negative_manipulation_torque(tau_g, tau_m, s_a, s_b):
+    assert suppress(tau_g, tau_m, s_a, s_b, "signed") == suppress(tau_g, tau_m, s_a, s_b, "magnitude")
+
+
+@given(st.floats(0.01, 5), st.floats(0, 10), st.floats(0, 10), st.floats(0.1, 50), st.floats(-1, 1))
+def test_magnitude_mode_never_grows_with_the_torque_size(tau_g, a, b, s_a, s_b):
+    small, large = sorted([a, b])
+    assert suppress(tau_g, -large, s_a, s_b) <= suppress(tau_g, small, s_a, s_b)
+
+
+@pytest.mark.parametrize("s_a", [0.0, 1e-12])
+@pytest.mark.parametrize("mode", ["magnitude", "signed"])
+def test_vanishing_gain_halves_the_grasp_torque(s_a, mode):
+    tau_g = np.array([0.4, -0.1, 2.0])
+    out = suppress(tau_g, np.array([5.0, -3.0, 0.0]), s_a, 0.05, mode=mode)
+    np.testing.assert_allclose(out, tau_g / 2, rtol=1e-9)
+
+
+def test_per_joint_parameters_broadcast():
+    tau_g = np.array([1.0, 1.0, 1.0])
+    tau_m = np.array([0.0, 0.1, -0.1])
+    s_a = np.array([10.0, 20.0, 30.0])
+    s_b = np.array([0.05, 0.1, 0.0])
+    expected = tau_g / (1 + np.exp(-s_a * (s_b - np.abs(tau_m))))
+    np.testing.assert_allclose(suppress(tau_g, tau_m, s_a, s_b), expected, rtol=1e-14)
+    assert isinstance(suppress(1.0, 0.0, 1.0, 0.0), float)
+
+
+@pytest.mark.parametrize(
+    "kwargs, message",
+    [
+        ({"mode": "absolute"}, "mode"),
+        ({"S_a": -1.0}, "S_a"),
+        ({"S_a": np.array([1.0, -0.1])}, "S_a"),
+        ({"S_a": float("nan")}, "S_a"),
+    ],
+)
+def test_bad_parameters_are_rejected(kwargs, message):
+    args = {"tau_g": np.ones(2), "tau_m": np.zeros(2), "S_a": 1.0, "S_b": 0.0}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=message):
+        suppress(**args)
