@@ -309,7 +309,7 @@ class _Planner:
         """Port-level order for blocks whose outputs have different feedthrough."""
         graph = nx.DiGraph()
         wires: dict[tuple, Connection] = {}
-        for n in nodes:
+        for n in sorted(nodes, key=self.order.get):
             blk = self.d.blocks[n].block
             for p in blk.outputs:
                 graph.add_node(("o", n, p))
@@ -325,7 +325,8 @@ class _Planner:
         except nx.NetworkXNoCycle:
             cycle = None
         if cycle:
-            start = next(i for i, e in enumerate(cycle) if e[0][0] == "o")
+            start = min((i for i, e in enumerate(cycle) if e[0][0] == "o"),
+                        key=lambda i: (self.order[cycle[i][0][1]], cycle[i][0][2]))
             cycle = cycle[start:] + cycle[:start]
             chain = [f"{cycle[0][0][1]}.{cycle[0][0][2]}"] + [f"{v[1]}.{v[2]}" for _, v in cycle]
             line = next((wires[e].line for e in cycle if e in wires), None)

@@ -359,6 +359,7 @@ class _Run:
             "base_tick": format_duration(self.s.base_tick),
             "wall_time_s": wall,
             "real_time_factor": simulated / wall if wall > 0 else None,
+            "block_types": {name: spec.type_name for name, spec in self.d.blocks.items()},
             "parameters": self.d.parameters(),
             "versions": dict(package_versions()),
         }

@@ -76,6 +76,21 @@ def build_parser() -> argparse.ArgumentParser:
     plot.add_argument("-o", "--output", type=Path, help="PNG file (default: RUN_DIR/plots/signals.png)")
     plot.set_defaults(handler=cmd_plot)
 
+    animate = sub.add_parser("animate", help="animate the hand, object and contact forces of a run (GIF)",
+                             description="Write a GIF of the hand, the object and the contact force arrows "
+                                         "over time from a results folder (needs PLANT.q and PLANT.obj logged; "
+                                         "arrows need PLANT.fn, PLANT.ft and PLANT.normal).")
+    animate.add_argument("run_dir", type=Path, metavar="RUN_DIR", help="results folder of 'hierhand run'")
+    animate.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.gif", help="GIF file to write")
+    animate.add_argument("--fps", type=float, default=25.0, help="GIF frames per second (default: 25)")
+    timing = animate.add_mutually_exclusive_group()
+    timing.add_argument("--speed", type=float, default=1.0,
+                        help="simulated seconds per second of GIF (default: 1; 0.1 = ten times slower)")
+    timing.add_argument("--every", type=int, metavar="N",
+                        help="instead of --speed: a frame at every N-th logged sample of PLANT.q")
+    animate.add_argument("--plant", metavar="NAME", help="the HandPlant block (needed if the run has several)")
+    animate.set_defaults(handler=cmd_animate)
+
     types = sub.add_parser("blocks", help="list block types with their ports and parameters")
     types.add_argument("types", nargs="*", metavar="TYPE", help="only these types")
     types.set_defaults(handler=cmd_blocks)
@@ -271,6 +286,20 @@ def cmd_plot(args: argparse.Namespace) -> int:
         raise UsageError(str(exc).strip("'\"")) from None
     for path in written:
         print(f"wrote {path}")
+    return EXIT_OK
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    from blocks import Results
+    from hierhand.animation import AnimationError, animate_run
+
+    results = Results.load(args.run_dir)
+    try:
+        written = animate_run(results, args.output, fps=args.fps, speed=args.speed,
+                              plant=args.plant, every=args.every)
+    except AnimationError as exc:
+        raise UsageError(str(exc)) from None
+    print(f"wrote {written}")
     return EXIT_OK
 
 

@@ -16,7 +16,7 @@ from .internal_forces import (
     project_internal,
     required_scale_from_sensors,
 )
-from .inverse_kinematics import UnreachableError, finger_fk, finger_ik, hand_ik, wrap_angle
+from .inverse_kinematics import UnreachableError, finger_fk, finger_ik, finger_ik_near, hand_ik, wrap_angle
 from .suppression import sigmoid, suppress
 from .trajectory import Trajectory
 
@@ -25,6 +25,7 @@ __all__ = [
     "UnreachableError",
     "finger_fk",
     "finger_ik",
+    "finger_ik_near",
     "friction_scale",
     "grasp_matrix",
     "hand_ik",

@@ -170,13 +170,14 @@ def friction_scale(
     c = np.concatenate([a_t - ratio * a_n, -a_t - ratio * a_n])
     d = np.concatenate([ratio * b_n - b_t, ratio * b_n + b_t])
     lo, hi = 0.0, math.inf
-    for ci, di in zip(c, d):
-        if ci > 0:
-            hi = min(hi, di / ci)
-        elif ci < 0:
-            lo = max(lo, di / ci)
-        elif di < 0:
-            return math.inf
+    with np.errstate(over="ignore"):  # a bound beyond float range is no bound: +-inf is right
+        for ci, di in zip(c, d):
+            if ci > 0:
+                hi = min(hi, di / ci)
+            elif ci < 0:
+                lo = max(lo, di / ci)
+            elif di < 0:
+                return math.inf
     return float(lo) if lo <= hi else math.inf
 
 

@@ -117,13 +117,19 @@ def hand_ik(hand: Any, targets: Any, q_ref: Any) -> np.ndarray:
     if q_ref.shape != (9,):
         raise ValueError(f"q_ref must have shape (9,), got {q_ref.shape}")
     q = np.empty(9)
-    for f, (name, base, base_angle, lengths) in enumerate(_finger_geometry(hand)):
-        ref = q_ref[3 * f : 3 * f + 3]
-        try:
-            branches = [finger_ik(base, base_angle, lengths, *targets[f], elbow=e) for e in (1, -1)]
-        except UnreachableError as err:
-            raise UnreachableError(err.distance, err.r_min, err.r_max, name) from None
-        steps = [wrap_angle(b - ref) for b in branches]
-        best = min(steps, key=lambda d: float(np.dot(d, d)))
-        q[3 * f : 3 * f + 3] = ref + best
+    for f in range(3):
+        q[3 * f : 3 * f + 3] = finger_ik_near(hand, f, targets[f], q_ref[3 * f : 3 * f + 3])
     return q
+
+
+def finger_ik_near(hand: Any, finger: int, target: Any, q_ref: Any) -> np.ndarray:
+    """Joint angles (3,) of one finger of ``hand`` for a tip target ``(x, y, phi)``: the
+    elbow branch nearer ``q_ref``, each angle as its representative nearest ``q_ref``."""
+    name, base, base_angle, lengths = _finger_geometry(hand)[finger]
+    ref = np.asarray(q_ref, dtype=float)
+    try:
+        branches = [finger_ik(base, base_angle, lengths, *target, elbow=e) for e in (1, -1)]
+    except UnreachableError as err:
+        raise UnreachableError(err.distance, err.r_min, err.r_max, name) from None
+    steps = [wrap_angle(b - ref) for b in branches]
+    return ref + min(steps, key=lambda d: float(np.dot(d, d)))

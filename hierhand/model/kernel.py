@@ -27,6 +27,8 @@ from numba import njit
 from .contact import (
     N_WRENCH,
     W_FN,
+    W_FN_PX,
+    W_FN_PY,
     W_FT,
     W_OBJ_FX,
     W_OBJ_FY,
@@ -56,6 +58,7 @@ from .layout import (
     O_FN,
     O_FT,
     O_OBJ,
+    O_NORMAL,
     O_OBJ_VEL,
     O_Q,
     O_QD,
@@ -251,9 +254,17 @@ def write_outputs(state, ws, row):
         ft = wrench[f, W_FT]
         row[O_FN + f] = fn
         row[O_FT + f] = ft
+        row[O_NORMAL + 2 * f] = 0.0
+        row[O_NORMAL + 2 * f + 1] = 0.0
         if fn > 0.0:
             row[O_RATIO + f] = abs(ft) / fn
             row[O_CONTACT + f] = 1.0
+            nx = wrench[f, W_FN_PX] / fn - tip[f, 0]
+            ny = wrench[f, W_FN_PY] / fn - tip[f, 1]
+            length = np.sqrt(nx * nx + ny * ny)
+            if length > 0.0:
+                row[O_NORMAL + 2 * f] = nx / length
+                row[O_NORMAL + 2 * f + 1] = ny / length
         else:
             row[O_RATIO + f] = 0.0
             row[O_CONTACT + f] = 0.0

@@ -83,6 +83,7 @@ OUTPUT_PORTS = (
     ("contact", 3),
     ("obj", 3),
     ("obj_vel", 3),
+    ("normal", 6),
 )
 O_Q = 0
 O_QD = 9
@@ -93,7 +94,8 @@ O_RATIO = 33
 O_CONTACT = 36
 O_OBJ = 39
 O_OBJ_VEL = 42
-N_OUTPUTS = 45
+O_NORMAL = 45
+N_OUTPUTS = 51
 
 # -- kernel status codes ---------------------------------------------------------------
 OK = 0

@@ -91,7 +91,9 @@ class HandPlant(Block):
     and tangential forces of its contact points summed, as a fingertip force sensor
     reports them; ``ft`` is the force on the object along the tip's counter-clockwise
     tangent), ``ratio`` (|ft| / fn, 0 without contact), ``contact`` (1.0 while fn > 0),
-    ``obj`` (x, y, theta), ``obj_vel``. Summing per point keeps ``ratio <= mu_s`` exact.
+    ``obj`` (x, y, theta), ``obj_vel``, ``normal`` (per finger the unit vector from the tip
+    centre to its normal-force-weighted contact point: the direction of the normal force on
+    the object, zero without contact). Summing per point keeps ``ratio <= mu_s`` exact.
     """
 
     type_name = "HandPlant"

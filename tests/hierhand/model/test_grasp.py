@@ -49,3 +49,14 @@ def test_pinch_drops_the_object_when_the_squeeze_is_clearly_too_weak(ratio):
     y = logs["obj"][:, 1]
     assert y[t <= 0.05].min() > 0.06 - 0.5e-3  # held up by f_ext at first
     assert y[-1] < 0.06 - 20e-3
+
+
+def test_contact_normals_point_from_each_tip_into_the_face_it_presses():
+    """Thumb presses the left face (+x), forefinger the right face (-x); the middle finger
+    touches nothing, so its normal is zero."""
+    _, logs, _ = pinch_under_gravity(1.5)
+    normal = logs["normal"][-1].reshape(3, 2)
+    np.testing.assert_allclose(normal[0], [1.0, 0.0], atol=0.05)
+    np.testing.assert_allclose(normal[1], [-1.0, 0.0], atol=0.05)
+    np.testing.assert_array_equal(normal[2], [0.0, 0.0])
+    np.testing.assert_allclose(np.linalg.norm(normal[:2], axis=1), 1.0, rtol=1e-12)

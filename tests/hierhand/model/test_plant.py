@@ -17,7 +17,8 @@ def test_ports_and_flags():
     assert plant.registered_name() == "HandPlant"
     assert plant.inputs == {"tau": 9, "f_ext": 3}
     assert plant.outputs == {
-        "q": 9, "qd": 9, "tip": 9, "fn": 3, "ft": 3, "ratio": 3, "contact": 3, "obj": 3, "obj_vel": 3
+        "q": 9, "qd": 9, "tip": 9, "fn": 3, "ft": 3, "ratio": 3, "contact": 3, "obj": 3, "obj_vel": 3,
+        "normal": 6,
     }
     assert np.array_equal(plant.input_defaults["f_ext"], np.zeros(3))
     assert plant.feedthrough is False and not plant.has_feedthrough()

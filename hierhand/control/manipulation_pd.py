@@ -1,0 +1,125 @@
+"""The manipulation controller (the paper's upper level): voluntary fingertip motion.
+
+Fingertip trajectories are given beforehand as timed waypoints (x, y, phi) per finger.
+Every hit (10 ms in the paper) samples them, turns the samples into joint targets by
+exact three-joint inverse kinematics and tracks them with a joint PD. Fingers without a
+trajectory hold their initial joint angles.
+
+Outputs: ``tau_m``, the PD torque of the voluntary motion (what the suppresser weighs
+against the grasping torque), and ``tau_ff``, a feedforward that keeps the 10 ms loop's
+gains small: the fingers' own gravity torques and the object's weight shared equally by
+the fingers in contact (``J^T`` of ``-m g / k``); without it the soft PD lets a held
+object sag by millimetres. The actuator command is the suppresser's output plus
+``tau_ff``. Keeping the feedforward out of ``tau_m`` matters: it is not voluntary
+motion, and a finger that merely carries the object must not have its grasp suppressed.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping
+
+import numpy as np
+
+from blocks import Block
+
+from ..model import load_hand
+from .inverse_kinematics import UnreachableError, finger_ik_near
+from .trajectory import Trajectory
+
+DERIVATIVE_STEP = 1e-3
+"""Seconds either side of t for the joint-velocity target (central difference of the IK)."""
+
+
+class ManipulationPD(Block):
+    """Manipulation controller: fingertip trajectories -> inverse kinematics -> joint PD."""
+
+    type_name = "ManipulationPD"
+    time_varying = True
+    param_docs = {
+        "gravity": "hand file section (default hand if omitted; share the plant's params_file)",
+        "fingers": "hand file section: the three fingers (geometry, q0)",
+        "object": "hand file section: the object's mass is used for the load feedforward",
+        "contact": "hand file section (unused)",
+        "trajectories": "per finger name: {waypoints: [[t, x, y, phi], ...], interpolation: minjerk|linear}",
+        "kp": "joint stiffness, N m/rad (scalar or 9 values)",
+        "kd": "joint damping, N m s/rad (scalar or 9 values)",
+        "gravity_compensation": "add the fingers' own gravity torques",
+        "load_compensation": "add J^T of the object's weight shared by the fingers in contact",
+        "contact_threshold": "normal force, N, above which a finger carries part of the object",
+    }
+
+    def __init__(self, gravity=None, fingers=None, object=None, contact=None,  # noqa: A002
+                 trajectories: Mapping[str, Any] | None = None, kp: Any = 2.0, kd: Any = 0.01,
+                 gravity_compensation: bool = True, load_compensation: bool = True,
+                 contact_threshold: float = 0.05):
+        self.hand = load_hand({"gravity": gravity, "fingers": fingers, "object": object, "contact": contact})
+        self.kp = np.broadcast_to(np.asarray(kp, dtype=float), (9,)).copy()
+        self.kd = np.broadcast_to(np.asarray(kd, dtype=float), (9,)).copy()
+        if np.any(self.kp < 0) or np.any(self.kd < 0) or not np.all(np.isfinite(self.kp + self.kd)):
+            raise ValueError("kp and kd must be finite and non-negative")
+        self.gravity_compensation = bool(gravity_compensation)
+        self.load_compensation = bool(load_compensation)
+        self.threshold = float(contact_threshold)
+        self.weight = self.hand.params.object.mass * self.hand.gravity
+        self.trajectories = self.parse_trajectories(trajectories or {})
+        self.inputs = {"q": 9, "qd": 9, "fn": 3}
+        self.outputs = {"tau_m": 9, "tau_ff": 9, "q_ref": 9}
+        self.feedthrough = True
+
+    def parse_trajectories(self, config: Mapping[str, Any]) -> list[Trajectory | None]:
+        """One trajectory or None per finger; every waypoint checked for reachability."""
+        if not isinstance(config, Mapping):
+            raise ValueError("trajectories must map finger names to {waypoints: [...]}")
+        unknown = [k for k in config if k not in self.hand.names]
+        if unknown:
+            raise ValueError(f"trajectories: unknown finger(s) {', '.join(map(str, unknown))}; "
+                             f"fingers are {', '.join(self.hand.names)}")
+        out: list[Trajectory | None] = []
+        for f, name in enumerate(self.hand.names):
+            if name not in config:
+                out.append(None)
+                continue
+            try:
+                traj = Trajectory.from_config(config[name])
+            except ValueError as exc:
+                raise ValueError(f"trajectory of finger '{name}': {exc}") from None
+            for t, point in zip(traj.times, traj.points):
+                try:
+                    self.joint_targets_for(f, point)
+                except UnreachableError as exc:
+                    raise ValueError(f"finger '{name}': the waypoint at t = {t:g} s "
+                                     f"(x={point[0]:g}, y={point[1]:g}, phi={point[2]:g}) is unreachable: {exc}") from None
+            out.append(traj)
+        return out
+
+    def joint_targets_for(self, finger: int, point: np.ndarray) -> np.ndarray:
+        """Joint angles (3,) of one finger for a tip target, on the branch nearest q0."""
+        return finger_ik_near(self.hand, finger, point, self.hand.q0[3 * finger:3 * finger + 3])
+
+    def reference(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Joint position and velocity targets (9,) at time t."""
+        q_ref = self.hand.q0.copy()
+        qd_ref = np.zeros(9)
+        for f, traj in enumerate(self.trajectories):
+            if traj is None:
+                continue
+            s = slice(3 * f, 3 * f + 3)
+            q_ref[s] = self.joint_targets_for(f, traj.sample(t))
+            if np.any(traj.velocity(t)):
+                ahead = self.joint_targets_for(f, traj.sample(t + DERIVATIVE_STEP))
+                behind = self.joint_targets_for(f, traj.sample(t - DERIVATIVE_STEP))
+                qd_ref[s] = (ahead - behind) / (2 * DERIVATIVE_STEP)
+        return q_ref, qd_ref
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        q, qd = inputs["q"], inputs["qd"]
+        q_ref, qd_ref = self.reference(t)
+        tau_m = self.kp * (q_ref - q) + self.kd * (qd_ref - qd)
+        tau_ff = self.hand.bias(q, np.zeros(9)) if self.gravity_compensation else np.zeros(9)
+        carrying = inputs["fn"] > self.threshold
+        if self.load_compensation and carrying.any():
+            share = -self.weight / carrying.sum()
+            jac = self.hand.tip_jacobians(q)
+            for f in np.flatnonzero(carrying):
+                tau_ff[3 * f:3 * f + 3] += jac[f].T @ share
+        return {"tau_m": tau_m, "tau_ff": tau_ff, "q_ref": q_ref}
