@@ -91,6 +91,15 @@ def build_parser() -> argparse.ArgumentParser:
     animate.add_argument("--plant", metavar="NAME", help="the HandPlant block (needed if the run has several)")
     animate.set_defaults(handler=cmd_animate)
 
+    rep = sub.add_parser("reproduce", help="run the paper's three tasks: figures, summary.json, report.md",
+                         description="Run the grasp, manipulation and re-grasp tasks (with and without "
+                                     "suppresser) and write fig09.png ... fig14.png, summary.json and report.md.")
+    rep.add_argument("-o", "--output", type=Path, default=Path("runs/reproduce"),
+                     help="output folder (default: runs/reproduce)")
+    rep.add_argument("--diagrams", type=Path, default=None,
+                     help="folder of the task diagrams (default: the repository's diagrams/)")
+    rep.set_defaults(handler=cmd_reproduce)
+
     types = sub.add_parser("blocks", help="list block types with their ports and parameters")
     types.add_argument("types", nargs="*", metavar="TYPE", help="only these types")
     types.set_defaults(handler=cmd_blocks)
@@ -300,6 +309,24 @@ def cmd_animate(args: argparse.Namespace) -> int:
     except AnimationError as exc:
         raise UsageError(str(exc)) from None
     print(f"wrote {written}")
+    return EXIT_OK
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, ReproduceError, reproduce
+
+    try:
+        summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS, report=print)
+    except ReproduceError as exc:
+        print(f"hierhand: {exc}", file=sys.stderr)
+        return EXIT_FAILED
+    r = summary["regrasp"]
+    print(f"grasp: peak ratio {summary['grasp']['peak_ratio']:.3f}, steady max "
+          f"{summary['grasp']['steady_ratio_max']:.3f}; manipulation: position error "
+          f"{1000 * summary['manipulation']['position_error_m']:.2f} mm; re-grasp: forefinger separates at "
+          f"{r['suppressed']['fore_separation_time_s']} s with suppresser, "
+          f"{r['unsuppressed']['fore_separation_time_s']} without")
+    print(f"wrote {args.output}/summary.json, report.md and fig09.png ... fig14.png")
     return EXIT_OK
 
 

@@ -1,0 +1,124 @@
+"""The paper's figures 9-14 drawn from the runs of the shipped task diagrams."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from blocks import Results
+
+from .metrics import FORE, SAFETY_RATIO, THUMB, TaskBlocks
+
+FINGER_NAMES = ("thumb", "forefinger", "middle finger")
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _ratio_axes(ax, results: Results, fingers, b: TaskBlocks, title: str, styles=("-", "-")) -> None:
+    t, ratio = results[f"{b.plant}.ratio"]
+    for f, style in zip(fingers, styles):
+        ax.plot(t, ratio[:, f], style, lw=1.2, label=FINGER_NAMES[f])
+    ax.axhline(SAFETY_RATIO, color="k", ls="--", lw=0.8, label="safety ratio 0.6")
+    ax.set_ylim(0, 1.05)
+    ax.set_ylabel("|f_t| / f_n")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper right", fontsize="small")
+
+
+def _torque_axes(ax, results: Results, joint: int, b: TaskBlocks, title: str) -> None:
+    t_g, tau_g = results[f"{b.reflex}.tau_g"]
+    t_m, tau_m = results[f"{b.manipulation}.tau_m"]
+    applied = f"{b.suppresser}.tau_g_eff"
+    if applied in results:
+        ax.plot(t_g, tau_g[:, joint], lw=0.8, ls="--", color="C0", label="grasp torque from the reflex")
+        t_a, tau_a = results[applied]
+        ax.plot(t_a, tau_a[:, joint], lw=1.2, color="C0", label="grasp torque applied (suppressed)")
+    else:
+        ax.plot(t_g, tau_g[:, joint], lw=1.2, label="grasp torque (reflex)")
+    ax.step(t_m, tau_m[:, joint], where="post", lw=1.2, color="C1", label="manipulation torque (PD)")
+    ax.axhline(0, color="k", lw=0.5)
+    ax.set_ylabel("torque (N m)")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left", fontsize="small")
+
+
+def _mark(ax, t: float | None, text: str) -> None:
+    if t is not None:
+        ax.axvline(t, color="0.5", ls=":", lw=1)
+        ax.annotate(text, (t, 0.98), xycoords=("data", "axes fraction"), fontsize=8, ha="left", va="top")
+
+
+def _save(fig, path: Path) -> Path:
+    fig.axes[-1].set_xlabel("time (s)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    _pyplot().close(fig)
+    return path
+
+
+def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBlocks = TaskBlocks()) -> list[Path]:
+    """fig09.png ... fig14.png in ``out`` from the runs 'grasp', 'manipulate', 'regrasp' and
+    'regrasp_unsuppressed'."""
+    plt = _pyplot()
+    fore_joint1 = 3 * FORE
+    written = []
+    g = summary["grasp"]
+
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    _ratio_axes(ax, runs["grasp"], (THUMB, FORE), b, "Fig. 9: friction ratio, grasp under disturbance")
+    _mark(ax, g["disturbance_time_s"], " disturbance")
+    written.append(_save(fig, out / "fig09.png"))
+
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    _torque_axes(ax, runs["grasp"], fore_joint1, b, "Fig. 10: forefinger joint 1, grasp under disturbance")
+    _mark(ax, g["disturbance_time_s"], " disturbance")
+    written.append(_save(fig, out / "fig10.png"))
+
+    m = summary["manipulation"]
+    fig, ax = plt.subplots(figsize=(8, 3.6))
+    _ratio_axes(ax, runs["manipulate"], (THUMB, FORE), b, "Fig. 11: friction ratio, manipulation")
+    written.append(_save(fig, out / "fig11.png"))
+
+    fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    t, obj = runs["manipulate"][f"{b.plant}.obj"]
+    target = m["target_pose"]
+    for j, label in enumerate(("x", "y")):
+        axes[0].plot(t, 1000 * obj[:, j], lw=1.2, label=f"object {label}")
+        axes[0].axhline(1000 * target[j], ls="--", lw=0.8, color=f"C{j}", label=f"target {label}")
+    axes[0].set_ylabel("position (mm)")
+    axes[0].set_title("Fig. 12: object position and posture, manipulation")
+    axes[0].legend(fontsize="small", ncol=2)
+    axes[1].plot(t, np.degrees(obj[:, 2]), lw=1.2, color="C2", label="object angle")
+    axes[1].axhline(np.degrees(target[2]), ls="--", lw=0.8, color="C2", label="target angle")
+    axes[1].set_ylabel("posture (deg)")
+    axes[1].legend(fontsize="small")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    written.append(_save(fig, out / "fig12.png"))
+
+    r = summary["regrasp"]
+    fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    for ax, key, label in ((axes[0], "regrasp", "with suppresser"), (axes[1], "regrasp_unsuppressed", "without")):
+        _ratio_axes(ax, runs[key], (FORE,), b, f"Fig. 13: forefinger friction ratio, re-grasp {label}")
+        run_key = "suppressed" if key == "regrasp" else "unsuppressed"
+        _mark(ax, r[run_key]["middle_contact_time_s"], " middle touches")
+        _mark(ax, r[run_key]["fore_separation_time_s"], " forefinger leaves")
+    written.append(_save(fig, out / "fig13.png"))
+
+    fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
+    for ax, key, label in ((axes[0], "regrasp", "with suppresser"), (axes[1], "regrasp_unsuppressed", "without")):
+        _torque_axes(ax, runs[key], fore_joint1, b, f"Fig. 14: forefinger joint 1, re-grasp {label}")
+        run_key = "suppressed" if key == "regrasp" else "unsuppressed"
+        _mark(ax, r[run_key]["fore_separation_time_s"], " forefinger leaves")
+    written.append(_save(fig, out / "fig14.png"))
+    return written

@@ -1,0 +1,123 @@
+"""The numbers the paper's tasks are judged by, computed from a run's Results.
+
+Every function takes the Results of a shipped task diagram and the names of its plant,
+reflex and controller blocks, so the same measures serve sweeps and tests.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from blocks import Results
+
+SAFETY_RATIO = 0.6
+DROP_DISTANCE = 0.02
+"""An object that ends more than 2 cm below where it started has been dropped."""
+
+THUMB, FORE, MIDDLE = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class TaskBlocks:
+    """Names of the blocks a task diagram uses."""
+
+    plant: str = "plant"
+    reflex: str = "reflex"
+    manipulation: str = "manip"
+    suppresser: str = "suppress"
+
+
+def _signal(results: Results, name: str) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        return results[name]
+    except KeyError as exc:
+        raise ValueError(f"the task needs the logged signal {exc}") from None
+
+
+def object_dropped(results: Results, b: TaskBlocks = TaskBlocks()) -> bool:
+    """Dropped: fewer than two fingers touch it at the end, or it fell by DROP_DISTANCE."""
+    _, contact = _signal(results, f"{b.plant}.contact")
+    _, obj = _signal(results, f"{b.plant}.obj")
+    return bool(contact[-1].sum() < 2 or obj[0, 1] - obj[-1, 1] > DROP_DISTANCE)
+
+
+def first_time(t: np.ndarray, condition: np.ndarray, after: float = -math.inf) -> float | None:
+    """First sample time after ``after`` where ``condition`` holds, or None."""
+    hits = np.flatnonzero(condition & (t > after))
+    return float(t[hits[0]]) if hits.size else None
+
+
+def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = TaskBlocks(),
+                  fingers: tuple[int, ...] = (THUMB, FORE), steady_window: float = 0.2) -> dict:
+    """Peak |f_t|/f_n after the disturbance, when it is back under the safety ratio for
+    good, its maximum over the last ``steady_window`` seconds, and how far the object moved."""
+    t, ratio = _signal(results, f"{b.plant}.ratio")
+    worst = ratio[:, list(fingers)].max(axis=1)
+    after = t >= disturbance_time
+    peak = float(worst[after].max())
+    above = np.flatnonzero(after & (worst > SAFETY_RATIO))
+    if above.size == 0:
+        recovery = 0.0
+    elif above[-1] + 1 < t.size:
+        recovery = float(t[above[-1] + 1] - disturbance_time)
+    else:
+        recovery = None
+    steady = t >= t[-1] - steady_window
+    t_obj, obj = _signal(results, f"{b.plant}.obj")
+    i0 = max(int(np.searchsorted(t_obj, disturbance_time)) - 1, 0)  # the last pose before the push
+    return {
+        "disturbance_time_s": float(disturbance_time),
+        "peak_ratio": peak,
+        "recovery_time_s": recovery,
+        "steady_ratio_max": float(worst[steady].max()),
+        "object_displacement_m": float(np.linalg.norm(obj[-1, :2] - obj[i0, :2])),
+        "object_dropped": object_dropped(results, b),
+    }
+
+
+def rigid_target(start_tips: np.ndarray, end_tips: np.ndarray, start_pose: np.ndarray) -> np.ndarray:
+    """The object pose that moves rigidly with two fingertips from ``start_tips`` (2, 2) to
+    ``end_tips``: the rotation of the line between them, then the matching translation."""
+    d0, d1 = start_tips[1] - start_tips[0], end_tips[1] - end_tips[0]
+    angle = math.atan2(d1[1], d1[0]) - math.atan2(d0[1], d0[0])
+    c, s = math.cos(angle), math.sin(angle)
+    rot = np.array([[c, -s], [s, c]])
+    centre = end_tips.mean(axis=0) + rot @ (start_pose[:2] - start_tips.mean(axis=0))
+    return np.array([centre[0], centre[1], start_pose[2] + angle])
+
+
+def manipulation_summary(results: Results, trajectories: dict, initial_pose: np.ndarray,
+                         b: TaskBlocks = TaskBlocks(), fingers: tuple[str, str] = ("thumb", "fore")) -> dict:
+    """Target pose implied by the two fingertip trajectories, the pose reached, the errors,
+    and the largest |f_t|/f_n once the grasp has settled (from the first waypoint on)."""
+    first = [np.asarray(trajectories[f]["waypoints"][0], dtype=float) for f in fingers]
+    last = [np.asarray(trajectories[f]["waypoints"][-1], dtype=float) for f in fingers]
+    target = rigid_target(np.array([w[1:3] for w in first]), np.array([w[1:3] for w in last]),
+                          np.asarray(initial_pose, dtype=float))
+    settle = min(w[0] for w in first)
+    t, ratio = _signal(results, f"{b.plant}.ratio")
+    _, obj = _signal(results, f"{b.plant}.obj")
+    final = obj[-1]
+    return {
+        "max_ratio_after_settle": float(ratio[t >= settle][:, [THUMB, FORE]].max()),
+        "target_pose": [float(v) for v in target],
+        "final_pose": [float(v) for v in final],
+        "position_error_m": float(np.linalg.norm(final[:2] - target[:2])),
+        "angle_error_rad": float(abs(final[2] - target[2])),
+        "object_dropped": object_dropped(results, b),
+    }
+
+
+def regrasp_summary(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
+    """When the middle finger first touches the object, and when the forefinger then lets go."""
+    t, contact = _signal(results, f"{b.plant}.contact")
+    middle = first_time(t, contact[:, MIDDLE] > 0)
+    separation = first_time(t, contact[:, FORE] == 0, after=middle) if middle is not None else None
+    return {
+        "middle_contact_time_s": middle,
+        "fore_separation_time_s": separation,
+        "object_dropped": object_dropped(results, b),
+    }

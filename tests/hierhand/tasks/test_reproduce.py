@@ -1,0 +1,70 @@
+"""The paper's behaviour on the shipped task diagrams, through `hierhand reproduce`."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+@pytest.fixture(scope="module")
+def reproduced(tmp_path_factory):
+    out = tmp_path_factory.mktemp("reproduce")
+    proc = subprocess.run([sys.executable, "-m", "hierhand", "reproduce", "-o", str(out),
+                           "--diagrams", str(ROOT / "diagrams")], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return out, json.loads((out / "summary.json").read_text())
+
+
+def test_summary_has_exactly_the_documented_keys(reproduced):
+    _, s = reproduced
+    assert set(s) == {"grasp", "manipulation", "regrasp"}
+    assert set(s["grasp"]) == {"disturbance_time_s", "peak_ratio", "recovery_time_s", "steady_ratio_max",
+                               "object_displacement_m", "object_dropped"}
+    assert set(s["manipulation"]) == {"max_ratio_after_settle", "target_pose", "final_pose",
+                                      "position_error_m", "angle_error_rad", "object_dropped"}
+    for case in ("suppressed", "unsuppressed"):
+        assert set(s["regrasp"][case]) == {"middle_contact_time_s", "fore_separation_time_s", "object_dropped"}
+
+
+def test_grasp_reflex_recovers_from_the_disturbance(reproduced):
+    g = reproduced[1]["grasp"]
+    assert g["peak_ratio"] > 0.6  # the push takes the ratio over the safety ratio ...
+    assert g["recovery_time_s"] is not None and g["recovery_time_s"] < 0.2  # ... and the reflex brings it back
+    assert g["steady_ratio_max"] <= 0.6
+    assert not g["object_dropped"]
+
+
+def test_manipulation_reaches_the_target_pose(reproduced):
+    m = reproduced[1]["manipulation"]
+    assert m["position_error_m"] <= 1e-3
+    assert m["angle_error_rad"] <= 0.0174533
+    assert m["max_ratio_after_settle"] <= 0.6
+    assert not m["object_dropped"]
+
+
+def test_regrasp_forefinger_separates_only_with_the_suppresser(reproduced):
+    r = reproduced[1]["regrasp"]
+    s, u = r["suppressed"], r["unsuppressed"]
+    assert s["middle_contact_time_s"] is not None
+    assert s["middle_contact_time_s"] < s["fore_separation_time_s"]
+    assert 0.45 <= s["fore_separation_time_s"] <= 0.65
+    assert not s["object_dropped"]
+    assert u["middle_contact_time_s"] is not None
+    assert u["fore_separation_time_s"] is None  # held on through t = 1.0 s
+    assert not u["object_dropped"]
+
+
+def test_figures_and_report_are_written(reproduced):
+    out, _ = reproduced
+    for n in range(9, 15):
+        assert (out / f"fig{n:02d}.png").stat().st_size > 10_000
+    report = (out / "report.md").read_text()
+    assert "0.55 s" in report and "![Fig. 14](fig14.png)" in report
+    for task in ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed"):
+        assert (out / "runs" / task / "signals.npz").is_file()
