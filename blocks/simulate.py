@@ -185,8 +185,7 @@ class _Run:
         blk = self.d.blocks[name].block
         output, i, inp, states = blk.output, self.index[name], self.inputs[name], self.states
         publish = tuple(blk.outputs) if ports is None else ports
-        held = self.held[name]
-        targets = [(held, p, p) for p in publish] + [f for f in self.fanout[name] if f[2] in publish]
+        targets = self.hold_targets(name, publish) + [f for f in self.fanout[name] if f[2] in publish]
         loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]] if log else []
         checked = self.checked
 
@@ -203,6 +202,12 @@ class _Run:
                 raise _StepFailure(name, "output", k, exc) from exc
 
         return op
+
+    def hold_targets(self, name: str, ports) -> list[tuple[dict, str, str]]:
+        """Where a block's new outputs must also be kept: only the ports that delayed
+        connections sample (everything else reaches its readers through the fan-out)."""
+        sampled = {c.src_port for c in self.d.connections if c.delay and c.src_block == name}
+        return [(self.held[name], p, p) for p in ports if p in sampled]
 
     def update_op(self, name: str):
         update, i, inp, states = self.d.blocks[name].block.update, self.index[name], self.inputs[name], self.states
@@ -228,8 +233,7 @@ class _Run:
         advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
         period, dt = self.s.period_ticks[name], float(blk.period)
         ports = tuple(blk.outputs)
-        held = self.held[name]
-        targets = [(held, p, p) for p in ports] + self.fanout[name]
+        targets = self.hold_targets(name, ports) + self.fanout[name]
         loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
 
         def op(k: int, t: float, next_k: int) -> None:
