@@ -105,15 +105,19 @@ class _Logger:
         self.hits += 1
 
     def add_rows(self, rows: np.ndarray) -> None:
-        n, d = len(rows), self.decimate
+        n, d, pos = rows.shape[0], self.decimate, self.pos
         if d == 1:
-            self.buf[self.pos:self.pos + n] = rows
-            self.pos += n
+            self.buf[pos:pos + n] = rows
+            self.pos = pos + n
         else:
-            first = (-self.hits) % d
-            picked = rows[first::d]
-            self.buf[self.pos:self.pos + len(picked)] = picked
-            self.pos += len(picked)
+            first = -self.hits % d
+            if first < n:
+                count = (n - 1 - first) // d + 1
+                if count == 1:
+                    self.buf[pos] = rows[first]
+                else:
+                    self.buf[pos:pos + count] = rows[first::d]
+                self.pos = pos + count
         self.hits += n
 
 
@@ -233,23 +237,29 @@ class _Run:
         advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
         period, dt = self.s.period_ticks[name], float(blk.period)
         ports = tuple(blk.outputs)
-        targets = self.hold_targets(name, ports) + self.fanout[name]
-        loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
+        by_port: dict[str, list[tuple[dict, str]]] = {}
+        for d, dp, sp in self.hold_targets(name, ports) + self.fanout[name]:
+            by_port.setdefault(sp, []).append((d, dp))
+        targets = list(by_port.items())
+        loggers = [(lg.add_rows, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
+        checked, key = self.checked, name + ":advance"
 
         def op(k: int, t: float, next_k: int) -> None:
             n = (next_k - k) // period
             try:
                 while n > 0:
-                    m = min(n, ADVANCE_CHUNK)
+                    m = n if n <= ADVANCE_CHUNK else ADVANCE_CHUNK
                     states[i], rows = advance(t, states[i], inp, m)
-                    if name + ":advance" not in self.checked:
+                    if key not in checked:
                         self.check_rows(name, rows, ports, m)
-                    for lg, p in loggers:
-                        lg.add_rows(rows[p])
+                    for add, p in loggers:
+                        add(rows[p])
                     n -= m
                     t += m * dt
-                for d, dp, sp in targets:
-                    d[dp] = rows[sp][-1]
+                for p, dests in targets:
+                    last = rows[p][-1]
+                    for d, dp in dests:
+                        d[dp] = last
             except Exception as exc:
                 raise _StepFailure(name, "advance", k, exc) from exc
 

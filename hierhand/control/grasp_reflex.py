@@ -20,6 +20,11 @@ At every hit (1 ms in the paper) the reflex
 Why a margin: an integral loop approaches its target exponentially, so aiming exactly at
 the safety ratio would leave ``|f_t| / f_n`` just above it for ever; aiming at
 ``safety_ratio / (1 + margin)`` brings it below the safety ratio in finite time.
+
+How: ``output`` and ``update`` each make one call into the compiled kernels of
+``reflex_kernel`` (the grasp matrix solve written out by hand, the tip Jacobians from the
+plant's compiled kinematics); ``internal_forces`` is the numpy reference they are tested
+against. The parameters are packed for the kernels when the block is made and bound.
 """
 
 from __future__ import annotations
@@ -31,7 +36,18 @@ import numpy as np
 from blocks import Block
 
 from ..model import load_hand
-from .internal_forces import internal_directions, project_internal
+from .reflex_kernel import (
+    N_OUT,
+    O_ACTIVE,
+    O_FORCE,
+    O_TAU,
+    P_DT,
+    pack_params,
+    reflex_directions,
+    reflex_forces,
+    reflex_output,
+    reflex_update,
+)
 
 
 def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray:
@@ -83,6 +99,9 @@ class GraspReflex(Block):
         self.ki, self.min_force, self.max_force = float(ki), float(min_force), float(max_force)
         self.ratio_target = float(safety_ratio) / (1.0 + float(margin))
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
+        # the kernels' flat parameter array; the period (P_DT) is set by bind
+        self._params = pack_params(self.threshold, self.approach_force, self.ki, np.nan, self.min_force,
+                                   self.ratio_target, self.max_force, self.initial)
         self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6}
         self.outputs = {"tau_g": 9, "force": 3, "active": 3}
         self.feedthrough = {"tau_g": {"q", "tip", "fn", "normal"}, "force": {"tip", "fn", "normal"},
@@ -93,6 +112,7 @@ class GraspReflex(Block):
             raise ValueError("GraspReflex needs an explicit period (the paper's is 1 ms)")
         super().bind(period)
         self.dt = float(period)
+        self._params[P_DT] = self.dt
 
     def initial_state(self) -> np.ndarray:
         """[grasp force scale s (N), has touched the object (3)]."""
@@ -113,47 +133,31 @@ class GraspReflex(Block):
         normal: ``(I - G^+ G) n``. It keeps each contact's force close to its normal, so
         raising the scale lowers ``|f_t| / f_n`` wherever the faces allow it (a focus-point
         squeeze can point a contact's force along the face instead). A finger still
-        approaching pushes towards the others' centroid.
+        approaching pushes towards the others' centroid. Should the projection leave a
+        finger not pushing (``g_i . push_i <= 0``), the grasp falls back to the centroid
+        squeeze ``internal_directions``. Computed by ``reflex_kernel.reflex_directions``
+        (``G^+ = G^T (G G^T)^-1`` solved by hand; ``project_internal`` is the reference).
         """
-        grasp, touching = self.members(state, fn)
-        g = np.zeros((3, 2))
-        if grasp.sum() < 2:
-            return g, grasp, touching
-        points = tip.reshape(3, 3)[:, :2]
-        push = normal.reshape(3, 2).copy()
-        for i in np.flatnonzero(grasp & ~touching):
-            toward = points[grasp & (np.arange(3) != i)].mean(axis=0) - points[i]
-            push[i] = toward / max(np.linalg.norm(toward), 1e-12)
-        idx = np.flatnonzero(grasp)
-        internal = project_internal(points[idx], points[idx].mean(axis=0), push[idx].ravel()).reshape(-1, 2)
-        if np.any(np.einsum("ij,ij->i", internal, push[idx]) <= 0):
-            internal = internal_directions(points[idx])
-        g[idx] = internal / np.max(np.linalg.norm(internal, axis=1))
-        return g, grasp, touching
+        return reflex_directions(self._params, _f64(state), _f64(tip), _f64(normal), _f64(fn))
 
     def forces(self, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        """(3, 2) fingertip force commands and the fingers in the grasp."""
-        g, grasp, touching = self.directions(state, inputs["tip"], inputs["normal"], inputs["fn"])
-        length = np.linalg.norm(g, axis=1)
-        scale = np.where(touching, state[0], self.approach_force / np.maximum(length, 1e-300))
-        return g * scale[:, None], grasp
+        """(3, 2) fingertip force commands and the fingers in the grasp: ``s g_i`` for a
+        touching finger, ``g_i`` scaled to ``approach_force`` for an approaching one."""
+        return reflex_forces(self._params, _f64(state), _f64(inputs["tip"]), _f64(inputs["normal"]),
+                             _f64(inputs["fn"]))
 
     def output(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        f, grasp = self.forces(state, inputs)
-        jac = self.hand.tip_jacobians(inputs["q"])
-        tau = np.concatenate([jac[i].T @ f[i] for i in range(3)])
-        return {"tau_g": tau, "force": np.linalg.norm(f, axis=1), "active": grasp.astype(float)}
+        """``tau_g = J_i^T f_i`` per finger (tip Jacobians at ``q``), ``|f_i|`` and the grasp
+        flags; one kernel call, the ports are views of one fresh array."""
+        out = reflex_output(self._params, self.hand.fingers, state, inputs["q"], inputs["tip"],
+                            inputs["normal"], inputs["fn"])
+        return {"tau_g": out[O_TAU:O_FORCE], "force": out[O_FORCE:O_ACTIVE], "active": out[O_ACTIVE:N_OUT]}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
-        fn, ft = inputs["fn"], inputs["ft"]
-        g, grasp, touching = self.directions(state, inputs["tip"], inputs["normal"], fn)
-        held = grasp & touching
-        scale = state[0]
-        if held.sum() >= 2:
-            normal = inputs["normal"].reshape(3, 2)[held]
-            gain = np.einsum("ij,ij->i", g[held], normal)  # normal force per unit of scale
-            need = np.maximum(self.min_force * np.linalg.norm(g[held], axis=1),
-                              np.abs(ft[held]) / self.ratio_target)
-            shortfall = float(np.max((need - fn[held]) / np.maximum(gain, 1e-3)))
-            scale = min(max(scale + self.ki * self.dt * shortfall, 0.0), self.max_force)
-        return np.concatenate(([scale], np.maximum(state[1:], touching)))
+        """The integral step of the grasp force scale and the touched flags (a fresh array)."""
+        return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"])
+
+
+def _f64(x) -> np.ndarray:
+    """A 1-D float64 array for the kernels (the helper methods also take lists)."""
+    return np.ascontiguousarray(x, dtype=np.float64).reshape(-1)

@@ -2,13 +2,38 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any, Mapping
 
 import numpy as np
+from numba import njit
 
 from blocks import Block
 
 from .suppression import MODES, suppress
+
+_PASS, _MAGNITUDE, _SIGNED = 0, 1, 2  # suppress_kernel's modes
+_F64 = np.dtype(np.float64)
+_ND = np.ndarray
+
+
+@njit(cache=True)
+def suppress_kernel(tau_g, tau_m, s_a, s_b, mode, out):
+    """``out[1] = suppress(tau_g, tau_m, s_a, s_b)`` (or ``tau_g`` for mode ``_PASS``),
+    ``out[0] = out[1] + tau_m``, over the 9 joints; the same operations as
+    ``suppression.suppress`` (whose numpy ``exp`` may differ from libm's in the last bit).
+    """
+    for j in range(9):
+        m = tau_m[j]
+        if mode == _PASS:
+            eff = tau_g[j]
+        else:
+            g = abs(m) if mode == _MAGNITUDE else m
+            x = s_a[j] * (s_b[j] - g)
+            e = math.exp(-abs(x))
+            eff = tau_g[j] * (1.0 / (1.0 + e) if x >= 0 else e / (1.0 + e))
+        out[1, j] = eff
+        out[0, j] = eff + m
 
 
 class Suppresser(Block):
@@ -19,6 +44,9 @@ class Suppresser(Block):
     paper's prose describes. ``mode: signed`` is the paper's literal formula (g = tau_m),
     which only suppresses against positive manipulation torques. ``enabled: false``
     passes tau_g through unchanged, for the paper's comparison run without suppression.
+
+    The nine joints are done in one compiled call (``suppress_kernel``);
+    ``output_reference`` is the numpy form on ``suppression.suppress``.
     """
 
     type_name = "Suppresser"
@@ -40,8 +68,19 @@ class Suppresser(Block):
         self.inputs = {"tau_g": 9, "tau_m": 9}
         self.outputs = {"tau": 9, "tau_g_eff": 9}
         self.feedthrough = True
+        self._mode = (_MAGNITUDE if mode == "magnitude" else _SIGNED) if self.enabled else _PASS
 
     def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        tau_g, tau_m = inputs["tau_g"], inputs["tau_m"]
+        if not (tau_g.__class__ is _ND and tau_m.__class__ is _ND and tau_g.dtype == _F64 and tau_m.dtype == _F64
+                and tau_g.shape == (9,) and tau_m.shape == (9,)):
+            return self.output_reference(t, state, inputs)
+        out = np.empty((2, 9))
+        suppress_kernel(tau_g, tau_m, self.S_a, self.S_b, self._mode, out)
+        return {"tau": out[0], "tau_g_eff": out[1]}
+
+    def output_reference(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """``output`` in numpy, on ``suppression.suppress``."""
         tau_g, tau_m = inputs["tau_g"], inputs["tau_m"]
         effective = suppress(tau_g, tau_m, self.S_a, self.S_b, self.mode) if self.enabled else tau_g.copy()
         return {"tau": effective + tau_m, "tau_g_eff": effective}

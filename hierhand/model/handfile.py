@@ -9,6 +9,9 @@ optional and default to the shipped hand (``default_hand.yaml`` beside this modu
 
 from __future__ import annotations
 
+import copy
+import functools
+
 import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -111,16 +114,25 @@ def _lists(x: Any) -> Any:
     return x
 
 
-def default_hand_dict() -> dict[str, Any]:
-    """The shipped default hand file as a plain dict (a fresh copy)."""
+_SafeLoader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+"""libyaml's parser where PyYAML has it: the plant and both controllers read the hand."""
+
+
+@functools.cache
+def _default_hand() -> dict[str, Any]:
     with open(DEFAULT_HAND_FILE, encoding="utf-8") as fh:
-        return yaml.safe_load(fh)
+        return yaml.load(fh, Loader=_SafeLoader)
+
+
+def default_hand_dict() -> dict[str, Any]:
+    """The shipped default hand file as a plain dict (a fresh copy; the file is read once)."""
+    return copy.deepcopy(_default_hand())
 
 
 def read_hand_file(path: str | Path) -> dict[str, Any]:
     """A hand file's raw content (YAML safe loading); it must be a mapping."""
     with open(path, encoding="utf-8") as fh:
-        data = yaml.safe_load(fh)
+        data = yaml.load(fh, Loader=_SafeLoader)
     if data is None:
         data = {}
     if not isinstance(data, dict):

@@ -49,6 +49,9 @@ for _name, _width in OUTPUT_PORTS:
 assert _offset == N_OUTPUTS
 _PORT_COLUMNS = [(name, (slice(None), sl)) for name, sl in _PORT_SLICES]  # ready-made 2-D indices
 _F64 = np.dtype(np.float64)
+_ND = np.ndarray
+_SHAPE9 = (9,)
+_SHAPE3 = (3,)
 
 
 @dataclass(frozen=True)
@@ -114,6 +117,9 @@ class HandPlant(Block):
         self.n_points = self.hand.n_points
         self._state_shape = (state_size(self.n_points),)
         self._body = self.hand.body.copy()
+        self._fingers = self.hand.fingers
+        self._edges = self.hand.edges
+        self._bound_shape: tuple[int] | None = None  # the state shape once bound: the fast paths' test
         self.dt: float | None = None
 
     @classmethod
@@ -130,6 +136,7 @@ class HandPlant(Block):
         self.period = period
         self.dt = dt
         self._body[B_DT] = dt
+        self._bound_shape = self._state_shape
 
     # -- state ------------------------------------------------------------------------
 
@@ -156,30 +163,48 @@ class HandPlant(Block):
 
     # -- the block contract -------------------------------------------------------------
 
+    # Fast paths: one identity/shape test per argument (the state's shape test also fails
+    # until bind() sets ``_bound_shape``), then the kernel, which checks every value for
+    # finiteness and reports by code; anything unusual goes through the full checks.
+
     def output(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        self._check_state(state)
+        self._quick_check(state)
         row = np.empty(N_OUTPUTS)
-        code, which = output_kernel(state, self.hand.fingers, self._body, self.hand.edges, row)
+        code, which = output_kernel(state, self._fingers, self._body, self._edges, row)
         if code:
             raise self._error(code, which, t)
         return {name: row[sl] for name, sl in _PORT_SLICES}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
-        self._check_state(state)
-        tau, f_ext = self._inputs(inputs)
-        code, done, which = step_kernel(state, tau, f_ext, self.hand.fingers, self._body, self.hand.edges)
+        tau, f_ext = self._arguments(state, inputs)
+        code, done, which = step_kernel(state, tau, f_ext, self._fingers, self._body, self._edges)
         if code:
             raise self._error(code, which, t + done * self.dt)
         return state
 
     def advance(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray], n: int):
-        self._check_state(state)
-        tau, f_ext = self._inputs(inputs)
+        tau, f_ext = self._arguments(state, inputs)
         rows = np.empty((n, N_OUTPUTS))
-        code, done, which = advance_kernel(state, tau, f_ext, self.hand.fingers, self._body, self.hand.edges, rows)
+        code, done, which = advance_kernel(state, tau, f_ext, self._fingers, self._body, self._edges, rows)
         if code:
             raise self._error(code, which, t + done * self.dt)
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
+
+    def _quick_check(self, state: np.ndarray) -> None:
+        """The full state checks, only when the state is not the bound plant's plain array."""
+        if not (state.__class__ is _ND and state.dtype == _F64 and state.shape == self._bound_shape):
+            self._check_state(state)
+
+    def _arguments(self, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """(tau, f_ext) for the kernels after a quick state check; inputs of an unusual
+        type or shape go through the full conversion and its error messages."""
+        self._quick_check(state)
+        tau = inputs["tau"]
+        f_ext = inputs.get("f_ext")
+        if not (tau.__class__ is _ND and f_ext.__class__ is _ND and tau.dtype == _F64 and f_ext.dtype == _F64
+                and tau.shape == _SHAPE9 and f_ext.shape == _SHAPE3):
+            tau, f_ext = self._inputs(inputs)
+        return tau, f_ext
 
     # -- inspection -------------------------------------------------------------------
 

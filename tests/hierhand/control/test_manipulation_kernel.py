@@ -1,0 +1,196 @@
+"""The compiled fast paths of ManipulationPD and Suppresser against their numpy references."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from hierhand.control.inverse_kinematics import (
+    UnreachableError,
+    finger_fk,
+    finger_ik_near,
+)
+from hierhand.control.manipulation_kernel import (
+    ik_near,
+    moving,
+    pack_trajectories,
+    sample,
+)
+from hierhand.control.manipulation_pd import ManipulationPD
+from hierhand.control.suppresser import Suppresser
+from hierhand.control.suppression import suppress
+from hierhand.control.trajectory import Trajectory
+from hierhand.model import Hand, HandPlant
+
+REGRASP = {
+    "middle": {"waypoints": [[0.15, 0.04798, 0.07000, 2.6], [0.35, 0.0328, 0.040, 3.0]]},
+    "fore": {"waypoints": [[0.38, 0.03310, 0.06017, 3.0], [0.68, 0.04810, 0.06017, 2.6]]},
+}
+MANIPULATE = {
+    "thumb": {"waypoints": [[0.3, -0.03412, 0.06017, -0.0306], [0.8, -0.02857, 0.07109, -0.2051]]},
+    "fore": {"waypoints": [[0.3, 0.03310, 0.06017, 3.0000], [0.8, 0.03762, 0.05942, 2.8255]],
+             "interpolation": "linear"},
+}
+THREE_SEGMENTS = {
+    "fore": {"waypoints": [[0.1, 0.03310, 0.06017, 3.0], [0.3, 0.0381, 0.06017, 2.8],
+                           [0.32, 0.0381, 0.0612, 2.8], [0.5, 0.0351, 0.0590, 2.9]]},
+    "thumb": {"waypoints": [[0.2, -0.03412, 0.06017, -0.0306], [0.4, -0.0300, 0.0650, -0.1],
+                            [0.6, -0.02857, 0.07109, -0.2051]], "interpolation": "linear"},
+}
+
+
+def _times(trajectories):
+    """A grid plus every waypoint time and its neighbours a derivative step away."""
+    ts = list(np.linspace(-0.05, 1.0, 211))
+    for spec in trajectories.values():
+        for w in spec["waypoints"]:
+            ts += [w[0], w[0] - 1e-3, w[0] + 1e-3, np.nextafter(w[0], -1.0), np.nextafter(w[0], 2.0)]
+    return ts
+
+
+@pytest.mark.parametrize("trajectories", [REGRASP, MANIPULATE, THREE_SEGMENTS, {}])
+@pytest.mark.parametrize("flags", [(True, True), (False, True), (True, False), (False, False)])
+def test_compiled_output_matches_the_numpy_reference(trajectories, flags):
+    hand = Hand.default()
+    pd = ManipulationPD(kp=[1.0, 2.0, 0.5] * 3, kd=0.015, trajectories=trajectories,
+                        gravity_compensation=flags[0], load_compensation=flags[1])
+    rng = np.random.default_rng(7)
+    for t in _times(trajectories):
+        inputs = {"q": hand.q0 + rng.normal(0.0, 0.1, 9), "qd": rng.normal(0.0, 1.0, 9),
+                  "fn": rng.choice([0.0, 0.04, 0.06, 2.0], 3)}
+        fast = pd.output(float(t), None, inputs)
+        ref = pd.output_reference(float(t), None, inputs)
+        assert set(fast) == set(ref) == set(pd.outputs)
+        for port in ref:
+            assert fast[port].shape == (9,) and fast[port].dtype == np.float64
+            np.testing.assert_allclose(fast[port], ref[port], rtol=1e-11, atol=1e-13, err_msg=f"{port} at t={t}")
+
+
+def test_outputs_are_fresh_arrays():
+    hand = Hand.default()
+    pd = ManipulationPD(trajectories=REGRASP)
+    inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.ones(3)}
+    a = pd.output(0.2, None, inputs)
+    kept = {k: v.copy() for k, v in a.items()}
+    pd.output(0.5, None, inputs)
+    for k in a:
+        np.testing.assert_array_equal(a[k], kept[k])
+        assert not np.shares_memory(a[k], pd._params)
+
+
+def test_unusual_inputs_take_the_reference_path():
+    hand = Hand.default()
+    pd = ManipulationPD(trajectories=REGRASP)
+    ref = pd.output(0.25, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)})
+    listed = pd.output(0.25, None, {"q": list(hand.q0), "qd": [0] * 9, "fn": np.zeros(3, dtype=np.float32)})
+    for k in ref:
+        np.testing.assert_allclose(listed[k], ref[k], rtol=1e-12, atol=1e-15)
+    integer_time = pd.output(0, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)})
+    np.testing.assert_array_equal(integer_time["q_ref"], pd.output(0.0, None, {"q": hand.q0, "qd": np.zeros(9),
+                                                                             "fn": np.zeros(3)})["q_ref"])
+
+
+def test_a_target_unreachable_between_waypoints_raises_naming_the_finger():
+    # fore finger: wrist points 50 mm above and below the base (reachable), whose
+    # straight-line interpolation passes the base itself (inside the inner radius)
+    hand = Hand.default()
+    pd = ManipulationPD(trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
+                                                             [1.0, 0.035, -0.038, math.pi / 2]]}})
+    inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)}
+    pd.output(0.1, None, inputs)
+    with pytest.raises(UnreachableError, match="fore: unreachable fingertip target"):
+        pd.output(0.5, None, inputs)
+
+
+def test_ik_near_matches_finger_ik_near():
+    hand = Hand.default()
+    rng = np.random.default_rng(3)
+    for _ in range(3000):
+        f = int(rng.integers(3))
+        q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 0.8, 3)
+        ref_q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 1.5, 3)
+        p = hand.params.fingers[f]
+        target = finger_fk(p.base, p.base_angle, [link.length for link in p.links], q)
+        ok, *got = ik_near(hand.fingers, f, *target, *ref_q)
+        assert ok
+        np.testing.assert_allclose(got, finger_ik_near(hand, f, target, ref_q), rtol=1e-12, atol=1e-12)
+    ok, *_ = ik_near(hand.fingers, 1, 1.0, 1.0, 0.0, *hand.q0[3:6])
+    assert not ok
+
+
+@pytest.mark.parametrize("interpolation", ["minjerk", "linear"])
+def test_trajectory_sampling_matches_trajectory(interpolation):
+    wp = [[0.1, 0.0, 1.0, 2.0], [0.3, 0.5, 1.0, 2.5], [0.35, 0.5, 1.0, 2.5], [0.9, -0.5, 2.0, 3.0]]
+    traj = Trajectory(wp, interpolation)
+    waypoints, meta = pack_trajectories([None, traj, Trajectory([[0.2, 1.0, 2.0, 3.0]])])
+    ts = list(np.linspace(0.0, 1.0, 1001)) + [w[0] for w in wp] + [np.nextafter(w[0], 0.0) for w in wp]
+    for t in ts:
+        assert sample(waypoints, meta, 1, t) == tuple(traj.sample(t)), t
+        assert moving(waypoints, meta, 1, t) == bool(np.any(traj.velocity(t))), t
+        assert sample(waypoints, meta, 2, t) == (1.0, 2.0, 3.0)
+        assert not moving(waypoints, meta, 2, t)
+
+
+@pytest.mark.parametrize("mode", ["magnitude", "signed"])
+@pytest.mark.parametrize("enabled", [True, False])
+def test_suppresser_kernel_matches_suppress(mode, enabled):
+    s = Suppresser(S_a=[200.0, 0.0, 50.0] * 3, S_b=[0.1, 0.2, 0.0] * 3, mode=mode, enabled=enabled)
+    rng = np.random.default_rng(5)
+    for scale in (1e-3, 0.1, 1.0, 1e3):
+        for _ in range(200):
+            inputs = {"tau_g": rng.normal(0.0, scale, 9), "tau_m": rng.normal(0.0, scale, 9)}
+            fast = s.output(0.0, None, inputs)
+            ref = s.output_reference(0.0, None, inputs)
+            if enabled:
+                np.testing.assert_allclose(ref["tau_g_eff"], suppress(inputs["tau_g"], inputs["tau_m"], s.S_a, s.S_b, mode))
+            for port in ("tau", "tau_g_eff"):
+                assert fast[port].shape == (9,) and fast[port].dtype == np.float64
+                np.testing.assert_allclose(fast[port], ref[port], rtol=1e-14, atol=1e-300)
+
+
+def test_suppresser_edge_values_and_unusual_inputs():
+    s = Suppresser(S_a=200.0, S_b=0.1)
+    tau_g = np.array([1.0, -2.0, 3.0, np.nan, 1.0, 1.0, 1e308, 0.0, 1.0])
+    tau_m = np.array([0.1, 1e300, -1e300, 0.0, np.inf, np.nan, 0.0, 5.0, -0.1])
+    fast = s.output(0.0, None, {"tau_g": tau_g, "tau_m": tau_m})
+    with np.errstate(all="ignore"):
+        ref = s.output_reference(0.0, None, {"tau_g": tau_g, "tau_m": tau_m})
+    for port in ref:
+        np.testing.assert_allclose(fast[port], ref[port], rtol=1e-14)
+    listed = s.output(0.0, None, {"tau_g": [0.3] * 9, "tau_m": np.zeros(9, dtype=np.float32)})
+    np.testing.assert_allclose(listed["tau_g_eff"], 0.3 / (1 + math.exp(-20.0)), rtol=1e-14)
+
+
+def test_unbound_plant_is_rejected_by_every_entry_point():
+    plant = HandPlant()
+    state = plant.initial_state()
+    inputs = {"tau": np.zeros(9)}
+    for call in (lambda: plant.output(0.0, state, inputs), lambda: plant.update(0.0, state, inputs),
+                 lambda: plant.advance(0.0, state, inputs, 3)):
+        with pytest.raises(Exception, match="not bound to a period"):
+            call()
+
+
+def test_float64_arrays_with_a_distinct_dtype_object_take_the_compiled_path(monkeypatch):
+    """Arrays from cached numba functions carry an equal but not identical float64 dtype."""
+    dtype = np.dtype(np.float64).newbyteorder("=")
+    assert dtype == np.float64 and dtype is not np.dtype(np.float64)
+    hand = Hand.default()
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("reference path taken")
+
+    pd = ManipulationPD(trajectories=REGRASP)
+    s = Suppresser()
+    monkeypatch.setattr(pd, "output_reference", refuse)
+    monkeypatch.setattr(s, "output_reference", refuse)
+    pd.output(0.2, None, {"q": hand.q0.astype(dtype), "qd": np.zeros(9, dtype), "fn": np.zeros(3, dtype)})
+    s.output(0.0, None, {"tau_g": np.ones(9, dtype), "tau_m": np.zeros(9, dtype)})
+    plant = HandPlant()
+    plant.bind(1e-4)
+    state = plant.initial_state().astype(dtype)
+    monkeypatch.setattr(plant, "_check_state", refuse)
+    monkeypatch.setattr(plant, "_inputs", refuse)
+    plant.advance(0.0, state, {"tau": np.zeros(9, dtype), "f_ext": np.zeros(3, dtype)}, 2)

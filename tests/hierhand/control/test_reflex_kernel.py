@@ -1,0 +1,187 @@
+"""The reflex's compiled kernels against the numpy reference (``internal_forces``).
+
+``reference_*`` below are the reflex's numpy formulation (``project_internal`` with
+``numpy.linalg.pinv``, ``internal_directions`` as the fallback, ``Hand.tip_jacobians``);
+``GraspReflex`` must agree with them to round-off on random 2- and 3-contact grasps,
+approaching fingers and the fallback included.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hierhand.control.grasp_reflex import GraspReflex
+from hierhand.control.internal_forces import internal_directions, project_internal
+from hierhand.control.reflex_kernel import reflex_directions
+
+
+def reference_directions(reflex, state, tip, normal, fn):
+    grasp, touching = reflex.members(state, fn)
+    g = np.zeros((3, 2))
+    if grasp.sum() < 2:
+        return g, grasp, touching, False
+    points = tip.reshape(3, 3)[:, :2]
+    push = normal.reshape(3, 2).copy()
+    for i in np.flatnonzero(grasp & ~touching):
+        toward = points[grasp & (np.arange(3) != i)].mean(axis=0) - points[i]
+        push[i] = toward / max(np.linalg.norm(toward), 1e-12)
+    idx = np.flatnonzero(grasp)
+    internal = project_internal(points[idx], points[idx].mean(axis=0), push[idx].ravel()).reshape(-1, 2)
+    fallback = bool(np.any(np.einsum("ij,ij->i", internal, push[idx]) <= 0))
+    if fallback:
+        internal = internal_directions(points[idx])
+    g[idx] = internal / np.max(np.linalg.norm(internal, axis=1))
+    return g, grasp, touching, fallback
+
+
+def reference_forces(reflex, state, inputs):
+    g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], inputs["fn"])
+    length = np.linalg.norm(g, axis=1)
+    scale = np.where(touching, state[0], reflex.approach_force / np.maximum(length, 1e-300))
+    return g * scale[:, None], grasp
+
+
+def reference_output(reflex, state, inputs):
+    f, grasp = reference_forces(reflex, state, inputs)
+    jac = reflex.hand.tip_jacobians(inputs["q"])
+    tau = np.concatenate([jac[i].T @ f[i] for i in range(3)])
+    return {"tau_g": tau, "force": np.linalg.norm(f, axis=1), "active": grasp.astype(float)}
+
+
+def reference_update(reflex, state, inputs):
+    fn, ft = inputs["fn"], inputs["ft"]
+    g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], fn)
+    held = grasp & touching
+    scale = state[0]
+    if held.sum() >= 2:
+        normal = inputs["normal"].reshape(3, 2)[held]
+        gain = np.einsum("ij,ij->i", g[held], normal)
+        need = np.maximum(reflex.min_force * np.linalg.norm(g[held], axis=1),
+                          np.abs(ft[held]) / reflex.ratio_target)
+        shortfall = float(np.max((need - fn[held]) / np.maximum(gain, 1e-3)))
+        scale = min(max(scale + reflex.ki * reflex.dt * shortfall, 0.0), reflex.max_force)
+    return np.concatenate(([scale], np.maximum(state[1:], touching)))
+
+
+def make_reflex(grasp):
+    reflex = GraspReflex(grasp=grasp, ki=50.0, min_force=3.0, approach_force=0.5)
+    reflex.bind(0.001)
+    return reflex
+
+
+def random_case(rng, reflex, k, inward: bool):
+    """A state and inputs with ``k`` fingers in the grasp (touching or approaching)."""
+    hand = reflex.hand
+    q = hand.q0 + rng.normal(scale=0.2, size=9)
+    tip = hand.tip_poses(q)
+    tip[:, :2] = rng.uniform(-0.05, 0.05, size=(3, 2)) + [0.0, 0.06]
+    chosen = rng.permutation(3)[:k]
+    fn = np.zeros(3)
+    state = np.array([rng.uniform(0.0, 10.0), 0.0, 0.0, 0.0])
+    initial = reflex.initial
+    for i in chosen:
+        if initial[i] and rng.random() < 0.3:
+            continue  # still approaching: listed in 'grasp', never touched, not touching
+        fn[i] = rng.uniform(0.1, 8.0)
+        state[1 + i] = float(rng.random() < 0.8)
+    for i in set(range(3)) - set(chosen):
+        state[1 + i] = 1.0 if initial[i] else float(rng.random() < 0.5)  # out of the grasp
+    centre = tip[chosen, :2].mean(axis=0)
+    normal = np.zeros((3, 2))
+    for i in range(3):
+        if inward:  # roughly toward the centroid, as contact normals of a held object are
+            d = centre - tip[i, :2] + rng.normal(scale=0.01, size=2)
+        else:
+            d = rng.normal(size=2)
+        normal[i] = d / np.linalg.norm(d)
+    inputs = {"q": q, "tip": tip.ravel(), "fn": fn, "ft": rng.normal(scale=2.0, size=3),
+              "normal": normal.ravel()}
+    return state, inputs
+
+
+@pytest.mark.parametrize("k", [2, 3])
+def test_compiled_directions_forces_and_ports_match_the_numpy_reference(k):
+    rng = np.random.default_rng(1234 + k)
+    seen = {"fallback": 0, "projection": 0, "approaching": 0}
+    for trial in range(600):
+        reflex = make_reflex(["thumb", "fore", "middle"] if trial % 2 else ["thumb", "fore"])
+        state, inputs = random_case(rng, reflex, k, inward=trial % 3 != 0)
+        g_ref, grasp_ref, touching_ref, fallback = reference_directions(
+            reflex, state, inputs["tip"], inputs["normal"], inputs["fn"])
+        g, grasp, touching = reflex.directions(state, inputs["tip"], inputs["normal"], inputs["fn"])
+        assert grasp.tolist() == grasp_ref.tolist() and touching.tolist() == touching_ref.tolist()
+        np.testing.assert_allclose(g, g_ref, rtol=0, atol=1e-11)
+        if grasp.sum() >= 2:
+            seen["fallback" if fallback else "projection"] += 1
+            seen["approaching"] += int(np.any(grasp & ~touching))
+
+        f_ref, _ = reference_forces(reflex, state, inputs)
+        f, grasp_f = reflex.forces(state, inputs)
+        assert grasp_f.tolist() == grasp_ref.tolist()
+        np.testing.assert_allclose(f, f_ref, rtol=1e-11, atol=1e-11 * max(1.0, state[0]))
+
+        out, out_ref = reflex.output(0.0, state, inputs), reference_output(reflex, state, inputs)
+        assert set(out) == set(out_ref)
+        for port, value in out_ref.items():
+            assert out[port].shape == value.shape and out[port].dtype == np.float64
+            np.testing.assert_allclose(out[port], value, rtol=1e-10, atol=1e-12 * max(1.0, state[0]))
+
+        new = reflex.update(0.0, state.copy(), inputs)
+        np.testing.assert_allclose(new, reference_update(reflex, state, inputs), rtol=1e-10, atol=1e-12)
+    assert min(seen.values()) > 10, seen  # every branch exercised
+
+
+def test_the_projection_is_internal_and_nearest_to_the_pushes():
+    """(I - G^+ G) n: zero net force and moment, and n minus it lies in G's row space."""
+    rng = np.random.default_rng(7)
+    reflex = make_reflex(["thumb", "fore", "middle"])
+    for _ in range(200):
+        state, inputs = random_case(rng, reflex, 3, inward=True)
+        inputs["fn"][:] = 2.0
+        g, grasp, _ = reflex.directions(state, inputs["tip"], inputs["normal"], inputs["fn"])
+        p = inputs["tip"].reshape(3, 3)[:, :2]
+        np.testing.assert_allclose(g.sum(axis=0), 0.0, atol=1e-12)
+        r = p - p.mean(axis=0)
+        assert abs(np.sum(r[:, 0] * g[:, 1] - r[:, 1] * g[:, 0])) < 1e-13
+
+
+def test_coincident_points_behave_as_the_reference():
+    reflex = make_reflex(["thumb", "fore"])
+    state = reflex.initial_state()
+    tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
+    fn = np.array([2.0, 2.0, 0.0])
+    # opposite normals: the pseudo-inverse drops the moment row, the pushes stay
+    opposite = np.array([1.0, 0.0, -1.0, 0.0, 0.0, 0.0])
+    g, _, _ = reflex.directions(state, tip, opposite, fn)
+    np.testing.assert_allclose(g, reference_directions(reflex, state, tip, opposite, fn)[0], atol=1e-15)
+    # equal normals: nothing internal is left (the SVD's pinv leaves round-off, which the
+    # reference then normalises) and no squeeze direction exists: the fallback's error
+    with pytest.raises(ValueError, match="all contact points coincide"):
+        internal_directions(tip.reshape(3, 3)[:2, :2])
+    same = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    with pytest.raises(ValueError, match="^internal forces are undefined: all contact points coincide$"):
+        reflex.directions(state, tip, same, fn)
+
+
+def test_output_ports_are_fresh_and_update_needs_the_period():
+    reflex = make_reflex(["thumb", "fore"])
+    rng = np.random.default_rng(3)
+    state, inputs = random_case(rng, reflex, 2, inward=True)
+    a, b = reflex.output(0.0, state, inputs), reflex.output(0.0, state, inputs)
+    for port in a:
+        assert not np.shares_memory(a[port], b[port]) and not np.shares_memory(a[port], state)
+    new = reflex.update(0.0, state, inputs)
+    assert new is not state and new.shape == (4,)
+    unbound = GraspReflex()
+    with pytest.raises(ValueError, match="explicit period"):
+        unbound.update(0.0, unbound.initial_state(), inputs)
+
+
+def test_kernel_takes_the_packed_parameters():
+    reflex = make_reflex(["thumb", "fore"])
+    state, inputs = random_case(np.random.default_rng(5), reflex, 2, inward=True)
+    g, grasp, touching = reflex_directions(reflex._params, state, inputs["tip"], inputs["normal"], inputs["fn"])
+    assert g.shape == (3, 2) and grasp.dtype == np.bool_ and touching.dtype == np.bool_
+    with pytest.raises(ValueError, match="'tip' must have 9 entries"):
+        reflex_directions(reflex._params, state, inputs["tip"][:6], inputs["normal"], inputs["fn"])
