@@ -57,7 +57,9 @@ class Block:
     # -- configuration hooks, called by the diagram loader -------------------------
 
     def bind(self, period: Fraction | None) -> None:
-        """Receive the sample period (``None`` when inherited). Override to precompute."""
+        """Receive the sample period (``None`` when the diagram gives none). Override to
+        precompute; a block with a natural rate of its own (an FMU's default step) may set
+        ``self.period`` when given ``None``, and is then scheduled at that period."""
         self.period = period
 
     def set_width(self, width: int) -> None:

@@ -367,6 +367,8 @@ class _Loader:
         try:
             block = cls(**params)
             block.bind(period)
+            if period is None and block.period is not None:
+                period = block.period  # a block with a natural rate (an FMU's default step)
         except Exception as exc:  # a block's own message says which parameter is wrong
             where = spec.line_of("params") if "params" in spec else line
             self.error(where, f"block '{name}' ({type_name}): {exc}",

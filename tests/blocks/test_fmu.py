@@ -1,0 +1,489 @@
+"""The FMU import block, with small FMI 2.0 and 3.0 co-simulation FMUs compiled at test time.
+
+The C sources and model descriptions are in ``fmu_sources/``: a discrete first-order
+system x[k+1] = a x[k] + b u[k], y = x, with a vector output z = [scale * x, time]
+(``z[2]``/``z[1]`` scalars in FMI 2, an array in FMI 3) and a doStep that fails when u
+exceeds a threshold. They are built with the system C compiler and fmpy's FMI headers;
+without a compiler these tests are skipped.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+
+import gc
+import os
+import shutil
+import stat
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import blocks
+from blocks import DiagramError, SimulationError, loads_diagram, simulate
+from blocks.fmu_archive import ArchiveError, extract_archive
+
+fmpy = pytest.importorskip("fmpy")
+
+SOURCES = Path(__file__).parent / "fmu_sources"
+HEADERS = Path(fmpy.__file__).parent / "c-code"
+
+
+def _compiler() -> str | None:
+    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if name and shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+def _zip(path: Path, files: dict[str, bytes | str]) -> Path:
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, data in files.items():
+            zf.writestr(name, data)
+    return path
+
+
+class Fmus:
+    """Builds FMU files in a folder from the compiled binaries and (edited) model descriptions."""
+
+    def __init__(self, folder: Path, lib2: bytes, lib3: bytes):
+        self.folder = folder
+        self.lib2, self.lib3 = lib2, lib3
+        self.xml2 = (SOURCES / "first_order_fmi2.xml").read_text()
+        self.xml3 = (SOURCES / "first_order_fmi3.xml").read_text()
+        self.fmi2 = self.make("first_order.fmu")
+        self.fmi3 = self.make("first_order3.fmu", version=3)
+
+    def make(self, name: str, xml: str | None = None, version: int = 2, binary: bool = True) -> Path:
+        ext = fmpy.sharedLibraryExtension
+        if version == 2:
+            files = {"modelDescription.xml": self.xml2 if xml is None else xml}
+            if binary:
+                files[f"binaries/{fmpy.platform}/FirstOrder{ext}"] = self.lib2
+        else:
+            files = {"modelDescription.xml": self.xml3 if xml is None else xml}
+            if binary:
+                files[f"binaries/{fmpy.platform_tuple}/FirstOrder3{ext}"] = self.lib3
+        return _zip(self.folder / name, files)
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory) -> Fmus:
+    if sys.platform.startswith("win"):
+        pytest.skip("the test FMUs are built with a Unix C compiler")
+    cc = _compiler()
+    if cc is None:
+        pytest.skip("no C compiler (cc, gcc or clang) on PATH to build the test FMUs")
+    if not (HEADERS / "fmi2Functions.h").is_file() or not (HEADERS / "fmi3Functions.h").is_file():
+        pytest.skip(f"fmpy's FMI headers are missing (looked in {HEADERS})")
+    build = tmp_path_factory.mktemp("fmu_build")
+
+    def compile_(out: str, *sources: str) -> bytes:
+        target = build / out
+        cmd = [cc, "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *(str(SOURCES / s) for s in sources),
+               "-o", str(target)]
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        assert done.returncode == 0, f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}"
+        return target.read_bytes()
+
+    lib2 = compile_("fo2" + fmpy.sharedLibraryExtension, "first_order_fmi2.c")
+    lib3 = compile_("fo3" + fmpy.sharedLibraryExtension, "first_order_fmi3.c", "fmi3_unsupported.c")
+    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3)
+
+
+def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
+            extra: str = "", t_end: str = "1 s", log: str = "[f.y, f.z]"):
+    src = source or "{type: Step, period: 0.1 s, params: {time: 0.3, before: 1.0, after: 2.0}}"
+    return loads_diagram(f"""
+time: {{t_end: {t_end}}}
+blocks:
+  src: {src}
+  f: {{type: FMU, period: {period}, params: {{path: '{path}', start_values: {start_values}}}}}
+{extra}
+connections:
+  - src.y -> f.u
+log: {log}
+""", filename="fmu.yaml")
+
+
+def first_order(a: float, b: float, x0: float, u) -> np.ndarray:
+    """x[k+1] = a x[k] + b u[k] with x[0] = x0: the values x[0..len(u)]."""
+    x = [x0]
+    for uk in u:
+        x.append(a * x[-1] + b * uk)
+    return np.array(x)
+
+
+def load_error(text_or_call) -> str:
+    with pytest.raises(DiagramError) as info:
+        text_or_call()
+    return str(info.value)
+
+
+# -- simulation ---------------------------------------------------------------------------
+
+
+def test_fmi2_fmu_matches_the_closed_form(fmus):
+    d = diagram(fmus.fmi2)
+    block = d.blocks["f"].block
+    assert block.inputs == {"u": 1} and block.outputs == {"y": 1, "z": 2}
+    assert block.feedthrough is False and block.fmi_version == "2.0"
+    assert block.variable_of("z") == "z[...]"
+    results = simulate(d)
+    assert results.complete, results.status
+    t, y = results["f.y"]
+    np.testing.assert_allclose(t, np.arange(11) / 10)
+    u = np.where(t[:-1] < 0.3, 1.0, 2.0)           # the input held over each step
+    np.testing.assert_allclose(y[:, 0], first_order(0.5, 1.0, 0.0, u), rtol=1e-12)
+    _, z = results["f.z"]
+    np.testing.assert_allclose(z[:, 0], y[:, 0], rtol=1e-12)  # z[1] = scale * x, sorted by index
+    np.testing.assert_allclose(z[:, 1], t, atol=1e-12)         # z[2] = the FMU's own time
+
+
+def test_start_values_of_every_type_change_the_result(fmus):
+    sv = "{a: 0.9, b: 0.5, x0: 2.0, scale: 3, frozen: false}"
+    results = simulate(diagram(fmus.fmi2, start_values=sv))
+    t, y = results["f.y"]
+    u = np.where(t[:-1] < 0.3, 1.0, 2.0)
+    np.testing.assert_allclose(y[:, 0], first_order(0.9, 0.5, 2.0, u), rtol=1e-12)
+    np.testing.assert_allclose(results["f.z"][1][:, 0], 3 * y[:, 0], rtol=1e-12)
+    frozen = simulate(diagram(fmus.fmi2, start_values="{x0: 2.0, frozen: true}"))
+    np.testing.assert_array_equal(frozen["f.y"][1], 2.0)
+
+
+def test_fmu_in_a_feedback_loop_has_no_algebraic_loop(fmus):
+    """Co-simulation outputs do not depend on the same instant's input: u = r - y is fine."""
+    d = loads_diagram(f"""
+time: {{t_end: 2 s}}
+blocks:
+  r: {{type: Constant, params: {{value: 1.0}}}}
+  e: {{type: Sum, params: {{signs: "+-"}}}}
+  f: {{type: FMU, period: 0.1 s, params: {{path: '{fmus.fmi2}', start_values: {{a: 0.8, b: 0.5}}}}}}
+connections:
+  - r.y -> e.u0
+  - f.y -> e.u1
+  - e.y -> f.u
+log: [f.y]
+""")
+    _, y = simulate(d)["f.y"]
+    x = [0.0]
+    for _ in range(20):
+        x.append(0.8 * x[-1] + 0.5 * (1.0 - x[-1]))
+    np.testing.assert_allclose(y[:, 0], x, rtol=1e-12)
+
+
+def test_offset_starts_the_fmu_at_its_first_hit(fmus):
+    d = loads_diagram(f"""
+time: {{t_end: 1 s}}
+blocks:
+  src: {{type: Constant, params: {{value: 1.0}}}}
+  f: {{type: FMU, period: 0.2 s, offset: 0.1 s, params: {{path: '{fmus.fmi2}'}}}}
+connections: [src.y -> f.u]
+log: [f.z]
+""")
+    t, z = simulate(d)["f.z"]
+    np.testing.assert_allclose(t, [0.1, 0.3, 0.5, 0.7, 0.9])
+    np.testing.assert_allclose(z[:, 1], t, atol=1e-12)
+
+
+def test_runs_reuse_one_instance_reset_between_runs(fmus):
+    d = diagram(fmus.fmi2, start_values="{a: 0.7}")
+    block = d.blocks["f"].block
+    first = simulate(d)
+    assert len(block._model.idle) == 1
+    pooled = block._model.idle[0]
+    second = simulate(d)
+    assert block._model.idle == [pooled] and block._model.live == 0
+    np.testing.assert_array_equal(first["f.y"][1], second["f.y"][1])
+    # Two states alive at once get two instances, each with its own FMU state.
+    s1, s2 = block.initial_state(), block.initial_state()
+    assert s1.instance is not s2.instance
+    u = {"u": np.array([1.0])}
+    block.output(0.0, s1, u)
+    block.output(0.0, s2, u)
+    block.update(0.0, s1, u)
+    assert block.output(0.1, s1, u)["y"][0] == 1.0 and block.output(0.0, s2, u)["y"][0] == 0.0
+    s1.close()
+    s2.close()
+    assert len(block._model.idle) == 2 and block._model.live == 0
+
+
+def test_close_frees_instances_and_extracted_files(fmus):
+    block = diagram(fmus.fmi2).blocks["f"].block
+    folder = block._model.dir
+    assert (folder / "modelDescription.xml").is_file()
+    block.close()
+    assert not folder.exists() and block._model.idle == []
+    with pytest.raises(blocks.BlockError, match="closed"):
+        block.initial_state()
+
+
+def test_extracted_files_go_away_with_the_block(fmus):
+    d = diagram(fmus.fmi2)
+    simulate(d)
+    folder = d.blocks["f"].block._model.dir
+    del d
+    gc.collect()
+    assert not folder.exists()
+
+
+def test_fmi3_arrays_float32_and_input_defaults(fmus):
+    d = loads_diagram(f"""
+time: {{t_end: 0.5 s}}
+blocks:
+  src: {{type: Constant, params: {{value: 1.0}}}}
+  f: {{type: FMU, period: 0.1 s, params: {{path: '{fmus.fmi3}', start_values: {{a: 0.5, scale: 2, w: [3, 4]}}}}}}
+connections: [src.y -> f.u]
+log: [f.y, f.z, f.wsum, f.yf]
+""")
+    block = d.blocks["f"].block
+    assert block.fmi_version == "3.0"
+    assert block.inputs == {"u": 1, "w": 2}
+    assert block.outputs == {"y": 1, "z": 2, "wsum": 1, "yf": 1}
+    np.testing.assert_array_equal(block.input_defaults["w"], [3.0, 4.0])  # unconnected: start values
+    results = simulate(d)
+    assert results.complete, results.status
+    t, y = results["f.y"]
+    np.testing.assert_allclose(y[:, 0], first_order(0.5, 1.0, 0.0, np.ones(5)), rtol=1e-12)
+    np.testing.assert_allclose(results["f.z"][1], np.column_stack((2 * y[:, 0], t)), atol=1e-12)
+    np.testing.assert_allclose(results["f.wsum"][1][1:, 0], 7.0)
+    np.testing.assert_allclose(results["f.yf"][1][:, 0], y[:, 0], rtol=1e-6)
+    again = simulate(d)                              # the pooled FMI 3 instance, reset
+    assert len(block._model.idle) == 1
+    np.testing.assert_array_equal(again["f.z"][1], results["f.z"][1])
+
+
+def test_fmi3_array_input_connected(fmus):
+    d = loads_diagram(f"""
+time: {{t_end: 0.2 s}}
+blocks:
+  src: {{type: Constant, params: {{value: 1.0}}}}
+  w: {{type: Constant, params: {{value: [0.25, 0.5]}}}}
+  f: {{type: FMU, period: 0.1 s, params: {{path: '{fmus.fmi3}'}}}}
+connections: [src.y -> f.u, w.y -> f.w]
+log: [f.wsum]
+""")
+    np.testing.assert_allclose(simulate(d)["f.wsum"][1][:, 0], [0.0, 0.75, 0.75])
+
+
+# -- run-time failures --------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_dostep_error_names_block_time_status_and_fmu_log(fmus, version):
+    path = fmus.fmi2 if version == 2 else fmus.fmi3
+    d = diagram(path, start_values="{threshold: 1.5}", log="[f.y]")
+    results = simulate(d)
+    assert not results.complete
+    status = results.status
+    assert status.startswith("failed at t=0.3 s: block 'f' (FMU)"), status
+    assert f"fmi{version}DoStep at t=0.3 s (step 0.1 s) returned status 'error'" in status
+    assert "input u = 2 exceeds the threshold 1.5 at t = 0.3" in status       # the FMU's log line
+    t, y = results["f.y"]                                                    # results so far kept
+    np.testing.assert_allclose(t, [0.0, 0.1, 0.2, 0.3])
+    np.testing.assert_allclose(y[:, 0], first_order(0.5, 1.0, 0.0, [1, 1, 1]))
+    with pytest.raises(SimulationError) as info:
+        simulate(d, raise_on_failure=True)
+    assert info.value.block == "f" and info.value.time == pytest.approx(0.3)
+    # The failed instance was freed, not pooled; the next run starts clean and fails the same way.
+    assert simulate(d).status == status
+
+
+def test_dostep_discard_is_a_failure(fmus):
+    src = "{type: Step, period: 0.1 s, params: {time: 0.2, before: 1.0, after: -5.0}}"
+    results = simulate(diagram(fmus.fmi2, start_values="{threshold: 2}", source=src))
+    assert "fmi2DoStep at t=0.2 s (step 0.1 s) returned status 'discard'" in results.status
+    assert "step discarded" in results.status
+
+
+# -- load-time errors ---------------------------------------------------------------------
+
+
+def test_unknown_start_value_is_named_with_a_suggestion(fmus):
+    msg = load_error(lambda: diagram(fmus.fmi2, start_values="{thresold: 3}"))
+    assert "fmu.yaml:" in msg and "block 'f' (FMU)" in msg
+    assert "unknown variable 'thresold' in start_values" in msg
+    assert "did you mean 'threshold'?" in msg
+
+
+@pytest.mark.parametrize("values, expected", [
+    ("{y: 1.0}", "cannot set a start value for 'y'"),
+    ("{z: [1, 2]}", "cannot set a start value for 'z[1]'"),
+    ("{scale: 1.5}", "start value of 'scale' must be an integer"),
+    ("{frozen: 3}", "start value of 'frozen' must be true or false"),
+    ("{a: [1, 2]}", "start value of 'a' must have 1 entries"),
+    ("{a: hello}", "start value of 'a' must be a number"),
+    ("[1, 2]", "parameter 'start_values' must be a mapping"),
+])
+def test_bad_start_values(fmus, values, expected):
+    assert expected in load_error(lambda: diagram(fmus.fmi2, start_values=values))
+
+
+def test_without_a_period_the_fmus_default_step_is_the_period(fmus):
+    text = f"""
+time: {{t_end: 0.5 s}}
+blocks:
+  src: {{type: Constant, params: {{value: 1.0}}}}
+  f: {{type: FMU, params: {{path: '{fmus.fmi2}'}}}}
+connections: [src.y -> f.u]
+log: [f.y]
+"""
+    d = loads_diagram(text)
+    assert d.blocks["f"].period == Fraction(1, 10)  # the FMU's DefaultExperiment stepSize
+    t, _ = simulate(d)["f.y"]
+    np.testing.assert_allclose(t, [0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
+
+
+def test_missing_file_relative_to_the_current_directory(fmus, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    msg = load_error(lambda: diagram(Path("nowhere/plant.fmu")))
+    assert f"FMU file not found: {tmp_path / 'nowhere' / 'plant.fmu'}" in msg
+    assert "relative paths are resolved against the current directory" in msg
+    shutil.copy(fmus.fmi2, tmp_path / "plant.fmu")
+    assert simulate(diagram(Path("plant.fmu"))).complete
+
+
+def test_not_a_zip(fmus, tmp_path):
+    bogus = tmp_path / "bogus.fmu"
+    bogus.write_text("not an FMU")
+    assert "is not an FMU: not a zip archive" in load_error(lambda: diagram(bogus))
+    assert "is a folder" in load_error(lambda: diagram(tmp_path))
+
+
+def test_no_model_description(fmus, tmp_path):
+    empty = _zip(tmp_path / "empty.fmu", {"resources/readme.txt": "hello"})
+    assert "the archive has no modelDescription.xml" in load_error(lambda: diagram(empty))
+
+
+def test_broken_model_description(fmus):
+    truncated = fmus.make("truncated.fmu", fmus.xml2[: len(fmus.xml2) // 2])
+    msg = load_error(lambda: diagram(truncated))
+    assert "has a broken modelDescription.xml" in msg
+    invalid = fmus.make("invalid.fmu", fmus.xml2.replace('causality="input"', 'causality="sideways"'))
+    assert "has a broken modelDescription.xml" in load_error(lambda: diagram(invalid))
+
+
+def test_model_exchange_only(fmus):
+    xml = fmus.xml2.replace('<CoSimulation modelIdentifier="FirstOrder" '
+                            'canHandleVariableCommunicationStepSize="true"/>',
+                            '<ModelExchange modelIdentifier="FirstOrder"/>')
+    me = fmus.make("me_only.fmu", xml, binary=False)
+    msg = load_error(lambda: diagram(me))
+    assert "has no co-simulation interface (it provides only model exchange)" in msg
+
+
+def test_no_binary_for_this_platform(fmus):
+    nobin = fmus.make("nobin.fmu", binary=False)
+    msg = load_error(lambda: diagram(nobin))
+    assert f"has no binary for this platform ({fmpy.platform}/FirstOrder" in msg
+    assert "it has no binaries" in msg
+
+
+def test_instantiation_failure_is_a_load_error_with_the_fmu_log(fmus):
+    wrong = fmus.make("wrong_guid.fmu", fmus.xml2.replace("8c4e810f", "00000000"))
+    msg = load_error(lambda: diagram(wrong))
+    assert "instantiating the FMU failed" in msg
+    assert "FMU log: [error] logStatusError: wrong FMU type or GUID {00000000" in msg
+
+
+def test_vector_with_a_gap(fmus):
+    gap = fmus.make("gap.fmu", fmus.xml2.replace('name="z[1]"', 'name="z[3]"'))
+    msg = load_error(lambda: diagram(gap))
+    assert "vector 'z' must be numbered 1..n without gaps, but z[1] is missing" in msg
+
+
+def test_unsafe_archive_is_refused_by_the_block(fmus, tmp_path):
+    evil = _zip(tmp_path / "evil.fmu", {"modelDescription.xml": fmus.xml2, "../evil.txt": "x"})
+    msg = load_error(lambda: diagram(evil))
+    assert "unsafe FMU archive" in msg and "'../evil.txt'" in msg
+    assert not (tmp_path.parent / "evil.txt").exists()
+
+
+def test_grouping_rules():
+    from types import SimpleNamespace as V
+
+    from blocks.fmu import _group_variables
+
+    def var(name, vr, type="Real"):
+        return V(name=name, valueReference=vr, type=type, dimensions=[], shape=())
+
+    ports = _group_variables([var("A[2,1]", 3), var("A[1,1]", 1), var("A[1,2]", 2), var("A[2,2]", 4),
+                              var("body.v", 5), var("q[1]", 7), var("q[2]", 6)], "output", "F")
+    assert {n: (p.width, p.vrs) for n, p in ports.items()} == {
+        "A": (4, [1, 2, 3, 4]), "body_v": (1, [5]), "q": (2, [7, 6])}
+    with pytest.raises(ValueError, match="'x' is both a variable and the vector"):
+        _group_variables([var("x", 1), var("x[1]", 2)], "input", "F")
+    with pytest.raises(ValueError, match=r"'a.b' and 'a_b' both map to the port name 'a_b'"):
+        _group_variables([var("a.b", 1), var("a_b", 2)], "input", "F")
+    with pytest.raises(ValueError, match="indices must start at 1"):
+        _group_variables([var("x[0]", 1), var("x[1]", 2)], "input", "F")
+
+
+# -- safe extraction ----------------------------------------------------------------------
+
+
+def _zip_with(path: Path, name: str, data: bytes = b"x", mode: int | None = None) -> Path:
+    info = zipfile.ZipInfo(name)
+    if mode is not None:
+        info.create_system = 3
+        info.external_attr = mode << 16
+    with zipfile.ZipFile(path, "w") as zf:
+        zf.writestr("ok.txt", "fine")
+        zf.writestr(info, data)
+    return path
+
+
+@pytest.mark.filterwarnings("ignore:Duplicate name")
+@pytest.mark.parametrize("name, mode, expected", [
+    ("../evil.txt", None, "has a '..' component"),
+    ("a/../../evil.txt", None, "has a '..' component"),
+    ("..\\evil.txt", None, "has a '..' component"),
+    ("/abs/evil.txt", None, "has an absolute path"),
+    ("C:/evil.txt", None, "drive letter"),
+    ("link", stat.S_IFLNK | 0o777, "is a symbolic link"),
+    ("fifo", stat.S_IFIFO | 0o644, "is a special file"),
+    ("ok.txt", None, "occurs twice"),
+])
+def test_extractor_rejects_unsafe_members(tmp_path, name, mode, expected):
+    archive = _zip_with(tmp_path / "a.zip", name, b"/etc/passwd" if mode else b"x", mode)
+    dest = tmp_path / "out"
+    dest.mkdir()
+    with pytest.raises(ArchiveError, match=expected) as info:
+        extract_archive(archive, dest)
+    assert repr(name) in str(info.value)
+    assert list(dest.iterdir()) == []               # nothing written
+    assert not (tmp_path / "evil.txt").exists()
+
+
+def test_extractor_limits_size_and_count(tmp_path):
+    big = _zip_with(tmp_path / "big.zip", "big.bin", b"\0" * 5000)
+    (tmp_path / "o1").mkdir()
+    with pytest.raises(ArchiveError, match="'big.bin' is 5000 bytes uncompressed, more than the limit of 1000"):
+        extract_archive(big, tmp_path / "o1", max_member_bytes=1000)
+    with pytest.raises(ArchiveError, match="more than the limit of 3000 bytes"):
+        extract_archive(big, tmp_path / "o1", max_total_bytes=3000)
+    many = _zip(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
+    with pytest.raises(ArchiveError, match="has 20 members, more than the limit of 10"):
+        extract_archive(many, tmp_path / "o1", max_members=10)
+    extract_archive(many, tmp_path / "o1")
+    assert len(list((tmp_path / "o1").iterdir())) == 20
+
+
+def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
+    """A forged header declaring a small size does not let more data through."""
+    archive = tmp_path / "forged.zip"
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_STORED) as zf:
+        zf.writestr("x.bin", b"A" * 4096)
+    data = bytearray(archive.read_bytes())
+    # Patch the uncompressed size in the central directory (offset 24 of its entry) to 16.
+    cd = data.rfind(b"PK\x01\x02")
+    data[cd + 24:cd + 28] = (16).to_bytes(4, "little")
+    archive.write_bytes(bytes(data))
+    (tmp_path / "out").mkdir()
+    with pytest.raises((ArchiveError, zipfile.BadZipFile)):
+        extract_archive(archive, tmp_path / "out", max_member_bytes=100)
+    assert not (tmp_path / "out" / "x.bin").exists()
