@@ -12,20 +12,20 @@ operation by operation, so the two agree to round-off.
 Everything comes in flat arrays (layouts below); ``pack_params`` and
 ``pack_trajectories`` build them. The kernel inlines the model's compiled kinematics and
 dynamics (``finger_frames``, ``point_jacobian``, ``finger_bias``), so its on-disk cache
-is flushed whenever those sources change (``_invalidate_if_stale``), like the plant's.
+is flushed whenever those sources change (``invalidate_if_stale``), like the plant's.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from pathlib import Path
 
 import numpy as np
 from numba import njit
+from numba.core.registry import CPUDispatcher
 
 from ..model.dynamics import finger_bias
-from ..model.kernel_cache import sources_digest
+from ..model.kernel_cache import invalidate_if_stale
 from ..model.kinematics import finger_frames, point_jacobian
 from ..model.layout import (
     F_BASE_ANGLE,
@@ -263,39 +263,7 @@ def manipulation_output(t, q, qd, fn, fingers, params, waypoints, meta, out):
 
 # -- on-disk cache consistency -------------------------------------------------------------
 
-_STAMP_NAME = "hierhand_manipulation_kernel.sha256"
-
-
-def _invalidate_if_stale() -> bool:
-    """Flush this module's numba cache when the model kernel sources it inlines changed.
-
-    Numba keys a cached function on its own file only; ``manipulation_output`` also
-    contains ``finger_frames``, ``point_jacobian`` and ``finger_bias``. Same scheme as
-    ``hierhand.model.kernel_cache.invalidate_if_stale``, with a stamp of its own so that
-    other modules' stamps in the same cache folder do not hide a stale cache here.
-    """
-    from numba.core.registry import CPUDispatcher
-
-    dispatchers = [obj for obj in globals().values()
-                   if isinstance(obj, CPUDispatcher) and getattr(obj, "_cache", None) is not None]
-    paths = {getattr(d._cache, "cache_path", None) for d in dispatchers}
-    paths.discard(None)
-    if not paths:
-        return False
-    digest = sources_digest()
-    try:
-        stale = [p for p in paths
-                 if not (Path(p) / _STAMP_NAME).is_file() or (Path(p) / _STAMP_NAME).read_text().strip() != digest]
-        if not stale:
-            return False
-        for d in dispatchers:
-            d._cache.flush()
-        for p in paths:
-            Path(p).mkdir(parents=True, exist_ok=True)
-            (Path(p) / _STAMP_NAME).write_text(digest + "\n")
-    except OSError:
-        return False
-    return True
-
-
-_invalidate_if_stale()
+# ``manipulation_output`` inlines the model's finger_frames, point_jacobian and finger_bias,
+# which numba's cache does not track (it keys on this file only).
+invalidate_if_stale([obj for obj in list(globals().values()) if isinstance(obj, CPUDispatcher)],
+                    stamp_name="hierhand_manipulation_kernel.sha256")

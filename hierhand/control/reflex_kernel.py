@@ -295,4 +295,5 @@ def reflex_update(params, state, tip, normal, fn, ft):
 
 # A compiled kernel also holds the kinematics it inlines: drop our cache entries when the
 # model's kernel sources change (numba keys the cache on this file only).
-invalidate_if_stale([_check_inputs, reflex_directions, reflex_forces, reflex_output, reflex_update])
+invalidate_if_stale([_check_inputs, reflex_directions, reflex_forces, reflex_output, reflex_update],
+                    stamp_name="hierhand_reflex_kernel.sha256")

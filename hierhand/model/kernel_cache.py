@@ -25,11 +25,13 @@ def sources_digest(directory: Path = Path(__file__).parent) -> str:
     return h.hexdigest()
 
 
-def invalidate_if_stale(dispatchers: Iterable) -> bool:
+def invalidate_if_stale(dispatchers: Iterable, stamp_name: str = STAMP_NAME) -> bool:
     """Flush the cache indexes of ``dispatchers`` if the kernel sources changed.
 
     Returns whether it flushed. Does nothing where caching is unavailable (no ``_cache``
-    on the dispatcher, or a read-only cache directory).
+    on the dispatcher, or a read-only cache directory). Modules that share a cache folder
+    pass a ``stamp_name`` of their own, so that one module's refreshed stamp cannot hide
+    another's stale cache.
     """
     dispatchers = [d for d in dispatchers if getattr(d, "_cache", None) is not None]
     paths = {getattr(d._cache, "cache_path", None) for d in dispatchers}
@@ -39,7 +41,7 @@ def invalidate_if_stale(dispatchers: Iterable) -> bool:
     digest = sources_digest()
     stale = False
     for path in paths:
-        stamp = Path(path) / STAMP_NAME
+        stamp = Path(path) / stamp_name
         try:
             if not stamp.is_file() or stamp.read_text().strip() != digest:
                 stale = True
@@ -52,7 +54,7 @@ def invalidate_if_stale(dispatchers: Iterable) -> bool:
             d._cache.flush()
         for path in paths:
             Path(path).mkdir(parents=True, exist_ok=True)
-            (Path(path) / STAMP_NAME).write_text(digest + "\n")
+            (Path(path) / stamp_name).write_text(digest + "\n")
     except OSError:
         return False
     return True
