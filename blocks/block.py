@@ -46,6 +46,9 @@ class Block:
 
     type_name: ClassVar[str | None] = None
     param_docs: ClassVar[dict[str, str]] = {}
+    path_params: ClassVar[tuple[str, ...]] = ()
+    """Parameters holding file paths: the loader resolves relative ones against the
+    diagram's folder, as it does ``params_file``."""
     time_varying: ClassVar[bool] = False
 
     inputs: dict[str, int | None] = {}

@@ -433,6 +433,10 @@ class _Loader:
                 target = target[part]
             else:
                 target[parts[-1]] = value
+        for key in cls.path_params:
+            value = params.get(key)
+            if isinstance(value, str) and value.strip() and not Path(value).expanduser().is_absolute():
+                params[key] = str(self.base_dir / value)
         missing = [p for p, d in declared.items() if d.default is d.empty and p not in params]
         if missing:
             self.error(spec.line_of("params") if "params" in spec else line,

@@ -7,7 +7,7 @@ In a diagram::
         type: FMU
         period: 10 ms                          # the communication step size (required)
         params:
-          path: fmus/first_order.fmu           # relative to the current directory
+          path: fmus/first_order.fmu           # relative to the diagram's folder
           start_values: {a: 0.9, "z[2]": 1.0, gains: [1, 2, 3]}
     connections:
       - ctrl.y -> plant.u
@@ -750,8 +750,8 @@ class FMU(Block):
     """An FMI 2.0 / 3.0 co-simulation FMU; its period is the communication step."""
 
     param_docs = {
-        "path": "the .fmu file; a relative path is resolved against the current directory "
-                "(not the diagram's folder)",
+        "path": "the .fmu file; in a diagram a relative path is resolved against the diagram's "
+                "folder (from Python, against the current directory)",
         "start_values": "mapping of FMU variable names to start values (parameters, inputs, "
                         "variables with an exact/approx start); a vector 'x' for x[1], x[2], ... "
                         "or an FMI 3 array takes a list",
@@ -759,6 +759,7 @@ class FMU(Block):
                      "DefaultExperiment tolerance, if any",
     }
     time_varying = True
+    path_params = ("path",)
 
     def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
                  tolerance: float | None = None):

@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 import blocks
-from blocks import DiagramError, SimulationError, loads_diagram, simulate
+from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, simulate
 from blocks.fmu_archive import ArchiveError, extract_archive
 
 fmpy = pytest.importorskip("fmpy")
@@ -338,13 +338,23 @@ log: [f.y]
     np.testing.assert_allclose(t, [0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
 
 
-def test_missing_file_relative_to_the_current_directory(fmus, tmp_path, monkeypatch):
+def test_a_relative_path_is_resolved_against_the_diagrams_folder(fmus, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    msg = load_error(lambda: diagram(Path("nowhere/plant.fmu")))
-    assert f"FMU file not found: {tmp_path / 'nowhere' / 'plant.fmu'}" in msg
-    assert "relative paths are resolved against the current directory" in msg
-    shutil.copy(fmus.fmi2, tmp_path / "plant.fmu")
-    assert simulate(diagram(Path("plant.fmu"))).complete
+    folder = tmp_path / "project"
+    (folder / "fmus").mkdir(parents=True)
+    shutil.copy(fmus.fmi2, folder / "fmus" / "plant.fmu")
+    text = """
+time: {t_end: 0.3 s}
+blocks:
+  src: {type: Constant, params: {value: 1.0}}
+  f: {type: FMU, period: 0.1 s, params: {path: fmus/plant.fmu}}
+connections: [src.y -> f.u]
+log: [f.y]
+"""
+    (folder / "d.yaml").write_text(text)
+    assert simulate(load_diagram(folder / "d.yaml")).complete
+    msg = load_error(lambda: loads_diagram(text, filename="d.yaml", base_dir=tmp_path / "elsewhere"))
+    assert f"FMU file not found: {tmp_path / 'elsewhere' / 'fmus' / 'plant.fmu'}" in msg
 
 
 def test_not_a_zip(fmus, tmp_path):
