@@ -497,3 +497,18 @@ def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
     with pytest.raises((ArchiveError, zipfile.BadZipFile)):
         extract_archive(archive, tmp_path / "out", max_member_bytes=100)
     assert not (tmp_path / "out" / "x.bin").exists()
+
+
+def test_fmu_info_lists_interfaces_experiment_and_variables(fmus, tmp_path):
+    from blocks.fmu_info import FMUInfoError, describe_fmu
+
+    text = describe_fmu(fmus.fmi2)
+    assert "FMI 2.0" in text and "co-simulation (model identifier" in text
+    assert "step 0.1" in text
+    for name in ("u", "y", "z[1]", "z[2]", "a"):
+        assert f"\n    {name} " in text
+    assert "input" in text and "output" in text and "parameter" in text
+    bogus = tmp_path / "bogus.fmu"
+    bogus.write_text("not a zip")
+    with pytest.raises(FMUInfoError, match="not a readable zip"):
+        describe_fmu(bogus)
