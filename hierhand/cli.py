@@ -100,6 +100,21 @@ def build_parser() -> argparse.ArgumentParser:
                      help="folder of the task diagrams (default: the repository's diagrams/)")
     rep.set_defaults(handler=cmd_reproduce)
 
+    fmu = sub.add_parser("fmu", help="export the hand plant as an FMU, or describe an FMU")
+    fmu_sub = fmu.add_subparsers(dest="fmu_command", required=True, metavar="FMU_COMMAND")
+    export = fmu_sub.add_parser("export", help="package the hand plant as an FMI co-simulation FMU",
+                                description="Package the HandPlant as an FMI 2.0 or 3.0 co-simulation FMU "
+                                            "(Python slave: the importing tool needs Python with numpy and "
+                                            "numba). Its parameters are the hand file's values.")
+    export.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default: 2)")
+    export.add_argument("--hand", type=Path, metavar="FILE", help="hand file (default: the shipped hand)")
+    export.add_argument("-o", "--output", type=Path, metavar="PATH",
+                        help="FMU file or folder to write (default: fmu/)")
+    export.set_defaults(handler=cmd_fmu_export)
+    info = fmu_sub.add_parser("info", help="variables, causality, default experiment, interface types")
+    info.add_argument("path", type=Path, metavar="PATH", help="FMU file")
+    info.set_defaults(handler=cmd_fmu_info)
+
     types = sub.add_parser("blocks", help="list block types with their ports and parameters")
     types.add_argument("types", nargs="*", metavar="TYPE", help="only these types")
     types.set_defaults(handler=cmd_blocks)
@@ -327,6 +342,26 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
           f"{r['suppressed']['fore_separation_time_s']} s with suppresser, "
           f"{r['unsuppressed']['fore_separation_time_s']} without")
     print(f"wrote {args.output}/summary.json, report.md and fig09.png ... fig14.png")
+    return EXIT_OK
+
+
+def cmd_fmu_export(args: argparse.Namespace) -> int:
+    from hierhand.fmu_export import export_plant_fmu
+
+    if args.hand is not None and not args.hand.is_file():
+        raise UsageError(f"--hand {args.hand}: hand file not found")
+    path = export_plant_fmu(args.output, fmi=args.fmi, hand=args.hand)
+    print(f"wrote {path}")
+    return EXIT_OK
+
+
+def cmd_fmu_info(args: argparse.Namespace) -> int:
+    from blocks.fmu_info import FMUInfoError, describe_fmu
+
+    try:
+        print(describe_fmu(args.path))
+    except FMUInfoError as exc:
+        raise UsageError(str(exc)) from None
     return EXIT_OK
 
 
