@@ -261,3 +261,29 @@ def test_default_output_path():
     assert FMU_DIR == REPO / "fmu" and (FMU_DIR / "hand_plant_slave.py.in").is_file()
     with pytest.raises(ValueError, match="fmi"):
         export_plant_fmu(fmi=1)
+
+
+@pytest.fixture(scope="module")
+def native_regrasp():
+    import blocks
+
+    return blocks.simulate(blocks.load_diagram(REPO / "diagrams" / "regrasp.yaml"))
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_regrasp_with_the_exported_plant_matches_the_native_run(fmus, native_regrasp, fmi):
+    """diagrams/regrasp_fmu.yaml: the same task with the plant as an FMU, at 1 ms steps."""
+    import blocks
+    from hierhand.tasks.metrics import regrasp_summary
+
+    diagram = blocks.load_diagram(REPO / "diagrams" / "regrasp_fmu.yaml",
+                                  overrides={"plant.path": str(fmus[fmi])})
+    via_fmu = blocks.simulate(diagram)
+    assert via_fmu.complete
+    t_native, q_native = native_regrasp["plant.q"]
+    t_fmu, q_fmu = via_fmu["plant.q"]
+    np.testing.assert_array_equal(t_fmu, t_native)
+    np.testing.assert_allclose(q_fmu, q_native, rtol=0, atol=TOL)
+    fmu_events, native_events = regrasp_summary(via_fmu), regrasp_summary(native_regrasp)
+    assert fmu_events == native_events
+    assert fmu_events["fore_separation_time_s"] is not None
