@@ -207,7 +207,10 @@ _ISOLATED = textwrap.dedent(
 
 def test_fmu_runs_in_a_python_without_hierhand(fmus, fmu_cache, tmp_path):
     paths = sysconfig.get_paths()
-    site = sorted({paths["purelib"], paths["platlib"]})
+    # the installed packages' folders (a virtual environment may also see the system's),
+    # but none of the .pth files that put the editable hierhand on the path
+    site = sorted({paths["purelib"], paths["platlib"]}
+                  | {p for p in sys.path if Path(p).name in ("site-packages", "dist-packages")})
     env = dict(os.environ, HIERHAND_FMU_CACHE=str(fmu_cache))
     env.pop("PYTHONPATH", None)
     proc = subprocess.run(
