@@ -14,8 +14,8 @@ Outputs: ``tau_m``, the PD torque of the voluntary motion (what the suppresser w
 against the grasping torque), and ``tau_ff``, a feedforward that keeps the 10 ms loop's
 gains small: the fingers' own gravity torques and the object's weight shared equally by
 the fingers in contact (``J^T`` of ``-m g / k``); without it the soft PD lets a held
-object sag by millimetres. The actuator command is the suppresser's output plus
-``tau_ff``. Keeping the feedforward out of ``tau_m`` matters: it is not voluntary
+object sag by millimetres. The suppresser adds ``tau_ff`` to the actuator command after
+suppression. Keeping the feedforward out of ``tau_m`` matters: it is not voluntary
 motion, and a finger that merely carries the object must not have its grasp suppressed.
 """
 

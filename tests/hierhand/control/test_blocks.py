@@ -150,3 +150,12 @@ def test_disabled_suppresser_passes_the_grasp_torque_through():
     out = s.output(0, None, {"tau_g": np.arange(9.0), "tau_m": np.ones(9)})
     np.testing.assert_array_equal(out["tau_g_eff"], np.arange(9.0))
     np.testing.assert_array_equal(out["tau"], np.arange(9.0) + 1)
+
+
+def test_suppresser_adds_the_feedforward_unsuppressed():
+    s = Suppresser(S_a=200.0, S_b=0.1)
+    tau_ff = np.linspace(-0.2, 0.2, 9)
+    big = np.full(9, 0.5)
+    out = s.output(0, None, {"tau_g": np.full(9, 0.3), "tau_m": big, "tau_ff": tau_ff})
+    np.testing.assert_allclose(out["tau"], big + tau_ff, atol=1e-30)
+    assert s.input_defaults["tau_ff"].tolist() == [0.0] * 9
