@@ -217,11 +217,7 @@ def reflex_directions(params, state, tip, normal, fn):
 @njit(cache=True)
 def reflex_forces(params, state, tip, normal, fn):
     """(f (3, 2), grasp (3,) bool): ``GraspReflex.forces``."""
-    _check_inputs(state, tip, normal, fn)
-    g = np.empty((3, 2))
-    grasp = np.empty(3, dtype=np.bool_)
-    touching = np.empty(3, dtype=np.bool_)
-    _directions(params, state, tip, normal, fn, g, grasp, touching)
+    g, grasp, touching = reflex_directions(params, state, tip, normal, fn)
     f = np.empty((3, 2))
     _forces(params, state, g, touching, f)
     return f, grasp

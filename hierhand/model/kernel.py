@@ -274,16 +274,23 @@ def write_outputs(state, ws, row):
 
 
 @njit(cache=True)
-def step_kernel(state, tau, f_ext, fingers, body, edges):
-    """One update in place; returns (code, updates done when it was found, index)."""
+def start_steps(state, tau, f_ext, fingers, body, edges):
+    """Check the inputs and the state and evaluate the contacts before the first update:
+    (code, index, number of surface points, workspace)."""
     code, which = check_inputs(tau, f_ext)
     if code == OK:
         code, which = check_state(state)
-    if code != OK:
-        return code, 0, which
     npts = n_points(edges)
     ws = make_workspace(npts)
-    code, which = evaluate(state, fingers, body, edges, npts, ws)
+    if code == OK:
+        code, which = evaluate(state, fingers, body, edges, npts, ws)
+    return code, which, npts, ws
+
+
+@njit(cache=True)
+def step_kernel(state, tau, f_ext, fingers, body, edges):
+    """One update in place; returns (code, updates done when it was found, index)."""
+    code, which, npts, ws = start_steps(state, tau, f_ext, fingers, body, edges)
     if code != OK:
         return code, 0, which
     commit(state, edges, npts, ws)
@@ -326,14 +333,7 @@ def advance_kernel(state, tau, f_ext, fingers, body, edges, rows):
     error was found in the state (0: the starting state), ``rows.shape[0]`` on success.
     """
     n = rows.shape[0]
-    code, which = check_inputs(tau, f_ext)
-    if code == OK:
-        code, which = check_state(state)
-    if code != OK:
-        return code, 0, which
-    npts = n_points(edges)
-    ws = make_workspace(npts)
-    code, which = evaluate(state, fingers, body, edges, npts, ws)
+    code, which, npts, ws = start_steps(state, tau, f_ext, fingers, body, edges)
     if code != OK:
         return code, 0, which
     for i in range(n):
