@@ -8,8 +8,9 @@ from .block import Block
 
 
 def summary(cls: type[Block]) -> str:
+    """The first paragraph of the class docstring, on one line."""
     doc = inspect.getdoc(cls) or ""
-    return doc.splitlines()[0] if doc else ""
+    return " ".join(doc.split("\n\n")[0].split())
 
 
 def describe_type(cls: type[Block]) -> str:
