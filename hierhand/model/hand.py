@@ -7,6 +7,9 @@ the plant's kernel uses, so what a controller computes from them is what the pla
 
 from __future__ import annotations
 
+import functools
+import json
+
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -56,11 +59,24 @@ from .layout import (
 
 
 def load_hand(path_or_dict: str | Path | Mapping[str, Any]) -> "Hand":
-    """A hand from a hand file (path) or its content (dict); missing sections default."""
+    """A hand from a hand file (path) or its content (dict); missing sections default.
+
+    Hands built from equal contents are one shared object (the plant and both
+    controllers of a diagram read the same hand); treat a Hand as read-only.
+    """
     if isinstance(path_or_dict, Mapping):
-        return Hand(parse_hand(merge_with_default(path_or_dict)))
+        try:
+            key = json.dumps(path_or_dict, sort_keys=True)
+        except (TypeError, ValueError):  # contents JSON cannot hold: no sharing, same checks
+            return Hand(parse_hand(merge_with_default(path_or_dict)))
+        return _hand_from_json(key)
     source = str(path_or_dict)
     return Hand(parse_hand(merge_with_default(read_hand_file(source)), source))
+
+
+@functools.lru_cache(maxsize=64)
+def _hand_from_json(key: str) -> "Hand":
+    return Hand(parse_hand(merge_with_default(json.loads(key))))
 
 
 class Hand:
