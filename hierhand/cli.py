@@ -1,4 +1,4 @@
-"""The ``hierhand`` command line: run, validate, graph, plot and list blocks.
+"""The ``hierhand`` command line: run, validate, graph, plot, sweep and list blocks.
 
 Exit codes: 0 ok, 2 bad input (a one-line message per problem, no traceback), 1 a failure
 during a simulation (the message names block, time and signal; partial results are kept).
@@ -114,6 +114,53 @@ def build_parser() -> argparse.ArgumentParser:
     info = fmu_sub.add_parser("info", help="variables, causality, default experiment, interface types")
     info.add_argument("path", type=Path, metavar="PATH", help="FMU file")
     info.set_defaults(handler=cmd_fmu_info)
+
+    sweep = sub.add_parser("sweep", help="run a diagram at many parameter points (Dask), one CSV row each",
+                           description="Run DIAGRAM at every point of a grid, random samples or a points "
+                                       "file, on a Dask LocalCluster (default: one single-threaded worker "
+                                       "process per core) or a running scheduler, appending one row per "
+                                       "finished run to OUTPUT/sweep.csv. Re-running the same command "
+                                       "resumes: points already in the file are skipped.")
+    sweep.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
+    sweep.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
+                       help="sweep folder: sweep.csv and sweep.json")
+    sweep.add_argument("--grid", action="append", default=[], metavar="BLOCK.PARAM=V1,V2,...",
+                       help="grid axis, values read as YAML (repeatable: cartesian product), "
+                            "e.g. --grid suppress.S_b=0.05,0.1,0.2")
+    sweep.add_argument("--random", action="append", default=[], metavar="BLOCK.PARAM=DIST",
+                       help="random axis, DIST uniform(a,b) or normal(mean,std) (repeatable; "
+                            "crossed with --grid if both are given)")
+    sweep.add_argument("--samples", type=int, default=10, metavar="N", help="random samples (default: 10)")
+    sweep.add_argument("--seed", type=int, default=0, metavar="S", help="random seed (default: 0)")
+    sweep.add_argument("--points", type=Path, metavar="FILE.csv",
+                       help="points file: header of BLOCK.PARAM columns, one point per row")
+    sweep.add_argument("--metric", action="append", default=[], dest="metrics", metavar="NAME=EXPR",
+                       help="a column per run (repeatable): REDUCER(BLOCK.PORT[i]) with final, max, min, "
+                            "mean, first_time_above(BLOCK.PORT[i], X), first_time_below(BLOCK.PORT[i], X); "
+                            "or a hand task measure: separation_time, object_dropped, peak_ratio[(T)], "
+                            "recovery_time[(T)]")
+    where = sweep.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="LocalCluster worker processes (default: one per core; 0 = in this process)")
+    where.add_argument("--scheduler", metavar="tcp://HOST:PORT", help="use the workers of a running scheduler")
+    where.add_argument("--serial", action="store_true", help="run the points in this process, one by one")
+    sweep.add_argument("--t-end", "--stop-time", dest="t_end", metavar="T",
+                       help="end time of every run (default: the diagram's time.t_end)")
+    sweep.add_argument("--trust", action="store_true",
+                       help="allow 'python:module:Class' block types, which import code named in the diagram")
+    sweep.add_argument("-q", "--quiet", action="store_true", help="no progress line or summary")
+    sweep.set_defaults(handler=cmd_sweep)
+
+    splot = sub.add_parser("sweep-plot", help="plot a metric of a sweep against one or two parameters",
+                           description="A line plot of METRIC over PARAM (one line per combination of the "
+                                       "other parameters, or their mean when there are many), or a heat "
+                                       "map over two parameters (other parameters averaged).")
+    splot.add_argument("sweep_dir", type=Path, metavar="DIR", help="sweep folder of 'hierhand sweep'")
+    splot.add_argument("--x", required=True, metavar="PARAM", help="parameter on the x axis, e.g. suppress.S_b")
+    splot.add_argument("--y", metavar="PARAM", help="second parameter: draws a heat map")
+    splot.add_argument("--metric", required=True, metavar="NAME", help="metric column to plot")
+    splot.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png", help="PNG file to write")
+    splot.set_defaults(handler=cmd_sweep_plot)
 
     types = sub.add_parser("blocks", help="list block types with their ports and parameters")
     types.add_argument("types", nargs="*", metavar="TYPE", help="only these types")
@@ -362,6 +409,69 @@ def cmd_fmu_info(args: argparse.Namespace) -> int:
         print(describe_fmu(args.path))
     except FMUInfoError as exc:
         raise UsageError(str(exc)) from None
+    return EXIT_OK
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    import time
+
+    from blocks import load_diagram
+    from hierhand.sweep import SweepError
+    from hierhand.sweep.metrics import parse_metrics
+    from hierhand.sweep.plan import execute, prepare
+    from hierhand.sweep.points import (combine, csv_points, grid_points, parse_grid, parse_random,
+                                       random_points)
+
+    try:
+        if args.points is not None and (args.grid or args.random):
+            raise SweepError("--points cannot be combined with --grid or --random")
+        if args.workers is not None and args.workers < 0:
+            raise SweepError(f"--workers must be 0 or more, got {args.workers}")
+        metrics = parse_metrics(args.metrics)
+        axes: dict[str, Any] = {}
+        if args.points is not None:
+            points = csv_points(args.points)
+            axes["points_file"] = str(args.points)
+        else:
+            grid, dists = parse_grid(args.grid), parse_random(args.random)
+            sampled = random_points(dists, args.samples, args.seed) if dists else []
+            points = combine(grid_points(grid) if grid else [], sampled)
+            if grid:
+                axes["grid"] = grid
+            if dists:
+                axes["random"] = {k: f"{kind}({a:g}, {b:g})" for k, (kind, a, b) in dists.items()}
+                axes.update(samples=args.samples, seed=args.seed)
+        if args.t_end is not None:
+            end_time(args, load_diagram(args.diagram, trust=args.trust))
+        plan = prepare(args.diagram, points, metrics, t_end=args.t_end, trust=args.trust, axes=axes)
+        t0 = time.perf_counter()
+        report, skipped, failed = execute(plan, args.output, workers=args.workers, scheduler=args.scheduler,
+                                          serial=args.serial or args.workers == 0, progress=not args.quiet)
+    except SweepError as exc:
+        raise UsageError(str(exc)) from None
+    if not args.quiet:
+        where = ("" if report.ran == 0 else " in this process" if report.workers == 0
+                 else f" on {report.workers} Dask worker(s)")
+        print(f"sweep: {len(plan.points)} points: {report.ran} run{where} ({report.failed} failed), "
+              f"{skipped} already in {args.output / 'sweep.csv'}; {time.perf_counter() - t0:.3g} s")
+    if failed:
+        print(f"hierhand: {failed} point(s) failed; see the status and error columns of "
+              f"{args.output / 'sweep.csv'}", file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def cmd_sweep_plot(args: argparse.Namespace) -> int:
+    from hierhand.sweep import SweepError
+    from hierhand.sweep.plot import plot_sweep
+
+    if args.output.suffix.lower() != ".png":
+        raise UsageError(f"-o {args.output}: write a .png file")
+    try:
+        written = plot_sweep(args.sweep_dir, args.x, args.metric, args.output, y=args.y)
+    except SweepError as exc:
+        raise UsageError(str(exc)) from None
+    print(f"wrote {written}")
     return EXIT_OK
 
 

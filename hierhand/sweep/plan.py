@@ -1,0 +1,107 @@
+"""A sweep checked before it runs: the points with their hashes, the metrics, the job.
+
+``prepare`` does every check that can fail before the first run: the parameter names
+(through the diagram loader, with the first point's values, so a typo gets the loader's
+own message and suggestion) and the metrics (against the diagram's logged signals).
+A bad *value* of one point is not refused here: that point runs, fails and is recorded
+as failed, and the other points go on. ``execute`` appends every finished run to the
+store and skips the points the store already holds.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import SweepError
+from .metrics import Metric
+from .points import Point, point_json, unique_points
+from .progress import SweepProgress
+from .runner import Outcome, SweepJob, SweepReport, run_dask, run_serial, warm_up
+from .store import OK, SweepStore
+
+
+@dataclass
+class SweepPlan:
+    """A validated sweep: the job every point runs and the (hash, point) pairs, in order."""
+
+    job: SweepJob
+    points: list[tuple[str, Point]]
+    parameters: list[str]
+    diagram_hash: str
+    axes: dict[str, Any] = field(default_factory=dict)
+
+    def description(self) -> dict[str, Any]:
+        """What sweep.json records: enough to read the CSV and to repeat the sweep."""
+        return {
+            "diagram": self.job.diagram,
+            "diagram_hash": self.diagram_hash,
+            "t_end": self.job.t_end,
+            "parameters": self.parameters,
+            "axes": self.axes,
+            "metrics": {m.name: m.text.partition("=")[2].strip() for m in self.job.metrics},
+            "points": len(self.points),
+        }
+
+
+def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_end: str | None = None,
+            trust: bool = False, axes: dict[str, Any] | None = None) -> SweepPlan:
+    """Check the points' parameter names and the metrics against the diagram; hash the points.
+
+    Raises the loader's DiagramError for an unknown block or parameter, SweepError for
+    anything else that cannot work.
+    """
+    from blocks import DiagramError, load_diagram
+
+    if not points:
+        raise SweepError("no points: give --grid, --random or --points")
+    keys = list(points[0])
+    for p in points:
+        if list(p) != keys:
+            raise SweepError(f"every point must set the same parameters; {point_json(p)} differs from "
+                             f"{', '.join(keys)}")
+    base = load_diagram(diagram, trust=trust)
+    checked = base
+    try:
+        checked = load_diagram(diagram, overrides=points[0], trust=trust)
+    except DiagramError as exc:
+        if any(str(i.file).startswith("--set ") for i in exc.issues):
+            raise
+    for metric in metrics:
+        metric.check(checked)
+    job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust)
+    return SweepPlan(job=job, points=unique_points(points, base.source_hash, t_end), parameters=keys,
+                     diagram_hash=base.source_hash, axes=axes or {})
+
+
+def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, scheduler: str | None = None,
+            serial: bool = False, progress: bool = True) -> tuple[SweepReport, int, int]:
+    """Run the points missing from OUTPUT/sweep.csv and append each as it finishes.
+
+    Returns the execution report, the number of points skipped (already in the file) and
+    the number of failed points in the whole sweep (recorded before or now).
+    """
+    store = SweepStore(output, plan.parameters, [m.name for m in plan.job.metrics])
+    done = store.open()
+    store.write_description(plan.description())
+    todo = [(h, p) for h, p in plan.points if h not in done]
+    failed_before = sum(1 for h, _ in plan.points if done.get(h, OK) != OK)
+    bar = SweepProgress(len(todo), enabled=progress)
+
+    def record(h: str, point: Point, outcome: Outcome) -> None:
+        store.append(h, point, outcome.status, outcome.error, outcome.wall_s, outcome.values)
+        bar.update(outcome.status == OK)
+
+    try:
+        if not todo:
+            report = SweepReport()
+        elif serial:
+            warm_up(plan.job, todo[0][1])
+            report = run_serial(plan.job, todo, record)
+        else:
+            warm_up(plan.job, todo[0][1])
+            report = run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler)
+    finally:
+        bar.close()
+    return report, len(plan.points) - len(todo), failed_before + report.failed
