@@ -230,28 +230,25 @@ def end_time(args: argparse.Namespace, diagram):
 
 
 class ProgressBar:
-    """A one-line progress bar on stderr, shown only on a terminal and after one second."""
+    """The run's progress on stderr: only on a terminal, and only once a run takes a second."""
 
     def __init__(self, t_end: float, enabled: bool):
+        from hierhand.status_line import StatusLine
+
         self.t_end = t_end
-        self.enabled = enabled and sys.stderr.isatty()
-        self.shown = False
+        self.line = StatusLine(enabled)
 
     def __call__(self, fraction: float, elapsed: float) -> None:
-        if not self.enabled or (elapsed < 1.0 and not self.shown):
+        if elapsed < 1.0 and not self.line.shown:
             return
-        self.shown = True
         width = 30
         filled = int(width * fraction)
         eta = elapsed * (1 - fraction) / fraction if fraction > 0 else float("nan")
-        sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
-                         f"t = {fraction * self.t_end:.4g} / {self.t_end:.4g} s  eta {eta:5.1f} s ")
-        sys.stderr.flush()
+        self.line.show(f"[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
+                       f"t = {fraction * self.t_end:.4g} / {self.t_end:.4g} s  eta {eta:5.1f} s")
 
     def close(self) -> None:
-        if self.shown:
-            sys.stderr.write("\n")
-            sys.stderr.flush()
+        self.line.close()
 
 
 def cmd_run(args: argparse.Namespace) -> int:

@@ -5,35 +5,28 @@ Shown only on a terminal (like ``hierhand run``'s progress bar), so logs and pip
 
 from __future__ import annotations
 
-import sys
 import time
 from typing import TextIO
+
+from ..status_line import StatusLine
 
 
 class SweepProgress:
     """Redrawn after every finished run; the ETA assumes the remaining runs take as long on average."""
 
     def __init__(self, total: int, enabled: bool = True, stream: TextIO | None = None):
-        self.stream = stream or sys.stderr
+        self.line = StatusLine(enabled, stream)
         self.total = total
-        self.enabled = enabled and self.stream.isatty()
         self.done = self.failed = 0
         self.start = time.perf_counter()
-        self.shown = False
 
     def update(self, ok: bool) -> None:
         self.done += 1
         self.failed += 0 if ok else 1
-        if not self.enabled:
-            return
-        self.shown = True
         elapsed = time.perf_counter() - self.start
         eta = elapsed * (self.total - self.done) / self.done
-        self.stream.write(f"\rsweep: {self.done}/{self.total} done, {self.failed} failed, "
-                          f"{elapsed:.1f} s elapsed, eta {eta:.1f} s ")
-        self.stream.flush()
+        self.line.show(f"sweep: {self.done}/{self.total} done, {self.failed} failed, "
+                       f"{elapsed:.1f} s elapsed, eta {eta:.1f} s")
 
     def close(self) -> None:
-        if self.shown:
-            self.stream.write("\n")
-            self.stream.flush()
+        self.line.close()
