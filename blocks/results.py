@@ -61,6 +61,11 @@ class Results:
     def complete(self) -> bool:
         return self.status == "complete"
 
+    @property
+    def interrupted(self) -> bool:
+        """True when the run was stopped by Ctrl-C rather than by its end time or a failure."""
+        return self.status.startswith("interrupted")
+
     def value_at(self, name: str, t: float) -> np.ndarray:
         """The held (zero-order hold) value of a signal at time ``t``."""
         times, values = self[name]

@@ -77,14 +77,22 @@ class Schedule:
 
     def hits(self, block: str, n_ticks: int) -> np.ndarray:
         """All ticks in [0, n_ticks] at which ``block`` fires (its sample times / base tick)."""
+        return self.nth_hits(block, np.arange(self.hit_count(block, n_ticks)))
+
+    def nth_hits(self, block: str, indices: np.ndarray) -> np.ndarray:
+        """The ticks of the block's hits numbered ``indices`` (0: its first hit), in closed form.
+
+        Decimated logs ask for every n-th hit only, so a long run never lists all of them.
+        """
+        indices = np.asarray(indices, dtype=np.int64)
         mask = self.masks[block]
         rel = np.flatnonzero(mask)
-        cycles = n_ticks // self.hyperperiod + 1
-        ticks = (rel[None, :] + self.hyperperiod * np.arange(cycles)[:, None]).ravel()
-        ticks = ticks[ticks <= n_ticks]
-        if self.fires_at_zero[block] and (ticks.size == 0 or ticks[0] != 0):
-            ticks = np.concatenate(([0], ticks))
-        return ticks.astype(np.int64)
+        extra_zero = self.fires_at_zero[block] and not mask[0]
+        if rel.size == 0:
+            return np.zeros(indices.shape, dtype=np.int64)
+        j = indices - 1 if extra_zero else indices
+        ticks = rel[j % rel.size] + self.hyperperiod * (j // rel.size)
+        return np.where(j < 0, 0, ticks).astype(np.int64)
 
     def hit_count(self, block: str, n_ticks: int) -> int:
         """How many ticks in [0, n_ticks] ``block`` fires at, without listing them."""

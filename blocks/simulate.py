@@ -157,13 +157,10 @@ class _Run:
                 self.inputs[c.dst_block][c.dst_port] = init
             else:
                 self.fanout[c.src_block].append((self.inputs[c.dst_block], c.dst_port, c.src_port))
-        self.hit_ticks: dict[str, np.ndarray] = {}
         self.loggers: dict[str, list[_Logger]] = {n: [] for n in self.names}
         self.all_loggers: list[_Logger] = []
         for e in diagram.log:
-            if e.block not in self.hit_ticks:
-                self.hit_ticks[e.block] = schedule.hits(e.block, self.n_ticks)
-            count = -(-len(self.hit_ticks[e.block]) // e.decimate)
+            count = -(-schedule.hit_count(e.block, self.n_ticks) // e.decimate)
             lg = _Logger(e.signal, diagram.blocks[e.block].block.outputs[e.port], count, e.decimate)
             self.loggers[e.block].append(lg)
             self.all_loggers.append(lg)
@@ -369,7 +366,7 @@ class _Run:
         tick = self.s.base_tick
         signals = {}
         for e, lg in zip(self.d.log, self.all_loggers):
-            ticks = self.hit_ticks[e.block][::e.decimate][:lg.pos]
+            ticks = self.s.nth_hits(e.block, np.arange(lg.pos) * e.decimate)
             signals[e.signal] = (ticks * tick.numerator / tick.denominator, lg.buf[:lg.pos].copy())
         return signals
 

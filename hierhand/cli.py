@@ -15,6 +15,7 @@ from typing import Any, Sequence
 import yaml
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+EXIT_INTERRUPTED = 130
 
 
 class UsageError(Exception):
@@ -37,7 +38,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("hierhand: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -270,7 +271,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if not results.complete:
         print(f"hierhand: {diagram.file}: {results.status}", file=sys.stderr)
         print(f"hierhand: partial results (marked incomplete) saved in {out}", file=sys.stderr)
-        return EXIT_FAILED
+        return EXIT_INTERRUPTED if results.interrupted else EXIT_FAILED
     if not args.quiet:
         info = results.info
         rtf = info.get("real_time_factor")
@@ -415,7 +416,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from blocks import load_diagram
     from hierhand.sweep import SweepError
     from hierhand.sweep.metrics import parse_metrics
-    from hierhand.sweep.plan import execute, prepare
+    from hierhand.sweep.plan import execute, prepare, stored_count
     from hierhand.sweep.points import (combine, csv_points, grid_points, parse_grid, parse_random,
                                        random_points)
 
@@ -442,8 +443,14 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             end_time(args, load_diagram(args.diagram, trust=args.trust))
         plan = prepare(args.diagram, points, metrics, t_end=args.t_end, trust=args.trust, axes=axes)
         t0 = time.perf_counter()
-        report, skipped, failed = execute(plan, args.output, workers=args.workers, scheduler=args.scheduler,
-                                          serial=args.serial or args.workers == 0, progress=not args.quiet)
+        try:
+            report, skipped, failed = execute(plan, args.output, workers=args.workers, scheduler=args.scheduler,
+                                              serial=args.serial or args.workers == 0, progress=not args.quiet)
+        except KeyboardInterrupt:
+            print(f"hierhand: sweep interrupted: {stored_count(plan, args.output)} of {len(plan.points)} points "
+                  f"are in {args.output / 'sweep.csv'} (hint: run the same command again to run the rest)",
+                  file=sys.stderr)
+            return EXIT_INTERRUPTED
     except SweepError as exc:
         raise UsageError(str(exc)) from None
     if not args.quiet:

@@ -18,8 +18,9 @@ from .errors import SweepError
 from .metrics import Metric
 from .points import Point, point_json, unique_points
 from .progress import SweepProgress
-from .runner import Outcome, SweepJob, SweepReport, run_dask, run_serial, warm_up
-from .store import OK, SweepStore
+from .cluster import run_dask
+from .runner import Outcome, SweepJob, SweepReport, run_serial, warm_up
+from .store import OK, SweepStore, read_sweep
 
 
 @dataclass
@@ -105,3 +106,12 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
     finally:
         bar.close()
     return report, len(plan.points) - len(todo), failed_before + report.failed
+
+
+def stored_count(plan: SweepPlan, output: str | Path) -> int:
+    """How many of the plan's points OUTPUT/sweep.csv holds (finished, ok or failed)."""
+    try:
+        held = {row["point_hash"] for row in read_sweep(output)[1]}
+    except SweepError:
+        return 0
+    return sum(h in held for h, _ in plan.points)

@@ -5,8 +5,10 @@ from __future__ import annotations
 import csv
 import json
 import os
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -270,3 +272,32 @@ def test_simulation_failure_exits_1_and_keeps_partial_results(tmp_path):
     np.testing.assert_allclose(y[:, 0], t)
     t_ramp, _ = r["ramp.y"]
     assert t_ramp[-1] < 0.010
+
+
+LONG_DIAGRAM = """\
+name: long
+time: {t_end: 100000 s}
+blocks:
+  ramp: {type: Ramp, period: 0.1 ms, params: {slope: 1.0}}
+log: [{signal: ramp.y, decimate: 10000}]
+"""
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGINT") or os.name != "posix", reason="POSIX signals")
+def test_ctrl_c_saves_the_run_so_far_and_exits_130(tmp_path):
+    diagram = tmp_path / "long.yaml"
+    diagram.write_text(LONG_DIAGRAM, encoding="utf-8")
+    out = tmp_path / "out"
+    proc = subprocess.Popen([sys.executable, "-m", "hierhand", "run", str(diagram), "-o", str(out)],
+                            cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(3.0)  # a billion ticks take far longer than this; imports far less
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    assert "interrupted at t=" in err and "partial results (marked incomplete) saved" in err
+    r = Results.load(out)
+    assert r.interrupted and not r.complete
+    t, y = r["ramp.y"]
+    assert 0 < t[-1] < 100000
+    np.testing.assert_allclose(y[:, 0], t)

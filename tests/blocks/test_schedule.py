@@ -34,7 +34,7 @@ def test_toy_plan():
 @settings(max_examples=60, deadline=None)
 @given(st.lists(st.tuples(st.integers(1, 12), st.integers(0, 11)), min_size=1, max_size=4),
        st.integers(1, 400))
-def test_hit_count_matches_the_listed_hits(rates, n_ticks):
+def test_hits_in_closed_form_match_the_firing_masks(rates, n_ticks):
     lines = ["blocks:"]
     for i, (p, o) in enumerate(rates):
         lines.append(f"  b{i}: {{type: Ramp, period: {p} ms, offset: {o % p} ms}}")
@@ -44,11 +44,30 @@ def test_hit_count_matches_the_listed_hits(rates, n_ticks):
     s = build_schedule(d, n_ticks * build_schedule(d, None).base_tick)
     for name in d.blocks:
         hits = s.hits(name, s.n_ticks)
-        assert s.hit_count(name, s.n_ticks) == len(hits)
-        assert np.all(np.diff(hits) > 0) and (hits.size == 0 or hits[-1] <= s.n_ticks)
+        listed = [k for k in range(s.n_ticks + 1)
+                  if s.masks[name][k % s.hyperperiod] or (k == 0 and s.fires_at_zero[name])]
+        np.testing.assert_array_equal(hits, listed)
+        assert s.hit_count(name, s.n_ticks) == len(listed)
+        for every in (2, 3, 7):
+            np.testing.assert_array_equal(s.nth_hits(name, np.arange(0, len(listed), every)), listed[::every])
     # an inherited block fires exactly when one of its sources does
     union = np.unique(np.concatenate([s.hits(f"b{i}", s.n_ticks) for i in range(len(rates))]))
     np.testing.assert_array_equal(s.hits("s", s.n_ticks), union)
+
+
+def test_a_block_fed_by_a_constant_fires_at_zero_then_with_its_offset_source():
+    d = loads_diagram("""
+blocks:
+  c: {type: Constant, params: {value: 1.0}}
+  r: {type: Ramp, period: 2 ms, offset: 1 ms}
+  s: {type: Sum, params: {signs: "++"}}
+connections: [c.y -> s.u0, r.y -> s.u1]
+""")
+    s = build_schedule(d, Fraction(9, 1000))
+    np.testing.assert_array_equal(s.hits("s", s.n_ticks), [0, 1, 3, 5, 7, 9])
+    np.testing.assert_array_equal(s.nth_hits("s", [0, 2, 4]), [0, 3, 7])
+    np.testing.assert_array_equal(s.hits("c", s.n_ticks), [0])
+    np.testing.assert_array_equal(s.hits("r", s.n_ticks), [1, 3, 5, 7, 9])
 
 
 def test_algebraic_loop_through_inherited_blocks_names_the_chain():

@@ -144,3 +144,56 @@ def test_sweep_on_a_running_scheduler(tmp_path):
     finally:
         _stop(procs)
         log.close()
+
+
+CRASH_MODULE = '''
+import os
+from blocks import Block
+
+
+class CrashOn(Block):
+    """y = u, except that the process dies (no exception, no clean-up) when u equals crash_on."""
+
+    def __init__(self, crash_on: float = -1.0):
+        self.crash_on = float(crash_on)
+        self.inputs = {"u": 1}
+        self.outputs = {"y": 1}
+        self.feedthrough = True
+
+    def output(self, t, state, inputs):
+        if inputs["u"][0] == self.crash_on:
+            os._exit(3)
+        return {"y": inputs["u"].copy()}
+'''
+
+CRASH_DIAGRAM = """\
+name: crash
+time: {t_end: 5 ms}
+blocks:
+  src: {type: Constant, params: {value: 1.0}}
+  crash: {type: "python:crash_block_mod:CrashOn", period: 1 ms, params: {crash_on: 12.0}}
+connections:
+  - src.y -> crash.u
+log: [crash.y]
+"""
+
+
+def test_a_point_that_kills_its_worker_fails_alone(tmp_path, monkeypatch, capsys):
+    import dask
+
+    (tmp_path / "crash_block_mod.py").write_text(CRASH_MODULE, encoding="utf-8")
+    (tmp_path / "crash.yaml").write_text(CRASH_DIAGRAM, encoding="utf-8")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    out = tmp_path / "sweep"
+    values = ",".join(str(v) for v in range(1, 17))
+    # After the first single-point tasks, the 16 points go in chunks of 3, one of them holding
+    # the point that kills its worker: that chunk is lost whole and its points run again alone.
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+        code = main(["sweep", str(tmp_path / "crash.yaml"), "-o", str(out), "--grid", f"src.value={values}",
+                     "--metric", "y=final(crash.y)", "--trust", "--workers", "2", "-q"])
+    got = {float(r["src.value"]): r for r in rows(out)}
+    assert code == 1, got
+    assert "1 point(s) failed" in capsys.readouterr().err, [(v, r["error"]) for v, r in got.items() if r["error"]]
+    assert sorted(got) == [float(v) for v in range(1, 17)]
+    assert got[12.0]["status"] == "failed" and "KilledWorker" in got[12.0]["error"]
+    assert all(r["status"] == "ok" and float(r["y"]) == v for v, r in got.items() if v != 12.0)

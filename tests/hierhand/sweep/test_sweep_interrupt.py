@@ -1,0 +1,86 @@
+"""Ctrl-C during ``hierhand sweep``, sent as a terminal sends it (SIGINT to the whole process
+group, workers included): one line and exit code 130, no traceback from any process, only
+whole rows in sweep.csv, no process left behind, and the same command then runs the rest."""
+
+from __future__ import annotations
+
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[3]
+TOY = str(ROOT / "diagrams" / "toy.yaml")
+GRID = "prop.k=1,2,3,4,5,6,7,8"
+
+
+def _command(out: Path, mode: list[str]) -> list[str]:
+    # 20 s of the toy diagram is about 0.2 s of work per point: long enough to interrupt mid-sweep.
+    return [sys.executable, "-m", "hierhand", "sweep", TOY, "-o", str(out), "--t-end", "20 s",
+            "--metric", "y=final(plant.y)", "--grid", GRID, "-q", *mode]
+
+
+def _rows(out: Path) -> list[dict]:
+    with open(out / "sweep.csv", newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _row_count(out: Path) -> int:
+    try:
+        return max(0, len((out / "sweep.csv").read_text().splitlines()) - 1)
+    except FileNotFoundError:
+        return 0
+
+
+def _group_gone(pgid: int, timeout: float) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(pgid, 0)
+        except ProcessLookupError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups are POSIX")
+@pytest.mark.parametrize("mode", [["--workers", "2"], ["--serial"]], ids=["local-cluster", "serial"])
+def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
+    out = tmp_path / "sweep"
+    proc = subprocess.Popen(_command(out, mode), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 120
+        while _row_count(out) < 2 and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()}"
+        os.killpg(proc.pid, signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=10)
+    assert proc.returncode == 130
+    assert "Traceback" not in err
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("hierhand: sweep interrupted: ")
+    assert "run the same command again" in lines[0]
+    assert _group_gone(proc.pid, timeout=20), "a worker process outlived the interrupted sweep"
+
+    kept = _rows(out)
+    assert 2 <= len(kept) < 8
+    assert f"{len(kept)} of 8 points are in" in lines[0]
+    assert all(r["status"] == "ok" and float(r["y"]) > 0 for r in kept)
+    assert (out / "sweep.csv").read_text().endswith("\n")
+
+    done = subprocess.run(_command(out, mode), cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    final = _rows(out)
+    assert len(final) == 8 and len({r["point_hash"] for r in final}) == 8
+    assert {r["point_hash"]: r["y"] for r in final if r["point_hash"] in {k["point_hash"] for k in kept}} == \
+        {r["point_hash"]: r["y"] for r in kept}
