@@ -21,11 +21,17 @@ Signal = np.ndarray
 
 
 class BlockError(Exception):
-    """Raised by a block during a run; ``port`` names the offending signal if there is one."""
+    """Raised by a block during a run; ``port`` names the offending signal if there is one.
 
-    def __init__(self, message: str, port: str | None = None):
+    An ``advance`` that fails part-way may pass ``rows``: the outputs of the hits it did
+    complete, shaped as ``advance`` returns them, so the run's log keeps everything
+    computed before the failure.
+    """
+
+    def __init__(self, message: str, port: str | None = None, rows: dict[str, np.ndarray] | None = None):
         super().__init__(message)
         self.port = port
+        self.rows = rows
 
 
 class Block:
@@ -100,6 +106,8 @@ class Block:
         (``t + period`` ... ``t + n * period``). Only used for blocks without
         feedthrough. This default is the reference loop; a block overrides it with
         something faster (a compiled kernel, a closed form) and the executor then uses it.
+        An override that fails part-way raises ``BlockError(..., rows=...)`` with the rows of
+        the hits before the failing update, so nothing computed is lost.
         """
         dt = float(self.period) if self.period is not None else 0.0
         rows: dict[str, list[Signal]] = {p: [] for p in self.outputs}

@@ -252,6 +252,7 @@ class _Run:
 
         def op(k: int, t: float, next_k: int) -> None:
             n = (next_k - k) // period
+            done = 0
             try:
                 while n > 0:
                     m = n if n <= ADVANCE_CHUNK else ADVANCE_CHUNK
@@ -261,13 +262,15 @@ class _Run:
                     for add, p in loggers:
                         add(rows[p])
                     n -= m
+                    done += m
                     t += m * dt
                 for p, dests in targets:
                     last = rows[p][-1]
                     for d, dp in dests:
                         d[dp] = last
             except Exception as exc:
-                raise _StepFailure(name, "advance", k, exc) from exc
+                done += self.log_partial_rows(name, exc, ports, loggers)
+                raise _StepFailure(name, "advance", k + done * period, exc) from exc
 
         return op
 
@@ -282,6 +285,20 @@ class _Run:
                 raise BlockError(f"output '{p}' must be a float64 array of shape ({blk.outputs[p]},), got {got}",
                                  port=p)
         self.checked.add(name)
+
+    def log_partial_rows(self, name: str, exc: Exception, ports: tuple[str, ...], loggers) -> int:
+        """Log the rows a failing ``advance`` completed (``BlockError.rows``); returns how many."""
+        rows = exc.rows if isinstance(exc, BlockError) else None
+        if not isinstance(rows, dict) or not ports or not isinstance(rows.get(ports[0]), np.ndarray):
+            return 0
+        m = rows[ports[0]].shape[0]
+        try:
+            self.check_rows(name, rows, ports, m)
+        except BlockError:
+            return 0
+        for add, p in loggers:
+            add(rows[p])
+        return m
 
     def check_rows(self, name: str, rows: Any, ports: tuple[str, ...], n: int) -> None:
         blk = self.d.blocks[name].block
@@ -342,7 +359,7 @@ class _Run:
         wall = time.perf_counter() - wall0
         if progress is not None and failure is None and not interrupted:
             progress(1.0, wall)
-        t_fail = float(k * self.s.base_tick)
+        t_fail = float((failure.tick if failure is not None else k) * self.s.base_tick)
         if failure is not None:
             err = failure.error
             port = getattr(err, "port", None)

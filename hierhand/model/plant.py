@@ -187,7 +187,10 @@ class HandPlant(Block):
         rows = np.empty((n, N_OUTPUTS))
         code, done, which = advance_kernel(state, tau, f_ext, self._fingers, self._body, self._edges, rows)
         if code:
-            raise self._error(code, which, t + done * self.dt)
+            error = self._error(code, which, t + done * self.dt)
+            written = max(done - 1, 0)  # the state after update ``done`` is the bad one: no row for it
+            error.rows = {name: rows[:written][index] for name, index in _PORT_COLUMNS}
+            raise error
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
 
     def _quick_check(self, state: np.ndarray) -> None:

@@ -75,3 +75,28 @@ class Clock(Block):
 
     def output(self, t, state, inputs):
         return {"y": np.array([t])}
+
+
+class CappedAccumulator(Accumulator):
+    """An Accumulator whose update fails once the state would pass ``limit``."""
+
+    def __init__(self, limit: float = 1.0):
+        super().__init__(1)
+        self.limit = float(limit)
+
+    def update(self, t, state, inputs):
+        new = state + inputs["u"]
+        if new[0] > self.limit:
+            raise BlockError(f"state passes {self.limit:g}", port="y")
+        return new
+
+
+class FastCappedAccumulator(CappedAccumulator):
+    """The same, advanced in closed form; a failing span hands back the rows it completed."""
+
+    def advance(self, t, state, inputs, n):
+        rows = state[None, :] + np.arange(1, n + 1)[:, None] * inputs["u"][None, :]
+        over = np.flatnonzero(rows[:, 0] > self.limit)
+        if over.size:
+            raise BlockError(f"state passes {self.limit:g}", port="y", rows={"y": rows[:over[0]]})
+        return rows[-1].copy(), {"y": rows}

@@ -250,6 +250,31 @@ log: [clk.y, f.y]
     assert res["clk.y"][0][-1] == 0.005
 
 
+def test_a_failing_advance_span_keeps_the_rows_it_completed():
+    """Stepped or advanced, the run fails at the same hit and logs the same samples."""
+    text = """
+time: {{t_end: 10 ms}}
+blocks:
+  one: {{type: Constant, params: {{value: 1.0}}}}
+  acc: {{type: "{defs}:{kind}", period: 0.1 ms, params: {{limit: 23.5}}}}
+  clk: {{type: "{defs}:Clock", period: 1 ms}}
+connections: [one.y -> acc.u]
+log: [acc.y, clk.y]
+"""
+    stepped = loads_diagram(text.format(defs=DEFS, kind="CappedAccumulator"), trust=True)
+    advanced = loads_diagram(text.format(defs=DEFS, kind="FastCappedAccumulator"), trust=True)
+    assert blocks.build_schedule(advanced, advanced.t_end).advanced == {"acc"}
+    r_step, r_adv = simulate(stepped), simulate(advanced)
+    # the state reaches 23 at 2.3 ms; the update there would make it 24 > 23.5
+    assert r_step.status.startswith("failed at t=0.0023 s") and "'acc'" in r_step.status
+    assert r_adv.status.startswith("failed at t=0.0023 s") and "advance: state passes 23.5" in r_adv.status
+    t, y = r_adv["acc.y"]
+    np.testing.assert_array_equal(t, r_step["acc.y"][0])
+    np.testing.assert_array_equal(y, r_step["acc.y"][1])
+    np.testing.assert_allclose(t[-1], 0.0023)
+    np.testing.assert_array_equal(y[:, 0], np.arange(24.0))
+
+
 def test_failure_can_raise_with_results():
     diagram = loads_diagram(f"""
 time: {{t_end: 10 ms}}

@@ -1,5 +1,6 @@
 """The HandPlant block contract: ports, state, advance == update/output, errors."""
 
+import re
 from fractions import Fraction
 
 import numpy as np
@@ -144,6 +145,16 @@ def test_penetration_deeper_than_the_tip_radius_is_an_error():
     with pytest.raises(BlockError, match=r"penetration deeper than the fingertip radius at t=0\.\d+ s: the (thumb|fore) tip") as info:
         plant.advance(0.0, plant.initial_state(), {"tau": tau}, 5000)
     assert info.value.port == "contact"
+    # the steps completed before the failing one come with the error, for the run's log
+    t_fail = float(re.search(r"at t=([0-9.]+) s", str(info.value)).group(1))
+    done = round(t_fail / plant.dt) - 1  # rows for the good states before the one at t_fail
+    assert 0 < done < 5000
+    assert {name: rows.shape for name, rows in info.value.rows.items()} == \
+        {name: (done, width) for name, width in plant.outputs.items()}
+    assert all(np.isfinite(rows).all() for rows in info.value.rows.values())
+    _, stepped = plant.advance(0.0, plant.initial_state(), {"tau": tau}, done)
+    for name, rows in stepped.items():
+        np.testing.assert_array_equal(info.value.rows[name], rows)
 
 
 def test_object_placed_inside_a_fingertip_is_rejected_at_output():
