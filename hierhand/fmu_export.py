@@ -1,7 +1,7 @@
 """Export the hand plant (``HandPlant``) as a co-simulation FMU, FMI 2.0 or 3.0.
 
 ``export_plant_fmu(out, fmi, hand)`` builds the FMU with pythonfmu (FMI 2) or pythonfmu3
-(FMI 3) from the slave template ``fmu/hand_plant_slave.py.in``:
+(FMI 3) from the slave template ``hierhand/hand_plant_slave.py.in``:
 
 - inputs ``tau[1]``..``tau[9]``, ``f_ext[1]``..``f_ext[3]`` (start 0); one output per
   element of every plant output port, named the same way (``q[1]``, ``obj[3]``, ...),
@@ -47,9 +47,9 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-REPO_ROOT = Path(__file__).resolve().parent.parent
-FMU_DIR = REPO_ROOT / "fmu"
-SLAVE_TEMPLATE = FMU_DIR / "hand_plant_slave.py.in"
+SLAVE_TEMPLATE = Path(__file__).resolve().with_name("hand_plant_slave.py.in")
+FMU_DIR = Path("fmu")
+"""Where exports go by default: ``fmu/`` under the current folder, like ``runs/`` for results."""
 
 INTERNAL_STEP = Fraction(1, 10000)
 DEFAULT_COMMUNICATION_STEP = 1e-3
@@ -108,7 +108,7 @@ def export_plant_fmu(out: Path | None = None, fmi: int = 2, hand: Path | None = 
     """Build the hand plant FMU and return its path.
 
     ``out``: a ``.fmu`` file, or a folder to put ``HandPlant_fmi<N>.fmu`` in (default
-    ``fmu/HandPlant_fmi<N>.fmu`` in the repository); ``fmi``: 2 or 3; ``hand``: a hand file
+    ``fmu/HandPlant_fmi<N>.fmu`` under the current folder); ``fmi``: 2 or 3; ``hand``: a hand file
     whose values become the parameters' start values (default: the shipped hand). Raises
     ``HandFileError`` for an invalid hand file and ``FmuExportError`` when the FMU cannot be
     built.
@@ -117,7 +117,7 @@ def export_plant_fmu(out: Path | None = None, fmi: int = 2, hand: Path | None = 
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
     target = _output_path(out, fmi)
     if not SLAVE_TEMPLATE.is_file():
-        raise FmuExportError(f"the FMU slave template {SLAVE_TEMPLATE} is missing (it ships with the repository)")
+        raise FmuExportError(f"the FMU slave template {SLAVE_TEMPLATE} is missing; reinstall hierhand")
 
     from hierhand.model import HandPlant, load_hand
     from hierhand.model.handfile import default_hand_dict

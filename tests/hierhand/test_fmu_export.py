@@ -28,7 +28,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
-from hierhand.fmu_export import FMU_DIR, default_output_path, export_plant_fmu
+from hierhand.fmu_export import default_output_path, export_plant_fmu
 from hierhand.model import Hand, HandPlant
 
 STEP = 1e-3  # communication step: 10 plant steps of 0.1 ms
@@ -259,11 +259,33 @@ def test_round_trip_through_the_fmu_import_block(fmus, fmi):
 
 
 def test_default_output_path():
-    assert default_output_path(2) == FMU_DIR / "HandPlant_fmi2.fmu"
-    assert default_output_path(3) == FMU_DIR / "HandPlant_fmi3.fmu"
-    assert FMU_DIR == REPO / "fmu" and (FMU_DIR / "hand_plant_slave.py.in").is_file()
+    assert default_output_path(2) == Path("fmu") / "HandPlant_fmi2.fmu"
+    assert default_output_path(3) == Path("fmu") / "HandPlant_fmi3.fmu"
     with pytest.raises(ValueError, match="fmi"):
         export_plant_fmu(fmi=1)
+
+
+def test_an_installed_package_exports_without_the_repository(tmp_path, fmus):
+    """Only the package folders, as an install has them, and another working folder: the
+    export needs nothing else, lands in ./fmu/, and carries the same model as from here."""
+    import shutil
+
+    site, work = tmp_path / "site", tmp_path / "work"
+    for package in ("blocks", "hierhand"):
+        shutil.copytree(REPO / package, site / package, ignore=shutil.ignore_patterns("__pycache__"))
+    work.mkdir()
+    script = ("import hierhand, sys; from hierhand.fmu_export import export_plant_fmu; "
+              "print(hierhand.__file__); print(export_plant_fmu(fmi=2))")
+    env = {**os.environ, "PYTHONPATH": str(site)}
+    done = subprocess.run([sys.executable, "-c", script], cwd=work, env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert done.returncode == 0, done.stderr
+    imported, written = done.stdout.split()
+    assert Path(imported).resolve().is_relative_to(site.resolve())
+    assert (work / written).resolve() == (work / "fmu" / "HandPlant_fmi2.fmu").resolve()
+    installed = read_model_description(str(work / written))
+    here = read_model_description(str(fmus[2]))
+    assert installed.coSimulation.modelIdentifier == here.coSimulation.modelIdentifier
 
 
 @pytest.fixture(scope="module")
