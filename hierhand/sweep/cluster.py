@@ -106,11 +106,14 @@ def _local_cluster(workers: int | None):
     import dask
     from distributed import LocalCluster
 
+    from .worker_plugin import IgnoreCtrlC
+
     env = {"NUMBA_CACHE_DIR": os.environ["NUMBA_CACHE_DIR"]} if os.environ.get("NUMBA_CACHE_DIR") else {}
     settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method()}
     with dask.config.set(settings), _children_ignore_ctrl_c():
         return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
-                            host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR, env=env)
+                            host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL, env=env,
+                            plugins={IgnoreCtrlC()})
 
 
 def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, workers: int | None = None,
