@@ -97,12 +97,10 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
     try:
         if not todo:
             report = SweepReport()
-        elif serial:
-            warm_up(plan.job, todo[0][1])
-            report = run_serial(plan.job, todo, record)
         else:
             warm_up(plan.job, todo[0][1])
-            report = run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler)
+            report = (run_serial(plan.job, todo, record) if serial
+                      else run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler))
     finally:
         bar.close()
     return report, len(plan.points) - len(todo), failed_before + report.failed
