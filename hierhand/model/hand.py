@@ -1,8 +1,9 @@
-"""``Hand``: a validated hand file packed for the kernels, with kinematics and dynamics.
+"""``Hand``: a validated hand file packed for the C core, with kinematics and dynamics.
 
 Vectors follow the hand file's order: q = thumb joints 1-3, fore 1-3, middle 1-3
-(proximal to distal, relative angles). The methods evaluate the same compiled functions
-the plant's kernel uses, so what a controller computes from them is what the plant does.
+(proximal to distal, relative angles). The methods call the same C functions the plant's
+step uses (``hierhand/csrc``), so what a controller computes from them is what the plant
+does.
 """
 
 from __future__ import annotations
@@ -15,22 +16,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .dynamics import finger_bias, finger_mass_matrix
+from .. import _native
 from .handfile import HandParams, merge_with_default, parse_hand, read_hand_file
-from .kinematics import finger_frames, point_jacobian
+from .hand_vector import hand_vector
 from .layout import (
-    B_C_N,
-    B_C_T,
-    B_GX,
-    B_GY,
-    B_HALF_A,
-    B_HALF_B,
-    B_INERTIA,
-    B_K_N,
-    B_K_T,
-    B_MASS,
-    B_MU_D,
-    B_MU_S,
     E_COUNT,
     E_DX,
     E_DY,
@@ -38,19 +27,7 @@ from .layout import (
     E_OY,
     E_SPACING,
     E_START,
-    F_ARMATURE,
-    F_BASE_ANGLE,
-    F_BASE_X,
-    F_BASE_Y,
-    F_DAMPING,
-    F_LINK0,
-    F_LINK_STRIDE,
     F_TIP_RADIUS,
-    L_COM_ACROSS,
-    L_COM_ALONG,
-    L_INERTIA,
-    L_LENGTH,
-    L_MASS,
     N_BODY_PARAMS,
     N_EDGE_COLS,
     N_EDGES,
@@ -80,20 +57,32 @@ def _hand_from_json(key: str) -> "Hand":
 
 
 class Hand:
-    """Three planar 3-link fingers with circular tips, and a square object."""
+    """Three planar 3-link fingers with circular tips, and a square object.
+
+    ``native`` is the hand packed for the C core (a ``hierhand._native.Model`` without a
+    step); ``fingers``, ``body`` and ``edges`` are read-only copies of its packed
+    parameter rows, ``vector`` the hand's numbers in the core's order.
+    """
 
     n_joints = 9
 
     def __init__(self, params: HandParams):
         self.params = params
         self.names = tuple(f.name for f in params.fingers)
-        self.fingers = _pack_fingers(params)
-        self.body = _pack_body(params)
-        self.edges = _pack_edges(params)
-        self.n_points = int(self.edges[:, E_COUNT].sum())
+        self.vector = hand_vector(params.to_dict())
+        self.native = _native.Model(self.vector)
+        self.fingers = np.empty((3, N_FINGER_PARAMS))
+        self.body = np.empty(N_BODY_PARAMS)
+        self.edges = np.empty((N_EDGES, N_EDGE_COLS))
+        self.q0 = np.empty(9)
+        pose0 = np.empty(3)
+        self.native.pack_into(self.fingers, self.body, self.edges, self.q0, pose0)
+        self.n_points = self.native.npts
         self.tip_radius = self.fingers[:, F_TIP_RADIUS].copy()
-        self.q0 = np.array([x for f in params.fingers for x in f.q0], dtype=float)
         self.gravity = np.array(params.gravity, dtype=float)
+        self._pose0 = pose0
+        for array in (self.fingers, self.body, self.edges, self.q0, self.tip_radius, self.gravity, pose0):
+            array.flags.writeable = False
 
     @classmethod
     def default(cls) -> "Hand":
@@ -102,8 +91,8 @@ class Hand:
 
     @property
     def object_pose0(self) -> np.ndarray:
-        o = self.params.object
-        return np.array([o.pos[0], o.pos[1], o.angle])
+        """(3,): the object's initial x, y and angle."""
+        return self._pose0.copy()
 
     # -- kinematics ---------------------------------------------------------------
 
@@ -112,8 +101,7 @@ class Hand:
         u = np.empty((3, 3, 2))
         pts = np.empty((3, 4, 2))
         phi = np.empty(3)
-        for f in range(3):
-            phi[f] = finger_frames(self.fingers, f, q, 3 * f, u, pts)
+        _native.frames(self.native, q, u, pts, phi)
         return u, pts, phi
 
     def joint_positions(self, q: np.ndarray) -> np.ndarray:
@@ -131,57 +119,43 @@ class Hand:
 
     def tip_jacobians(self, q: np.ndarray) -> np.ndarray:
         """(3, 2, 3): d(tip centre of finger f)/d(its three joint angles)."""
-        _, pts, _ = self._frames(q)
+        q = _vector(q, 9, "q")
+        tips = self.tip_positions(q)
         jac = np.empty((3, 2, 3))
         for f in range(3):
-            point_jacobian(pts, f, pts[f, 3, 0], pts[f, 3, 1], jac)
+            _native.point_jacobian(self.native, q, f, tips[f, 0], tips[f, 1], jac[f])
         return jac
 
     def point_jacobian(self, q: np.ndarray, finger: int, point: np.ndarray) -> np.ndarray:
         """(2, 3): Jacobian of the point of link 3 of ``finger`` now at ``point``."""
-        _, pts, _ = self._frames(q)
-        jac = np.empty((3, 2, 3))
-        point_jacobian(pts, finger, float(point[0]), float(point[1]), jac)
-        return jac[finger]
+        jac = np.empty((2, 3))
+        _native.point_jacobian(self.native, _vector(q, 9, "q"), int(finger), float(point[0]), float(point[1]), jac)
+        return jac
 
     # -- dynamics -----------------------------------------------------------------
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """(9, 9): joint-space mass matrix including armature (block-diagonal per finger)."""
-        u, _, _ = self._frames(q)
-        m = np.zeros((9, 9))
-        block = np.empty((3, 3))
-        for f in range(3):
-            finger_mass_matrix(self.fingers, f, u, block)
-            m[3 * f : 3 * f + 3, 3 * f : 3 * f + 3] = block
+        m = np.empty((9, 9))
+        _native.mass_matrix(self.native, _vector(q, 9, "q"), m)
         return m
 
     def bias(self, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
         """(9,): Coriolis/centrifugal + gravity + joint damping; tau = M qdd + bias."""
-        qd = _vector(qd, 9, "qd")
-        u, _, _ = self._frames(q)
         h = np.empty(9)
-        gx, gy = self.gravity
-        for f in range(3):
-            h[3 * f : 3 * f + 3] = finger_bias(
-                self.fingers, f, u, qd[3 * f], qd[3 * f + 1], qd[3 * f + 2], gx, gy
-            )
+        _native.bias(self.native, _vector(q, 9, "q"), _vector(qd, 9, "qd"), h)
         return h
 
     def static_torques(self, q: np.ndarray, forces: np.ndarray, points: np.ndarray | None = None) -> np.ndarray:
         """(9,): torques holding ``q`` at rest against gravity while fingertip f pushes
         the object with ``forces[f]`` (3, 2) applied at ``points[f]`` (default: tip centres).
         """
+        q = _vector(q, 9, "q")
         forces = np.asarray(forces, dtype=float).reshape(3, 2)
         tau = self.bias(q, np.zeros(9))
-        _, pts, _ = self._frames(q)
-        if points is None:
-            points = pts[:, 3, :]
-        points = np.asarray(points, dtype=float).reshape(3, 2)
-        jac = np.empty((3, 2, 3))
+        points = self.tip_positions(q) if points is None else np.asarray(points, dtype=float).reshape(3, 2)
         for f in range(3):
-            point_jacobian(pts, f, points[f, 0], points[f, 1], jac)
-            tau[3 * f : 3 * f + 3] += jac[f].T @ forces[f]
+            tau[3 * f : 3 * f + 3] += self.point_jacobian(q, f, points[f]).T @ forces[f]
         return tau
 
     # -- object -------------------------------------------------------------------
@@ -215,61 +189,3 @@ def _vector(x: Any, n: int, name: str) -> np.ndarray:
     if arr.shape != (n,):
         raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
     return arr
-
-
-def _pack_fingers(params: HandParams) -> np.ndarray:
-    rows = np.zeros((3, N_FINGER_PARAMS))
-    for f, finger in enumerate(params.fingers):
-        row = rows[f]
-        row[F_BASE_X], row[F_BASE_Y] = finger.base
-        row[F_BASE_ANGLE] = finger.base_angle
-        for i, link in enumerate(finger.links):
-            k = F_LINK0 + F_LINK_STRIDE * i
-            row[k + L_LENGTH] = link.length
-            row[k + L_MASS] = link.mass
-            row[k + L_COM_ALONG] = link.com_along
-            row[k + L_COM_ACROSS] = link.com_across
-            row[k + L_INERTIA] = link.inertia
-        row[F_DAMPING : F_DAMPING + 3] = finger.damping
-        row[F_ARMATURE : F_ARMATURE + 3] = finger.armature
-        row[F_TIP_RADIUS] = finger.tip_radius
-    return rows
-
-
-def _pack_body(params: HandParams) -> np.ndarray:
-    """Gravity, object and contact parameters; the step (B_DT) is set by the plant."""
-    body = np.zeros(N_BODY_PARAMS)
-    body[B_GX], body[B_GY] = params.gravity
-    o = params.object
-    body[B_MASS] = o.mass
-    body[B_INERTIA] = o.inertia
-    body[B_HALF_A] = o.size[0] / 2
-    body[B_HALF_B] = o.size[1] / 2
-    c = params.contact
-    body[B_K_N] = c.k_n
-    body[B_C_N] = c.c_n
-    body[B_K_T] = c.k_t
-    body[B_C_T] = c.c_t
-    body[B_MU_S] = c.mu_s
-    body[B_MU_D] = c.mu_d
-    return body
-
-
-def _pack_edges(params: HandParams) -> np.ndarray:
-    """The square's four edges counter-clockwise from the bottom-left corner.
-
-    Each edge of length L gets round(L / surface_spacing) points, evenly spaced, so the
-    spacing is as close to the requested one as a whole number of points allows.
-    """
-    a, b = params.object.size
-    corners = [(-a / 2, -b / 2), (a / 2, -b / 2), (a / 2, b / 2), (-a / 2, b / 2)]
-    edges = np.zeros((N_EDGES, N_EDGE_COLS))
-    start = 0
-    for e in range(N_EDGES):
-        (x0, y0), (x1, y1) = corners[e], corners[(e + 1) % N_EDGES]
-        length = float(np.hypot(x1 - x0, y1 - y0))
-        count = max(1, int(round(length / params.object.surface_spacing)))
-        dx, dy = (x1 - x0) / length, (y1 - y0) / length
-        edges[e] = [x0, y0, dx, dy, dy, -dx, length / count, count, start]
-        start += count
-    return edges

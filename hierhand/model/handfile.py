@@ -5,6 +5,10 @@ rejected and every field is checked, and all problems of a file are reported at 
 each naming its field (``fingers[1].links[2].mass must be > 0``). Top-level sections are
 optional and default to the shipped hand (``default_hand.yaml`` beside this module);
 ``object`` and ``contact`` may be partial, their missing keys taken from the default.
+
+This module checks the file's shape (sections, keys, lists, numbers); what values a
+hand's numbers may take (positive masses, mu_d <= mu_s, ...) is judged by the C core
+(``hand_params.c``), the same check an exported FMU applies to its parameters.
 """
 
 from __future__ import annotations
@@ -18,6 +22,9 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import yaml
+
+from .. import _native
+from .hand_vector import hand_file_path, hand_vector, parameter_names
 
 DEFAULT_HAND_FILE = Path(__file__).with_name("default_hand.yaml")
 
@@ -178,16 +185,16 @@ def parse_hand(data: Mapping[str, Any], source: str | None = None) -> HandParams
     fingers = _parse_fingers(check, data["fingers"])
     obj = _parse_object(check, data["object"])
     contact = _parse_contact(check, data["contact"])
-    if fingers is not None and obj is not None and not check.errors:
-        smallest = min(f.tip_radius for f in fingers)
-        if obj.surface_spacing >= smallest:
-            check.error(
-                f"object.surface_spacing must be smaller than the smallest tip_radius "
-                f"({smallest:g} m), got {obj.surface_spacing:g}"
-            )
     if check.errors:
         raise HandFileError(check.errors, source)
-    return HandParams(gravity=gravity, fingers=fingers, object=obj, contact=contact)
+    params = HandParams(gravity=gravity, fingers=fingers, object=obj, contact=contact)
+    derived = set() if "inertia" in data["object"] else {"object.inertia"}  # follows mass and size
+    names = parameter_names()
+    problems = [f"{hand_file_path(names[i])} {text}" for i, text in _native.check_hand(hand_vector(params.to_dict()))
+                if names[i] not in derived]
+    if problems:
+        raise HandFileError(problems, source)
+    return params
 
 
 def _parse_fingers(check: "_Checker", raw: Any) -> tuple[FingerParams, ...] | None:
@@ -218,9 +225,9 @@ def _parse_fingers(check: "_Checker", raw: Any) -> tuple[FingerParams, ...] | No
                 base=check.vector(f["base"], f"{path}.base", 2),
                 base_angle=check.number(f["base_angle"], f"{path}.base_angle"),
                 links=links,
-                damping=check.vector(f["damping"], f"{path}.damping", N_LINKS, minimum=0.0),
-                armature=check.vector(f["armature"], f"{path}.armature", N_LINKS, minimum=0.0),
-                tip_radius=check.number(f["tip_radius"], f"{path}.tip_radius", positive=True),
+                damping=check.vector(f["damping"], f"{path}.damping", N_LINKS),
+                armature=check.vector(f["armature"], f"{path}.armature", N_LINKS),
+                tip_radius=check.number(f["tip_radius"], f"{path}.tip_radius"),
                 q0=check.vector(f["q0"], f"{path}.q0", N_LINKS),
             )
         )
@@ -239,7 +246,7 @@ def _parse_links(check: "_Checker", raw: Any, path: str) -> tuple[LinkParams, ..
             continue
         if not check.keys(link, LINK_KEYS, lpath):
             continue
-        length = check.number(link["length"], f"{lpath}.length", positive=True)
+        length = check.number(link["length"], f"{lpath}.length")
         com = link["com"]
         if isinstance(com, (list, tuple)):
             along, across = check.vector(com, f"{lpath}.com", 2)
@@ -248,10 +255,10 @@ def _parse_links(check: "_Checker", raw: Any, path: str) -> tuple[LinkParams, ..
         links.append(
             LinkParams(
                 length=length,
-                mass=check.number(link["mass"], f"{lpath}.mass", positive=True),
+                mass=check.number(link["mass"], f"{lpath}.mass"),
                 com_along=along,
                 com_across=across,
-                inertia=check.number(link["inertia"], f"{lpath}.inertia", positive=True),
+                inertia=check.number(link["inertia"], f"{lpath}.inertia"),
             )
         )
     return tuple(links) if len(links) == N_LINKS else None
@@ -263,15 +270,13 @@ def _parse_object(check: "_Checker", raw: Any) -> ObjectParams | None:
         return None
     if not check.keys(raw, OBJECT_KEYS, "object", optional=OBJECT_OPTIONAL):
         return None
-    mass = check.number(raw["mass"], "object.mass", positive=True)
-    size = check.vector(raw["size"], "object.size", 2, positive=True)
+    mass = check.number(raw["mass"], "object.mass")
+    size = check.vector(raw["size"], "object.size", 2)
     if "inertia" in raw:
-        inertia = check.number(raw["inertia"], "object.inertia", positive=True)
+        inertia = check.number(raw["inertia"], "object.inertia")
     else:
         inertia = mass * (size[0] ** 2 + size[1] ** 2) / 12.0
-    spacing = check.number(raw["surface_spacing"], "object.surface_spacing", positive=True)
-    if spacing > 0 and min(size) > 0 and spacing > min(size) / 4:
-        check.error(f"object.surface_spacing must be at most a quarter of the smallest side, got {spacing:g}")
+    spacing = check.number(raw["surface_spacing"], "object.surface_spacing")
     return ObjectParams(
         mass=mass,
         inertia=inertia,
@@ -288,17 +293,7 @@ def _parse_contact(check: "_Checker", raw: Any) -> ContactParams | None:
         return None
     if not check.keys(raw, CONTACT_KEYS, "contact"):
         return None
-    c = ContactParams(
-        k_n=check.number(raw["k_n"], "contact.k_n", positive=True),
-        c_n=check.number(raw["c_n"], "contact.c_n", minimum=0.0),
-        k_t=check.number(raw["k_t"], "contact.k_t", positive=True),
-        c_t=check.number(raw["c_t"], "contact.c_t", minimum=0.0),
-        mu_s=check.number(raw["mu_s"], "contact.mu_s", minimum=0.0),
-        mu_d=check.number(raw["mu_d"], "contact.mu_d", minimum=0.0),
-    )
-    if c.mu_d > c.mu_s:
-        check.error(f"contact.mu_d must be <= contact.mu_s (a sliding contact cannot carry more), got {c.mu_d:g} > {c.mu_s:g}")
-    return c
+    return ContactParams(*(check.number(raw[key], f"contact.{key}") for key in CONTACT_KEYS))
 
 
 class _Checker:
@@ -324,7 +319,8 @@ class _Checker:
             self.error(f"{path}.{k} is missing")
         return not missing
 
-    def number(self, value: Any, path: str, positive: bool = False, minimum: float | None = None) -> float:
+    def number(self, value: Any, path: str) -> float:
+        """A finite number (its allowed range is the C core's check)."""
         # PyYAML reads 1e-4 (no dot) as a string, so numeric strings are accepted too.
         if isinstance(value, bool) or not isinstance(value, (int, float, str)):
             self.error(f"{path} must be a number, got {value!r}")
@@ -337,16 +333,10 @@ class _Checker:
         if not math.isfinite(x):
             self.error(f"{path} must be finite, got {value!r}")
             return 0.0
-        if positive and not x > 0:
-            self.error(f"{path} must be > 0, got {x:g}")
-        if minimum is not None and x < minimum:
-            self.error(f"{path} must be >= {minimum:g}, got {x:g}")
         return x
 
-    def vector(self, value: Any, path: str, n: int, positive: bool = False, minimum: float | None = None) -> tuple[float, ...]:
+    def vector(self, value: Any, path: str, n: int) -> tuple[float, ...]:
         if not isinstance(value, (list, tuple)) or len(value) != n:
             self.error(f"{path} must be a list of {n} numbers, got {value!r}")
             return (0.0,) * n
-        return tuple(
-            self.number(v, f"{path}[{i}]", positive=positive, minimum=minimum) for i, v in enumerate(value)
-        )
+        return tuple(self.number(v, f"{path}[{i}]") for i, v in enumerate(value))

@@ -1,67 +1,68 @@
-"""Flat-array layouts shared by the Python side and the compiled kernels.
+"""Flat-array layouts of the plant's C core, named for Python.
 
-The kernels take a handful of float64 arrays rather than objects so that a call costs
-little to dispatch and needs no allocation per step; these constants name the slots.
-Numba freezes module-level integers as compile-time constants.
+The slots are defined once, in ``hierhand/csrc/hand.h``; the extension reports them in
+``hierhand._native.LAYOUT`` and this module gives them names Python code can import.
 """
 
+from .._native import LAYOUT as _L
+
 # -- per-finger parameter row: fingers[f, :] -------------------------------------------
-F_BASE_X = 0
-F_BASE_Y = 1
-F_BASE_ANGLE = 2
-F_LINK0 = 3  # link i occupies F_LINK0 + F_LINK_STRIDE * i + (L_*)
-F_LINK_STRIDE = 5
-L_LENGTH = 0
-L_MASS = 1
-L_COM_ALONG = 2
-L_COM_ACROSS = 3
-L_INERTIA = 4
-F_DAMPING = 18  # three joints
-F_ARMATURE = 21  # three joints
-F_TIP_RADIUS = 24
-N_FINGER_PARAMS = 25
+F_BASE_X: int = _L["F_BASE_X"]
+F_BASE_Y: int = _L["F_BASE_Y"]
+F_BASE_ANGLE: int = _L["F_BASE_ANGLE"]
+F_LINK0: int = _L["F_LINK0"]  # link i occupies F_LINK0 + F_LINK_STRIDE * i + (L_*)
+F_LINK_STRIDE: int = _L["F_LINK_STRIDE"]
+L_LENGTH: int = _L["L_LENGTH"]
+L_MASS: int = _L["L_MASS"]
+L_COM_ALONG: int = _L["L_COM_ALONG"]
+L_COM_ACROSS: int = _L["L_COM_ACROSS"]
+L_INERTIA: int = _L["L_INERTIA"]
+F_DAMPING: int = _L["F_DAMPING"]  # three joints
+F_ARMATURE: int = _L["F_ARMATURE"]  # three joints
+F_TIP_RADIUS: int = _L["F_TIP_RADIUS"]
+N_FINGER_PARAMS: int = _L["N_FINGER_PARAMS"]
 
 # -- body parameters: gravity, object, contact law, step ------------------------------
-B_GX = 0
-B_GY = 1
-B_MASS = 2
-B_INERTIA = 3
-B_HALF_A = 4
-B_HALF_B = 5
-B_K_N = 6
-B_C_N = 7
-B_K_T = 8
-B_C_T = 9
-B_MU_S = 10
-B_MU_D = 11
-B_DT = 12
-N_BODY_PARAMS = 13
+B_GX: int = _L["B_GX"]
+B_GY: int = _L["B_GY"]
+B_MASS: int = _L["B_MASS"]
+B_INERTIA: int = _L["B_INERTIA"]
+B_HALF_A: int = _L["B_HALF_A"]
+B_HALF_B: int = _L["B_HALF_B"]
+B_K_N: int = _L["B_K_N"]
+B_C_N: int = _L["B_C_N"]
+B_K_T: int = _L["B_K_T"]
+B_C_T: int = _L["B_C_T"]
+B_MU_S: int = _L["B_MU_S"]
+B_MU_D: int = _L["B_MU_D"]
+B_DT: int = _L["B_DT"]
+N_BODY_PARAMS: int = _L["N_BODY_PARAMS"]
 
 # -- object edges, in the object frame: edges[e, :] -------------------------------------
 # Point k of edge e (k = 0 .. count-1) sits at origin + k * spacing * direction; the
 # edge's end corner is point 0 of the next edge. Points are numbered start + k.
-E_OX = 0
-E_OY = 1
-E_DX = 2
-E_DY = 3
-E_NX = 4  # outward normal
-E_NY = 5
-E_SPACING = 6
-E_COUNT = 7
-E_START = 8
-N_EDGE_COLS = 9
-N_EDGES = 4
+E_OX: int = _L["E_OX"]
+E_OY: int = _L["E_OY"]
+E_DX: int = _L["E_DX"]
+E_DY: int = _L["E_DY"]
+E_NX: int = _L["E_NX"]  # outward normal
+E_NY: int = _L["E_NY"]
+E_SPACING: int = _L["E_SPACING"]
+E_COUNT: int = _L["E_COUNT"]
+E_START: int = _L["E_START"]
+N_EDGE_COLS: int = _L["N_EDGE_COLS"]
+N_EDGES: int = _L["EDGES"]
 
 # -- state vector ----------------------------------------------------------------------
 # q(9) qd(9) obj pose(3) obj velocity(3) contact windows(3 x 4 x 2: first and last point
 # index per finger and edge that may hold an anchor) touching flags(3 x npts) anchors
 # (3 x npts x 2, in the frame of link 3 relative to the tip centre).
-S_Q = 0
-S_QD = 9
-S_OBJ = 18
-S_OBJ_VEL = 21
-S_WINDOW = 24
-S_TOUCH = 48
+S_Q: int = _L["S_Q"]
+S_QD: int = _L["S_QD"]
+S_OBJ: int = _L["S_OBJ"]
+S_OBJ_VEL: int = _L["S_OBJ_VEL"]
+S_WINDOW: int = _L["S_WINDOW"]
+S_TOUCH: int = _L["S_TOUCH"]
 
 
 def state_size(npts: int) -> int:
@@ -85,24 +86,39 @@ OUTPUT_PORTS = (
     ("obj_vel", 3),
     ("normal", 6),
 )
-O_Q = 0
-O_QD = 9
-O_TIP = 18
-O_FN = 27
-O_FT = 30
-O_RATIO = 33
-O_CONTACT = 36
-O_OBJ = 39
-O_OBJ_VEL = 42
-O_NORMAL = 45
-N_OUTPUTS = 51
+O_Q: int = _L["O_Q"]
+O_QD: int = _L["O_QD"]
+O_TIP: int = _L["O_TIP"]
+O_FN: int = _L["O_FN"]
+O_FT: int = _L["O_FT"]
+O_RATIO: int = _L["O_RATIO"]
+O_CONTACT: int = _L["O_CONTACT"]
+O_OBJ: int = _L["O_OBJ"]
+O_OBJ_VEL: int = _L["O_OBJ_VEL"]
+O_NORMAL: int = _L["O_NORMAL"]
+N_OUTPUTS: int = _L["N_OUTPUTS"]
 
-# -- kernel status codes ---------------------------------------------------------------
-OK = 0
-ERR_Q = 1
-ERR_QD = 2
-ERR_OBJ = 3
-ERR_OBJ_VEL = 4
-ERR_PENETRATION = 5
-ERR_TAU = 6
-ERR_F_EXT = 7
+# -- per-finger contact summary (ContactWrenches) -----------------------------------------
+W_OBJ_FX: int = _L["W_OBJ_FX"]  # force on the object
+W_OBJ_FY: int = _L["W_OBJ_FY"]
+W_OBJ_M: int = _L["W_OBJ_M"]  # its moment about the object's centre
+W_TIP_M: int = _L["W_TIP_M"]  # moment of the force on the object about the tip centre
+W_FN: int = _L["W_FN"]  # summed normal force
+W_FT: int = _L["W_FT"]  # summed tangential force (signed, along t = z x n)
+W_FN_PX: int = _L["W_FN_PX"]  # sum of f_n * p, for the force-weighted contact point
+W_FN_PY: int = _L["W_FN_PY"]
+N_WRENCH: int = _L["N_WRENCH"]
+
+# -- status codes ------------------------------------------------------------------------
+OK: int = _L["OK"]
+ERR_Q: int = _L["ERR_Q"]
+ERR_QD: int = _L["ERR_QD"]
+ERR_OBJ: int = _L["ERR_OBJ"]
+ERR_OBJ_VEL: int = _L["ERR_OBJ_VEL"]
+ERR_PENETRATION: int = _L["ERR_PENETRATION"]
+ERR_TAU: int = _L["ERR_TAU"]
+ERR_F_EXT: int = _L["ERR_F_EXT"]
+
+_ports_width = sum(width for _, width in OUTPUT_PORTS)
+if _ports_width != N_OUTPUTS:
+    raise ImportError(f"the output ports hold {_ports_width} values but the C core writes {N_OUTPUTS}")

@@ -1,10 +1,11 @@
 """``HandPlant``: the hand/object plant as a block (penalty contact, 0.1 ms typical).
 
-The state is one flat float64 vector (layout in ``layout.py``): joint angles and rates,
-object pose and velocity, and the contact bookkeeping (per finger and surface point an
-in-contact flag and an anchor). Copying it checkpoints a run. ``views(state)`` names its
-parts. All physics runs in the compiled kernels of ``kernel.py``; ``advance`` does n steps
-in one call and equals n times ``update`` then ``output``, bit for bit.
+The state is one flat float64 vector (layout in ``hierhand/csrc/hand.h``): joint angles
+and rates, object pose and velocity, and the contact bookkeeping (per finger and surface
+point an in-contact flag and an anchor). Copying it checkpoints a run. ``views(state)``
+names its parts. All physics runs in the C core (``hierhand/csrc``, through
+``hierhand._native``): ``update``, ``output`` and ``advance`` are one native call each,
+and ``advance`` equals n times ``update`` then ``output``, bit for bit.
 """
 
 from __future__ import annotations
@@ -16,12 +17,10 @@ import numpy as np
 
 from blocks.block import Block, BlockError
 
-from .contact import W_FN, W_FN_PX, W_FN_PY, W_FT, W_OBJ_FX, W_OBJ_FY, W_OBJ_M, W_TIP_M, N_WRENCH
+from .. import _native
 from .hand import Hand
 from .handfile import merge_with_default, parse_hand
-from .kernel import advance_kernel, contact_kernel, output_kernel, step_kernel
 from .layout import (
-    B_DT,
     ERR_F_EXT,
     ERR_OBJ,
     ERR_OBJ_VEL,
@@ -30,6 +29,7 @@ from .layout import (
     ERR_QD,
     ERR_TAU,
     N_OUTPUTS,
+    N_WRENCH,
     OUTPUT_PORTS,
     S_OBJ,
     S_OBJ_VEL,
@@ -37,6 +37,14 @@ from .layout import (
     S_QD,
     S_TOUCH,
     S_WINDOW,
+    W_FN,
+    W_FN_PX,
+    W_FN_PY,
+    W_FT,
+    W_OBJ_FX,
+    W_OBJ_FY,
+    W_OBJ_M,
+    W_TIP_M,
     anchor_offset,
     state_size,
 )
@@ -46,12 +54,10 @@ _offset = 0
 for _name, _width in OUTPUT_PORTS:
     _PORT_SLICES.append((_name, slice(_offset, _offset + _width)))
     _offset += _width
-assert _offset == N_OUTPUTS
 _PORT_COLUMNS = [(name, (slice(None), sl)) for name, sl in _PORT_SLICES]  # ready-made 2-D indices
-_F64 = np.dtype(np.float64)
-_ND = np.ndarray
-_SHAPE9 = (9,)
-_SHAPE3 = (3,)
+_ZERO3 = np.zeros(3)
+_ZERO3.flags.writeable = False
+_advance, _step, _output = _native.advance, _native.step, _native.output
 
 
 @dataclass(frozen=True)
@@ -112,14 +118,11 @@ class HandPlant(Block):
         sections = {"gravity": gravity, "fingers": fingers, "object": object, "contact": contact}
         self.hand = Hand(parse_hand(merge_with_default(sections), "HandPlant parameters"))
         self.inputs = {"tau": 9, "f_ext": 3}
-        self.input_defaults = {"f_ext": np.zeros(3)}
+        self.input_defaults = {"f_ext": _ZERO3}
         self.outputs = dict(OUTPUT_PORTS)
         self.n_points = self.hand.n_points
         self._state_shape = (state_size(self.n_points),)
-        self._body = self.hand.body.copy()
-        self._fingers = self.hand.fingers
-        self._edges = self.hand.edges
-        self._bound_shape: tuple[int] | None = None  # the state shape once bound: the fast paths' test
+        self._model: _native.Model | None = None  # the hand packed with its step, once bound
         self.dt: float | None = None
 
     @classmethod
@@ -135,17 +138,13 @@ class HandPlant(Block):
             raise ValueError(f"HandPlant period must be > 0, got {period}")
         self.period = period
         self.dt = dt
-        self._body[B_DT] = dt
-        self._bound_shape = self._state_shape
+        self._model = self.hand.native.with_dt(dt)
 
     # -- state ------------------------------------------------------------------------
 
     def initial_state(self) -> np.ndarray:
-        state = np.zeros(state_size(self.n_points))
-        v = self.views(state)
-        v.q[:] = self.hand.q0
-        v.obj[:] = self.hand.object_pose0
-        v.window[:, :, 1] = -1.0
+        state = np.empty(self._state_shape)
+        _native.initial_state(self.hand.native, state)
         return state
 
     def views(self, state: np.ndarray) -> StateViews:
@@ -163,29 +162,40 @@ class HandPlant(Block):
 
     # -- the block contract -------------------------------------------------------------
 
-    # Fast paths: one identity/shape test per argument (the state's shape test also fails
-    # until bind() sets ``_bound_shape``), then the kernel, which checks every value for
-    # finiteness and reports by code; anything unusual goes through the full checks.
+    # Fast paths: the native call checks the arrays it is given (float64, C-contiguous,
+    # their lengths) and every value for finiteness, reporting by code; anything it
+    # refuses goes through ``_arguments``, which converts inputs or names the problem.
 
     def output(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        self._quick_check(state)
         row = np.empty(N_OUTPUTS)
-        code, which = output_kernel(state, self._fingers, self._body, self._edges, row)
+        try:
+            code, _, which = _output(self._model, state, row)
+        except (TypeError, ValueError):
+            self._check_state(state)
+            raise
         if code:
             raise self._error(code, which, t)
         return {name: row[sl] for name, sl in _PORT_SLICES}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
-        tau, f_ext = self._arguments(state, inputs)
-        code, done, which = step_kernel(state, tau, f_ext, self._fingers, self._body, self._edges)
+        tau, f_ext = inputs["tau"], inputs.get("f_ext", _ZERO3)
+        try:
+            code, done, which = _step(self._model, state, tau, f_ext)
+        except (TypeError, ValueError):
+            tau, f_ext = self._arguments(state, inputs)
+            code, done, which = _step(self._model, state, tau, f_ext)
         if code:
             raise self._error(code, which, t + done * self.dt)
         return state
 
     def advance(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray], n: int):
-        tau, f_ext = self._arguments(state, inputs)
+        tau, f_ext = inputs["tau"], inputs.get("f_ext", _ZERO3)
         rows = np.empty((n, N_OUTPUTS))
-        code, done, which = advance_kernel(state, tau, f_ext, self._fingers, self._body, self._edges, rows)
+        try:
+            code, done, which = _advance(self._model, state, tau, f_ext, rows)
+        except (TypeError, ValueError):
+            tau, f_ext = self._arguments(state, inputs)
+            code, done, which = _advance(self._model, state, tau, f_ext, rows)
         if code:
             error = self._error(code, which, t + done * self.dt)
             written = max(done - 1, 0)  # the state after update ``done`` is the bad one: no row for it
@@ -193,21 +203,12 @@ class HandPlant(Block):
             raise error
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
 
-    def _quick_check(self, state: np.ndarray) -> None:
-        """The full state checks, only when the state is not the bound plant's plain array."""
-        if not (state.__class__ is _ND and state.dtype == _F64 and state.shape == self._bound_shape):
-            self._check_state(state)
-
     def _arguments(self, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        """(tau, f_ext) for the kernels after a quick state check; inputs of an unusual
-        type or shape go through the full conversion and its error messages."""
-        self._quick_check(state)
-        tau = inputs["tau"]
+        """(tau, f_ext) as the native calls take them; a state they cannot take, or an
+        input of the wrong width, is a ``BlockError`` naming it."""
+        self._check_state(state)
         f_ext = inputs.get("f_ext")
-        if not (tau.__class__ is _ND and f_ext.__class__ is _ND and tau.dtype == _F64 and f_ext.dtype == _F64
-                and tau.shape == _SHAPE9 and f_ext.shape == _SHAPE3):
-            tau, f_ext = self._inputs(inputs)
-        return tau, f_ext
+        return _port_vector(inputs["tau"], 9, "tau"), _ZERO3 if f_ext is None else _port_vector(f_ext, 3, "f_ext")
 
     # -- inspection -------------------------------------------------------------------
 
@@ -216,7 +217,7 @@ class HandPlant(Block):
         self._check_state(state)
         tips = np.empty((3, 3))
         w = np.empty((3, N_WRENCH))
-        code, which = contact_kernel(state, self.hand.fingers, self._body, self.hand.edges, tips, w)
+        code, _, which = _native.contact(self._model, state, tips, w)
         if code:
             raise self._error(code, which, None)
         on_obj = w[:, [W_OBJ_FX, W_OBJ_FY]].copy()
@@ -237,25 +238,13 @@ class HandPlant(Block):
     # -- helpers ----------------------------------------------------------------------
 
     def _check_state(self, state: Any) -> None:
-        if not (state.__class__ is np.ndarray and state.dtype is _F64 and state.shape == self._state_shape):
-            if not (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.shape == self._state_shape):
-                raise BlockError(
-                    f"HandPlant state must be the float64 vector of shape {self._state_shape} made by initial_state()"
-                )
-        if self.dt is None:
+        if not (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.shape == self._state_shape
+                and state.flags.c_contiguous and state.flags.writeable):
+            raise BlockError(
+                f"HandPlant state must be the float64 vector of shape {self._state_shape} made by initial_state()"
+            )
+        if self._model is None:
             raise BlockError("HandPlant is not bound to a period; call bind(period) first")
-
-    @staticmethod
-    def _inputs(inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-        tau = inputs["tau"]
-        f_ext = inputs.get("f_ext")
-        if f_ext is None:
-            f_ext = _ZERO3
-        if not (tau.__class__ is np.ndarray and tau.dtype is _F64 and tau.shape == (9,)):
-            tau = _port_vector(tau, 9, "tau")
-        if not (f_ext.__class__ is np.ndarray and f_ext.dtype is _F64 and f_ext.shape == (3,)):
-            f_ext = _port_vector(f_ext, 3, "f_ext")
-        return tau, f_ext
 
     def _error(self, code: int, which: int, t: float | None) -> BlockError:
         names = self.hand.names
@@ -279,9 +268,6 @@ class HandPlant(Block):
         }
         port, quantity = what[code]
         return BlockError(f"HandPlant: non-finite value {when}: {quantity} is not finite", port=port)
-
-
-_ZERO3 = np.zeros(3)
 
 
 def _port_vector(x: Any, n: int, name: str) -> np.ndarray:

@@ -1,0 +1,73 @@
+"""Build the hand's C core: the Python extension and the FMI 2 / FMI 3 plant libraries.
+
+Metadata lives in pyproject.toml; this file only declares what is compiled, because
+setuptools' extension support is the build path every pip and every Python install
+already has (no CMake, no code generator). Besides the extension ``hierhand._native``
+the build links two plain shared libraries from the same C sources,
+``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so``, that ``hierhand fmu export`` copies
+into FMUs, so exporting needs no compiler. They link libc and libm only; their FMI
+headers come from fmpy (a build requirement), the headers an importer builds against too.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from setuptools import Extension, setup
+from setuptools.command.build_ext import build_ext
+
+ROOT = Path(__file__).resolve().parent
+sys.path.insert(0, str(ROOT / "hierhand"))
+from native_sources import (  # noqa: E402 - the source lists live in the package, for the exporter
+    CFLAGS,
+    EXTENSION_SOURCES,
+    FMI_LIBRARIES,
+    fmi_headers,
+)
+
+sys.path.pop(0)
+
+
+class BuildNative(build_ext):
+    """build_ext that also links the FMU libraries next to the extension."""
+
+    def run(self) -> None:
+        super().run()
+        for fmi, sources in FMI_LIBRARIES.items():
+            self._link_fmi_library(fmi, sources)
+
+    def _link_fmi_library(self, fmi: int, sources: list[str]) -> None:
+        relative = Path("hierhand", "fmu_binaries", f"fmi{fmi}.so")
+        targets = [Path(self.build_lib) / relative]
+        if self.inplace or getattr(self, "editable_mode", False):
+            targets.append(ROOT / relative)
+        objects = self.compiler.compile(
+            sources,
+            output_dir=os.path.join(self.build_temp, f"fmi{fmi}"),
+            include_dirs=[fmi_headers()],
+            extra_postargs=CFLAGS + ["-std=c99"],
+        )
+        for target in targets:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            self.compiler.link_shared_object(objects, str(target), libraries=["m"])
+
+    def get_outputs(self) -> list[str]:
+        outputs = super().get_outputs()
+        for fmi in FMI_LIBRARIES:
+            outputs.append(str(Path(self.build_lib, "hierhand", "fmu_binaries", f"fmi{fmi}.so")))
+        return outputs
+
+
+setup(
+    ext_modules=[
+        Extension(
+            "hierhand._native",
+            sources=EXTENSION_SOURCES,
+            extra_compile_args=CFLAGS + ["-std=c11"],
+            libraries=["m"],
+        )
+    ],
+    cmdclass={"build_ext": BuildNative},
+)
