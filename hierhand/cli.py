@@ -104,9 +104,10 @@ def build_parser() -> argparse.ArgumentParser:
     fmu = sub.add_parser("fmu", help="export the hand plant as an FMU, or describe an FMU")
     fmu_sub = fmu.add_subparsers(dest="fmu_command", required=True, metavar="FMU_COMMAND")
     export = fmu_sub.add_parser("export", help="package the hand plant as an FMI co-simulation FMU",
-                                description="Package the HandPlant as an FMI 2.0 or 3.0 co-simulation FMU "
-                                            "(Python slave: the importing tool needs Python with numpy and "
-                                            "numba). Its parameters are the hand file's values.")
+                                description="Package the HandPlant as an FMI 2.0 or 3.0 co-simulation FMU: "
+                                            "the plant's C core as a native binary (Linux, no Python needed "
+                                            "at the importer) plus its C sources. Its parameters are the "
+                                            "hand file's values.")
     export.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default: 2)")
     export.add_argument("--hand", type=Path, metavar="FILE", help="hand file (default: the shipped hand)")
     export.add_argument("-o", "--output", type=Path, metavar="PATH",
@@ -391,11 +392,17 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def cmd_fmu_export(args: argparse.Namespace) -> int:
-    from hierhand.fmu_export import export_plant_fmu
+    from hierhand.fmu_export import FmuExportError, export_plant_fmu
+    from hierhand.model import HandFileError
 
     if args.hand is not None and not args.hand.is_file():
         raise UsageError(f"--hand {args.hand}: hand file not found")
-    path = export_plant_fmu(args.output, fmi=args.fmi, hand=args.hand)
+    try:
+        path = export_plant_fmu(args.output, fmi=args.fmi, hand=args.hand)
+    except HandFileError as exc:
+        raise UsageError("; ".join(f"{exc.source or '--hand'}: {e}" for e in exc.errors)) from None
+    except (FmuExportError, OSError) as exc:
+        raise UsageError(f"fmu export: {exc}") from None
     print(f"wrote {path}")
     return EXIT_OK
 
