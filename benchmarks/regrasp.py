@@ -1,21 +1,21 @@
-"""Re-grasp end to end: diagrams/regrasp.yaml, 1 s, loader + executor vs the bare plant kernel.
+"""Re-grasp end to end: diagrams/regrasp.yaml, 1 s, loader + executor vs the bare C core of the plant.
 
 The re-grasp diagram simulated for 1 s through the YAML loader and the executor, against
-the bare compiled plant kernel over the same 0.1 ms steps.
+the bare C core of the plant over the same 0.1 ms steps.
 
-Reports, as medians of --repeat runs after one warm-up run (numba JIT and caches):
+Reports, as medians of --repeat runs after one warm-up run:
 
 - full: ``blocks.load_diagram`` + ``blocks.simulate`` (ms per simulated second and the
   real-time factor, simulated / wall time);
 - simulate only, the diagram loaded once;
-- the bare compiled kernel (``advance_kernel``): the same number of plant steps from the
+- the bare C core (``hierhand._native.advance``): the same number of plant steps from the
   plant's initial state under constant pinching torques (gravity compensation plus an
   inward squeeze on thumb and forefinger tips and an upward share of the object's
   weight each, ``f_ext`` zero), called in chunks of 10 steps (as the executor does
   between 1 ms controller events) and in one call; the open-loop pinch drifts apart after
   about 0.4 s, so a third run ("pinch held") restarts from the initial state every 0.25 s
   to show the cost with the object held throughout;
-- the split of the full run: the plant (bare kernel, chunked) against the rest
+- the split of the full run: the plant (bare core, chunked) against the rest
   (controllers, executor, loader, logging).
 
 Target: at most 30 ms of wall time per simulated second through loader + scheduler.
@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 
 import blocks
-from hierhand.model.kernel import advance_kernel
+from hierhand import _native
 from hierhand.model.layout import N_OUTPUTS, OUTPUT_PORTS
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -71,19 +71,18 @@ def pinch_torques(hand, q) -> np.ndarray:
     return hand.static_torques(q, forces, points)
 
 
-def kernel_runner(plant, n_steps: int, chunk: int, segment: int | None = None):
-    """A callable running ``n_steps`` bare kernel steps from the plant's initial state in
+def core_runner(plant, n_steps: int, chunk: int, segment: int | None = None):
+    """A callable running ``n_steps`` bare core steps from the plant's initial state in
     calls of ``chunk`` steps, restarting from the initial state every ``segment`` steps
     (default: never), and one doing the same while returning the contact flags per step.
     """
     hand = plant.hand
-    body = plant._body  # the bound parameters: the kernel sees exactly what advance does
-    fingers, edges = hand.fingers, hand.edges
+    model = plant._model  # the bound model: the core steps exactly what advance does
     start = plant.initial_state()
     tau = pinch_torques(hand, hand.q0)
     f_ext = np.zeros(3)
     segment = n_steps if segment is None else segment
-    plan = []  # per segment, the steps of each kernel call
+    plan = []  # per segment, the steps of each core call
     for s0 in range(0, n_steps, segment):
         seg = min(segment, n_steps - s0)
         plan.append([chunk] * (seg // chunk) + ([seg % chunk] if seg % chunk else []))
@@ -96,9 +95,9 @@ def kernel_runner(plant, n_steps: int, chunk: int, segment: int | None = None):
             state[:] = start
             for n in seg:
                 out = rows[n]
-                code, _, _ = advance_kernel(state, tau, f_ext, fingers, body, edges, out)
+                code, _, _ = _native.advance(model, state, tau, f_ext, out)
                 if code:
-                    raise RuntimeError(f"bare kernel failed with code {code}")
+                    raise RuntimeError(f"bare core failed with code {code}")
                 if record is not None:
                     record[k : k + n] = out[:, _CONTACT_COL : _CONTACT_COL + 3]
                 k += n
@@ -146,11 +145,11 @@ def main() -> None:
     t_full, res = timed(full, args.repeat)
     t_sim, _ = timed(simulate_only, args.repeat)
 
-    chunked, calls, contact_c = kernel_runner(plant, n_steps, CHUNK)
+    chunked, calls, contact_c = core_runner(plant, n_steps, CHUNK)
     t_kc, _ = timed(chunked, args.repeat)
-    single, _, _ = kernel_runner(plant, n_steps, n_steps)
+    single, _, _ = core_runner(plant, n_steps, n_steps)
     t_k1, _ = timed(single, args.repeat)
-    held, calls_h, contact_h = kernel_runner(plant, n_steps, CHUNK, HOLD_STEPS)
+    held, calls_h, contact_h = core_runner(plant, n_steps, CHUNK, HOLD_STEPS)
     t_kh, _ = timed(held, args.repeat)
 
     per = 1e3 / t_end  # seconds of wall time -> ms per simulated second
@@ -167,18 +166,18 @@ def main() -> None:
     print(f"  run status: {res.status}")
     print(line("full (load + simulate)", ms_full))
     print(line("simulate only (diagram loaded once)", ms_sim))
-    print(line(f"bare kernel, {calls} calls of {CHUNK} steps", ms_kc))
-    print(line(f"bare kernel, 1 call of {n_steps} steps", ms_k1))
-    print(line(f"bare kernel, {calls_h} calls, pinch held", ms_kh))
+    print(line(f"bare core, {calls} calls of {CHUNK} steps", ms_kc))
+    print(line(f"bare core, 1 call of {n_steps} steps", ms_k1))
+    print(line(f"bare core, {calls_h} calls, pinch held", ms_kh))
     print(f"    constant pinch torques (squeeze {SQUEEZE:g} N, f_ext 0) from the initial state: thumb/fore/middle in"
           f" contact {share(contact_c())} of the steps;")
     print(f"    the open-loop pinch is lost after ~0.4 s, so 'pinch held' restarts every {HOLD_STEPS * dt:g} s"
           f" ({share(contact_h())})")
-    print(f"  ratio full / bare kernel: {ms_full / ms_kc:6.2f} (chunked)   {ms_full / ms_k1:6.2f} (one call)"
+    print(f"  ratio full / bare core: {ms_full / ms_kc:6.2f} (chunked)   {ms_full / ms_k1:6.2f} (one call)"
           f"   {ms_full / ms_kh:6.2f} (chunked, pinch held)")
-    print(f"  ratio simulate only / bare kernel (chunked): {ms_sim / ms_kc:6.2f}")
+    print(f"  ratio simulate only / bare core (chunked): {ms_sim / ms_kc:6.2f}")
     rest = ms_full - ms_kc
-    print(f"  split of the full run, ms per simulated s: plant (bare kernel, chunked) {ms_kc:6.2f}"
+    print(f"  split of the full run, ms per simulated s: plant (bare core, chunked) {ms_kc:6.2f}"
           f" ({ms_kc / ms_full:.0%}), rest (controllers + executor) {rest:6.2f} ({rest / ms_full:.0%}),"
           f" of which load + schedule {ms_full - ms_sim:5.2f}")
     print(f"  reference: MuJoCo stepping the same hand, controlled every 1 ms from Python: ~{MUJOCO_MS:g} ms per"

@@ -640,6 +640,16 @@ class _Instance:
 
         self.reads = plan(self.model.out_groups, get)
         self.writes = plan(self.model.in_groups, put)
+        # doStep straight through the library's function, its status checked here: fmpy's
+        # wrapper (and, for FMI 3, its fresh output arguments) cost more than the call
+        if self.model.major == 2:
+            self._do_step = s._functions["fmi2DoStep"]
+            self._step_flags = ()
+        else:
+            self._do_step = s._functions["fmi3DoStep"]
+            flags = [ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(), ctypes.c_double()]
+            self._step_flags = flags
+            self._step_refs = [ctypes.byref(f) for f in flags]
 
     def log_text(self) -> str:
         if not self.messages:
@@ -670,6 +680,7 @@ class _Instance:
         self.started = True
 
     def read(self) -> dict[str, Signal]:
+        """Fresh float64 outputs: one copy per group, each port a view of it."""
         out: dict[str, Signal] = {}
         component = self.slave.component
         for fn, vrs, nvr, buf, count, view, slices in self.reads:
@@ -677,9 +688,26 @@ class _Instance:
                 fn(component, vrs, nvr, buf)
             else:
                 fn(component, vrs, nvr, buf, count)
+            values = view.astype(np.float64)
             for name, a, b in slices:
-                out[name] = np.array(view[a:b], dtype=np.float64)
+                out[name] = values[a:b]
         return out
+
+    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
+        """One doStep; (terminate requested, returned early, last successful time).
+        Raises fmpy's FMICallException for an error status, as fmpy's own call does."""
+        if self.model.major == 2:
+            status = self._do_step(self.slave.component, t, h, 1)
+        else:
+            status = self._do_step(self.slave.component, t, h, True, *self._step_refs)
+        if status > 1:
+            from fmpy.fmi1 import FMICallException
+
+            raise FMICallException(function=f"fmi{self.model.major}DoStep", status=status)
+        if self.model.major == 2:
+            return False, False, t + h
+        _, terminate, early, last = self._step_flags
+        return terminate.value, early.value, last.value
 
     def write(self, inputs: Mapping[str, Signal]) -> None:
         component = self.slave.component
@@ -864,17 +892,13 @@ class FMU(Block):
         try:
             if inst.model.major == 2:
                 _fmi2_arm()
-                inst.write(inputs)
-                inst.slave.doStep(t, h)
-            else:
-                inst.write(inputs)
-                _, terminate, early, last = inst.slave.doStep(t, h)
-                if terminate or early:
-                    inst.broken = True
-                    what = "requested to terminate the simulation" if terminate else \
-                        f"returned early at t={last:.9g} s"
-                    raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) "
-                                     f"{what}{inst.log_text()}")
+            inst.write(inputs)
+            terminate, early, last = inst.do_step(t, h)
+            if terminate or early:
+                inst.broken = True
+                what = "requested to terminate the simulation" if terminate else f"returned early at t={last:.9g} s"
+                raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) "
+                                 f"{what}{inst.log_text()}")
             state.time = t + h
             state.outputs = inst.read()
         except BlockError:
