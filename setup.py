@@ -47,11 +47,11 @@ class BuildNative(build_ext):
             sources,
             output_dir=os.path.join(self.build_temp, f"fmi{fmi}"),
             include_dirs=[fmi_headers()],
-            extra_postargs=CFLAGS + ["-std=c99"],
+            extra_postargs=CFLAGS + ["-std=c99", "-g0"],  # no debug info in what FMUs carry
         )
         for target in targets:
             target.parent.mkdir(parents=True, exist_ok=True)
-            self.compiler.link_shared_object(objects, str(target), libraries=["m"])
+            self.compiler.link_shared_object(objects, str(target), libraries=["m"], extra_postargs=["-s"])
 
     def get_outputs(self) -> list[str]:
         outputs = super().get_outputs()
