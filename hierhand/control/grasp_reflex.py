@@ -21,10 +21,11 @@ Why a margin: an integral loop approaches its target exponentially, so aiming ex
 the safety ratio would leave ``|f_t| / f_n`` just above it for ever; aiming at
 ``safety_ratio / (1 + margin)`` brings it below the safety ratio in finite time.
 
-How: ``output`` and ``update`` each make one call into the compiled kernels of
-``reflex_kernel`` (the grasp matrix solve written out by hand, the tip Jacobians from the
-plant's compiled kinematics); ``internal_forces`` is the numpy reference they are tested
-against. The parameters are packed for the kernels when the block is made and bound.
+How: ``output`` and ``update`` each make one native call through ``reflex_kernel`` (the
+law in C, ``hierhand/csrc/reflex.c``: the grasp matrix solve written out by hand, the tip
+Jacobians from the plant's own kinematics); ``internal_forces`` is the numpy reference
+they are tested against. The parameters are packed for the native calls when the block
+is made and bound.
 """
 
 from __future__ import annotations
@@ -99,7 +100,7 @@ class GraspReflex(Block):
         self.ki, self.min_force, self.max_force = float(ki), float(min_force), float(max_force)
         self.ratio_target = float(safety_ratio) / (1.0 + float(margin))
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
-        # the kernels' flat parameter array; the period (P_DT) is set by bind
+        # the native calls' flat parameter array; the period (P_DT) is set by bind
         self._params = pack_params(self.threshold, self.approach_force, self.ki, np.nan, self.min_force,
                                    self.ratio_target, self.max_force, self.initial)
         self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6}
@@ -138,26 +139,20 @@ class GraspReflex(Block):
         squeeze ``internal_directions``. Computed by ``reflex_kernel.reflex_directions``
         (``G^+ = G^T (G G^T)^-1`` solved by hand; ``project_internal`` is the reference).
         """
-        return reflex_directions(self._params, _f64(state), _f64(tip), _f64(normal), _f64(fn))
+        return reflex_directions(self._params, state, tip, normal, fn)
 
     def forces(self, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """(3, 2) fingertip force commands and the fingers in the grasp: ``s g_i`` for a
         touching finger, ``g_i`` scaled to ``approach_force`` for an approaching one."""
-        return reflex_forces(self._params, _f64(state), _f64(inputs["tip"]), _f64(inputs["normal"]),
-                             _f64(inputs["fn"]))
+        return reflex_forces(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"])
 
     def output(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """``tau_g = J_i^T f_i`` per finger (tip Jacobians at ``q``), ``|f_i|`` and the grasp
-        flags; one kernel call, the ports are views of one fresh array."""
-        out = reflex_output(self._params, self.hand.fingers, state, inputs["q"], inputs["tip"],
-                            inputs["normal"], inputs["fn"])
+        flags; one native call, the ports are views of one fresh array."""
+        out = reflex_output(self.hand.native, self._params, state, inputs["q"], inputs["tip"], inputs["normal"],
+                            inputs["fn"])
         return {"tau_g": out[O_TAU:O_FORCE], "force": out[O_FORCE:O_ACTIVE], "active": out[O_ACTIVE:N_OUT]}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
         """The integral step of the grasp force scale and the touched flags (a fresh array)."""
         return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"])
-
-
-def _f64(x) -> np.ndarray:
-    """A 1-D float64 array for the kernels (the helper methods also take lists)."""
-    return np.ascontiguousarray(x, dtype=np.float64).reshape(-1)

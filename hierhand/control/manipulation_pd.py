@@ -5,10 +5,10 @@ Every hit (10 ms in the paper) samples them, turns the samples into joint target
 exact three-joint inverse kinematics and tracks them with a joint PD. Fingers without a
 trajectory hold their initial joint angles.
 
-All of that runs in one compiled call per hit (``manipulation_kernel.manipulation_output``,
-over flat arrays packed once at load time); ``output_reference`` is the same computation
-in numpy, kept as the reference the kernel is tested against and as the path that raises
-a descriptive error when a target turns out unreachable during the run.
+All of that runs in one native call per hit (``manipulation_kernel.manipulation_output``,
+the law in C over flat arrays packed once at load time); ``output_reference`` is the same
+computation in numpy, kept as the reference the C law is tested against and as the path
+that raises a descriptive error when a target turns out unreachable during the run.
 
 Outputs: ``tau_m``, the PD torque of the voluntary motion (what the suppresser weighs
 against the grasping torque), and ``tau_ff``, a feedforward that keeps the 10 ms loop's
@@ -34,9 +34,6 @@ from .trajectory import Trajectory
 
 DERIVATIVE_STEP = 1e-3
 """Seconds either side of t for the joint-velocity target (central difference of the IK)."""
-
-_F64 = np.dtype(np.float64)
-_ND = np.ndarray
 
 
 class ManipulationPD(Block):
@@ -74,8 +71,8 @@ class ManipulationPD(Block):
         self.inputs = {"q": 9, "qd": 9, "fn": 3}
         self.outputs = {"tau_m": 9, "tau_ff": 9, "q_ref": 9}
         self.feedthrough = True
-        # the compiled output's flat arrays (built from the attributes above, once)
-        self._fingers = self.hand.fingers
+        # the native output's flat arrays (built from the attributes above, once)
+        self._model = self.hand.native
         self._params = pack_params(self.hand.q0, self.kp, self.kd, self.hand.gravity, self.weight, self.threshold,
                                    self.gravity_compensation, self.load_compensation, DERIVATIVE_STEP)
         self._waypoints, self._meta = pack_trajectories(self.trajectories)
@@ -112,7 +109,7 @@ class ManipulationPD(Block):
 
     def reference(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Joint position and velocity targets (9,) at time t (numpy; ``output`` computes
-        the same in its compiled kernel)."""
+        the same in its native call)."""
         q_ref = self.hand.q0.copy()
         qd_ref = np.zeros(9)
         for f, traj in enumerate(self.trajectories):
@@ -127,23 +124,22 @@ class ManipulationPD(Block):
         return q_ref, qd_ref
 
     def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """One compiled call on the arrays packed in ``__init__`` (so parameters changed on
-        the object afterwards are not seen). Inputs other than float64 arrays of the port
-        widths, and a target found unreachable, go through ``output_reference``."""
-        q, qd, fn = inputs["q"], inputs["qd"], inputs["fn"]
-        if not (q.__class__ is _ND and qd.__class__ is _ND and fn.__class__ is _ND
-                and q.dtype == _F64 and qd.dtype == _F64 and fn.dtype == _F64
-                and q.shape == (9,) and qd.shape == (9,) and fn.shape == (3,)):
-            return self.output_reference(t, state, inputs)
-        if t.__class__ is not float:
-            t = float(t)
+        """One native call on the arrays packed in ``__init__`` (so parameters changed on
+        the object afterwards are not seen). Inputs the native call refuses (anything but
+        C-contiguous float64 arrays of the port widths), and a target found unreachable,
+        go through ``output_reference``."""
         out = np.empty((3, 9))
-        if manipulation_output(t, q, qd, fn, self._fingers, self._params, self._waypoints, self._meta, out) != OK:
+        try:
+            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, inputs["q"],
+                                         inputs["qd"], inputs["fn"], out)
+        except (TypeError, ValueError):
+            return self.output_reference(t, state, inputs)
+        if status != OK:
             return self.output_reference(t, state, inputs)  # raises the UnreachableError naming the finger
         return {"tau_m": out[0], "tau_ff": out[1], "q_ref": out[2]}
 
     def output_reference(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """``output`` in numpy (the compiled kernel follows it operation by operation)."""
+        """``output`` in numpy (the native call follows it operation by operation)."""
         q, qd = inputs["q"], inputs["qd"]
         q_ref, qd_ref = self.reference(t)
         tau_m = self.kp * (q_ref - q) + self.kd * (qd_ref - qd)

@@ -2,38 +2,44 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any, Mapping
 
 import numpy as np
-from numba import njit
 
 from blocks import Block
 
+from .. import _native
 from .suppression import MODES, suppress
 
-_PASS, _MAGNITUDE, _SIGNED = 0, 1, 2  # suppress_kernel's modes
-_F64 = np.dtype(np.float64)
-_ND = np.ndarray
+_L = _native.LAYOUT
+P_S_A: int = _L["SUPPRESS_P_S_A"]  # 9 sigmoid steepnesses
+P_S_B: int = _L["SUPPRESS_P_S_B"]  # 9 half-suppression torques
+P_MODE: int = _L["SUPPRESS_P_MODE"]  # PASS, MAGNITUDE or SIGNED
+N_PARAMS: int = _L["SUPPRESS_N_PARAMS"]
+PASS: int = _L["SUPPRESS_PASS"]
+MAGNITUDE: int = _L["SUPPRESS_MAGNITUDE"]
+SIGNED: int = _L["SUPPRESS_SIGNED"]
+O_TAU: int = _L["SUPPRESS_O_TAU"]
+O_TAU_G_EFF: int = _L["SUPPRESS_O_TAU_G_EFF"]
+N_OUT: int = _L["SUPPRESS_N_OUT"]
+
+suppress_output = _native.suppress
+"""``suppress_output(params, tau_g, tau_m, tau_ff, out)``: ``out[O_TAU_G_EFF:]`` =
+``suppress(tau_g, tau_m, S_a, S_b)`` (or ``tau_g`` for mode ``PASS``), ``out[O_TAU:]`` =
+that ``+ tau_m + tau_ff``, over the 9 joints; the law in C (``hierhand/csrc/suppresser.c``)
+with the same operations as ``suppression.suppress`` (whose numpy ``exp`` may differ from
+libm's in the last bit). Takes C-contiguous float64 arrays only (``TypeError`` otherwise)."""
 
 
-@njit(cache=True)
-def suppress_kernel(tau_g, tau_m, tau_ff, s_a, s_b, mode, out):
-    """``out[1] = suppress(tau_g, tau_m, s_a, s_b)`` (or ``tau_g`` for mode ``_PASS``),
-    ``out[0] = out[1] + tau_m + tau_ff``, over the 9 joints; the same operations as
-    ``suppression.suppress`` (whose numpy ``exp`` may differ from libm's in the last bit).
-    """
-    for j in range(9):
-        m = tau_m[j]
-        if mode == _PASS:
-            eff = tau_g[j]
-        else:
-            g = abs(m) if mode == _MAGNITUDE else m
-            x = s_a[j] * (s_b[j] - g)
-            e = math.exp(-abs(x))
-            eff = tau_g[j] * (1.0 / (1.0 + e) if x >= 0 else e / (1.0 + e))
-        out[1, j] = eff
-        out[0, j] = (eff + m) + tau_ff[j]
+def pack_params(S_a: np.ndarray, S_b: np.ndarray, mode: int) -> np.ndarray:
+    """The ``params`` vector of ``suppress_output``: 9 values each of S_a and S_b, a mode."""
+    if mode not in (PASS, MAGNITUDE, SIGNED):
+        raise ValueError(f"mode must be PASS, MAGNITUDE or SIGNED ({PASS}, {MAGNITUDE}, {SIGNED}), got {mode!r}")
+    p = np.empty(N_PARAMS)
+    p[P_S_A:P_S_A + 9] = S_a
+    p[P_S_B:P_S_B + 9] = S_b
+    p[P_MODE] = mode
+    return p
 
 
 class Suppresser(Block):
@@ -49,8 +55,8 @@ class Suppresser(Block):
     which only suppresses against positive manipulation torques. ``enabled: false``
     passes tau_g through unchanged, for the paper's comparison run without suppression.
 
-    The nine joints are done in one compiled call (``suppress_kernel``);
-    ``output_reference`` is the numpy form on ``suppression.suppress``.
+    The nine joints are done in one native call (``suppress_output``); ``output_reference``
+    is the numpy form on ``suppression.suppress``.
     """
 
     type_name = "Suppresser"
@@ -73,17 +79,21 @@ class Suppresser(Block):
         self.input_defaults = {"tau_ff": np.zeros(9)}
         self.outputs = {"tau": 9, "tau_g_eff": 9}
         self.feedthrough = True
-        self._mode = (_MAGNITUDE if mode == "magnitude" else _SIGNED) if self.enabled else _PASS
+        self._params = pack_params(self.S_a, self.S_b,
+                                   (MAGNITUDE if mode == "magnitude" else SIGNED) if self.enabled else PASS)
 
     def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        tau_g, tau_m, tau_ff = inputs["tau_g"], inputs["tau_m"], inputs.get("tau_ff", self.input_defaults["tau_ff"])
-        if not (tau_g.__class__ is _ND and tau_m.__class__ is _ND and tau_ff.__class__ is _ND
-                and tau_g.dtype == _F64 and tau_m.dtype == _F64 and tau_ff.dtype == _F64
-                and tau_g.shape == (9,) and tau_m.shape == (9,) and tau_ff.shape == (9,)):
+        """One native call on the parameters packed in ``__init__`` (so S_a, S_b or the mode
+        changed on the object afterwards are not seen). Inputs the native call refuses
+        (anything but C-contiguous float64 arrays of 9 values) go through
+        ``output_reference``."""
+        out = np.empty(N_OUT)
+        try:
+            suppress_output(self._params, inputs["tau_g"], inputs["tau_m"],
+                            inputs.get("tau_ff", self.input_defaults["tau_ff"]), out)
+        except (TypeError, ValueError):
             return self.output_reference(t, state, inputs)
-        out = np.empty((2, 9))
-        suppress_kernel(tau_g, tau_m, tau_ff, self.S_a, self.S_b, self._mode, out)
-        return {"tau": out[0], "tau_g_eff": out[1]}
+        return {"tau": out[O_TAU:O_TAU + 9], "tau_g_eff": out[O_TAU_G_EFF:O_TAU_G_EFF + 9]}
 
     def output_reference(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """``output`` in numpy, on ``suppression.suppress``."""

@@ -1,8 +1,177 @@
 /* The hierarchical controller's compiled laws: grasping reflex, manipulation PD,
- * suppresser. Work in progress: the layouts below are fixed; the functions follow. */
+ * suppresser.
+ *
+ * Each law is one call over flat double arrays that the caller owns: the block's
+ * constants packed once into a parameter vector (slots HH_REFLEX_P_*, HH_MANIP_P_*,
+ * HH_SUPPRESS_P_*), the inputs of one hit, and an output vector. Nothing is allocated and
+ * nothing global changes, so a call costs microseconds and calls are independent. The
+ * finger geometry comes from an hh_model through the inline kinematics and dynamics the
+ * plant's step uses (kinematics.h, dynamics.h).
+ *
+ * Every law follows its numpy reference operation by operation (the same formulas, the
+ * same order of additions, Python's max/min/% as float_ops.h gives them), so the two
+ * agree to the last bit wherever libm does: the references are internal_forces.py
+ * (reflex), inverse_kinematics.py and trajectory.py (manipulation) and suppression.py.
+ * Numbers that Python defines (tolerances, the derivative step) arrive in the parameter
+ * vectors, so each has one definition.
+ *
+ * Failures are status codes (HH_REFLEX_*, HH_MANIP_*), never aborts.
+ */
 #ifndef HIERHAND_CONTROL_H
 #define HIERHAND_CONTROL_H
 
 #include "hand.h"
+
+/* == grasping reflex (reflex.c) =========================================================
+ *
+ * The fingers in contact (fn > threshold), and those listed in the block's 'grasp' that
+ * have not touched yet, are squeezed together by the internal force (I - G^+ G) push,
+ * each finger pushing along its contact normal (an approaching one toward the others'
+ * centroid); one integral loop scales it until every contact has the normal force it
+ * needs. */
+
+/* -- parameters: params[HH_REFLEX_P_*] -------------------------------------------------- */
+enum {
+    HH_REFLEX_P_THRESHOLD = 0, /* normal force, N, above which a finger is in contact */
+    HH_REFLEX_P_APPROACH = 1, /* force, N, of a finger approaching the others */
+    HH_REFLEX_P_KI = 2, /* integral gain, 1/s */
+    HH_REFLEX_P_DT = 3, /* period, s (not > 0: unbound, update refuses) */
+    HH_REFLEX_P_MIN_FORCE = 4, /* smallest normal force per contact, N */
+    HH_REFLEX_P_RATIO = 5, /* |f_t| / f_n the loop aims at: safety_ratio / (1 + margin) */
+    HH_REFLEX_P_MAX_FORCE = 6, /* largest force scale, N */
+    HH_REFLEX_P_INITIAL = 7, /* three: non-zero for the fingers listed in 'grasp' */
+    HH_REFLEX_P_COINCIDENT_RTOL = 10, /* points this close, relative to their size, coincide */
+    HH_REFLEX_N_PARAMS = 11
+};
+
+/* -- state: [force scale, has touched the object (3)] ------------------------------------ */
+enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_TOUCHED = 1, HH_REFLEX_N_STATE = 4 };
+
+/* -- output of hh_reflex_output: tau_g (9), |f_i| (3), in the grasp (3, 0 or 1) ---------- */
+enum { HH_REFLEX_O_TAU = 0, HH_REFLEX_O_FORCE = 9, HH_REFLEX_O_ACTIVE = 12, HH_REFLEX_N_OUT = 15 };
+
+/* -- status -------------------------------------------------------------------------------- */
+enum {
+    HH_REFLEX_OK = 0,
+    HH_REFLEX_COINCIDENT = 1, /* the squeeze is undefined: all grasp points coincide */
+    HH_REFLEX_NO_PERIOD = 2 /* update without a period (params[HH_REFLEX_P_DT] not > 0) */
+};
+
+/* Inputs of one hit, as the plant's output ports give them. */
+typedef struct hh_reflex_inputs {
+    const double *tip; /* 9: per finger tip centre x, y and link-3 angle */
+    const double *normal; /* 6: per finger the contact normal (into the object) */
+    const double *fn; /* 3: normal force per finger */
+} hh_reflex_inputs;
+
+/* The internal force per finger at unit scale, g (3 x 2: largest row length 1, zero
+ * outside the grasp or with fewer than two fingers in it), and the flags grasp and
+ * touching (0 or 1). Should the projection leave some finger not pushing
+ * (g_i . push_i <= 0), g is the centroid squeeze c - p_i. HH_REFLEX_OK or
+ * HH_REFLEX_COINCIDENT (g then incomplete). */
+int hh_reflex_directions(const double *params, const double *state, const hh_reflex_inputs *in, double g[3][2],
+                         int grasp[3], int touching[3]);
+
+/* Fingertip force commands f (3 x 2) from the directions: g_i times the state's scale for
+ * a touching finger, g_i scaled to the approach force otherwise. */
+void hh_reflex_forces(const double *params, const double *state, const double g[3][2], const int touching[3],
+                      double f[3][2]);
+
+/* out (HH_REFLEX_N_OUT): tau_g = J_i^T f_i per finger (J_i: Jacobian of finger i's tip
+ * centre at joint angles q), |f_i|, and the grasp flags. Status as
+ * hh_reflex_directions. */
+int hh_reflex_output(const hh_model *m, const double *params, const double *state, const hh_reflex_inputs *in,
+                     const double *q, double *out);
+
+/* next (HH_REFLEX_N_STATE): with two or more fingers in the grasp and touching, the scale
+ * moves by ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3), need_i =
+ * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; the touched flags
+ * latch. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
+int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
+                     double *next);
+
+/* == manipulation PD (manipulation.c) ===================================================
+ *
+ * Fingertip trajectories (timed waypoints t, x, y, phi) are sampled, turned into joint
+ * targets by exact inverse kinematics (the elbow branch nearest q0, each angle as its
+ * representative nearest q0), differentiated centrally in time for the velocity target
+ * and tracked by a joint PD; the fingers' gravity torques and the object's weight, shared
+ * by the fingers carrying it, are fed forward. */
+
+/* -- parameters: params[HH_MANIP_P_*] --------------------------------------------------- */
+enum {
+    HH_MANIP_P_Q0 = 0, /* 9: held by fingers without a trajectory; the IK's reference */
+    HH_MANIP_P_KP = 9, /* 9 joint stiffnesses */
+    HH_MANIP_P_KD = 18, /* 9 joint dampings */
+    HH_MANIP_P_GX = 27, /* gravity */
+    HH_MANIP_P_GY = 28,
+    HH_MANIP_P_WX = 29, /* the object's weight m g */
+    HH_MANIP_P_WY = 30,
+    HH_MANIP_P_THRESHOLD = 31, /* normal force above which a finger carries the object */
+    HH_MANIP_P_GRAVITY_COMP = 32, /* non-zero: feed the fingers' gravity torques forward */
+    HH_MANIP_P_LOAD_COMP = 33, /* non-zero: feed J^T of the shared weight forward */
+    HH_MANIP_P_STEP = 34, /* seconds either side of t for the velocity target */
+    HH_MANIP_P_REACH_RTOL = 35, /* wrist distances this close (relative to l1 + l2)
+                                   outside the reachable annulus count as on it */
+    HH_MANIP_N_PARAMS = 36
+};
+
+/* -- trajectories -------------------------------------------------------------------------
+ * Finger f's waypoint k is the row waypoints + (f * capacity + k) * HH_MANIP_W_COLS; its
+ * meta row meta + f * HH_MANIP_N_META holds the waypoint count (0: no trajectory, the
+ * finger holds q0) and the interpolation, both as doubles. Times strictly increase. */
+enum { HH_MANIP_W_T = 0, HH_MANIP_W_X = 1, HH_MANIP_W_Y = 2, HH_MANIP_W_PHI = 3, HH_MANIP_W_COLS = 4 };
+enum { HH_MANIP_M_COUNT = 0, HH_MANIP_M_INTERP = 1, HH_MANIP_N_META = 2 };
+enum { HH_MANIP_INTERP_LINEAR = 0, HH_MANIP_INTERP_MINJERK = 1 };
+
+typedef struct hh_trajectories {
+    const double *waypoints; /* HH_FINGERS x capacity x HH_MANIP_W_COLS */
+    const double *meta; /* HH_FINGERS x HH_MANIP_N_META */
+    long capacity; /* waypoint rows per finger */
+} hh_trajectories;
+
+/* -- output of hh_manipulation_output: rows tau_m, tau_ff, q_ref (9 each) --------------- */
+enum { HH_MANIP_O_TAU_M = 0, HH_MANIP_O_TAU_FF = 9, HH_MANIP_O_Q_REF = 18, HH_MANIP_N_OUT = 27 };
+
+/* -- status: HH_MANIP_OK, or HH_MANIP_UNREACHABLE + f when a target of finger f is out of
+ * its reach ---------------------------------------------------------------------------- */
+enum { HH_MANIP_OK = 0, HH_MANIP_UNREACHABLE = 1 };
+
+/* Joint angles q (3) of the finger with parameter row ``finger`` (hh_model.fingers[f])
+ * placing its tip centre at (x, y) with link 3 at absolute angle phi: of the two elbow
+ * branches the one nearer ref (wrapped differences, summed squares; elbow +1 on a tie),
+ * each angle as its representative nearest ref. Returns 1, or 0 when the wrist point is
+ * out of reach (q untouched). */
+int hh_ik_near(const double *finger, double reach_rtol, double x, double y, double phi, const double ref[3],
+               double q[3]);
+
+/* Pose (x, y, phi) of finger f's trajectory at time t: the first waypoint before it, the
+ * last after it, linear or minimum-jerk in between. The finger must have waypoints. */
+void hh_trajectory_sample(const hh_trajectories *tr, int f, double t, double pose[3]);
+
+/* 1 when the trajectory's analytic velocity at t (right-continuous; zero before the first
+ * and from the last waypoint on) has a non-zero component, else 0. */
+int hh_trajectory_moving(const hh_trajectories *tr, int f, double t);
+
+/* out (HH_MANIP_N_OUT) at time t, joint angles q (9), rates qd (9) and normal forces fn
+ * (3): tau_m = kp (q_ref - q) + kd (qd_ref - qd), tau_ff the gravity and load
+ * feedforward, q_ref. HH_MANIP_OK or HH_MANIP_UNREACHABLE + f (out then incomplete). */
+int hh_manipulation_output(const hh_model *m, const double *params, const hh_trajectories *tr, double t,
+                           const double *q, const double *qd, const double *fn, double *out);
+
+/* == suppresser (suppresser.c) ===========================================================
+ *
+ * tau_g_eff = tau_g * sigmoid(S_a (S_b - g(tau_m))) per joint, g = |tau_m| (magnitude) or
+ * tau_m (signed), or tau_g unchanged (pass); the command is tau_g_eff + tau_m + tau_ff. */
+
+/* -- parameters: params[HH_SUPPRESS_P_*] ------------------------------------------------ */
+enum { HH_SUPPRESS_P_S_A = 0, HH_SUPPRESS_P_S_B = 9, HH_SUPPRESS_P_MODE = 18, HH_SUPPRESS_N_PARAMS = 19 };
+enum { HH_SUPPRESS_PASS = 0, HH_SUPPRESS_MAGNITUDE = 1, HH_SUPPRESS_SIGNED = 2 }; /* params[P_MODE] */
+
+/* -- output: tau (9), tau_g_eff (9) ----------------------------------------------------- */
+enum { HH_SUPPRESS_O_TAU = 0, HH_SUPPRESS_O_TAU_G_EFF = 9, HH_SUPPRESS_N_OUT = 18 };
+
+/* out (HH_SUPPRESS_N_OUT) from the torques tau_g, tau_m, tau_ff (9 each). */
+void hh_suppress(const double *params, const double *tau_g, const double *tau_m, const double *tau_ff, double *out);
 
 #endif

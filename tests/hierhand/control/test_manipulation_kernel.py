@@ -1,4 +1,4 @@
-"""The compiled fast paths of ManipulationPD and Suppresser against their numpy references."""
+"""The native (C) fast paths of ManipulationPD and Suppresser against their numpy references."""
 
 from __future__ import annotations
 
@@ -12,8 +12,17 @@ from hierhand.control.inverse_kinematics import (
     finger_fk,
     finger_ik_near,
 )
+from hierhand.control import reflex_kernel
+from hierhand.control.grasp_reflex import GraspReflex
 from hierhand.control.manipulation_kernel import (
+    INTERP_LINEAR,
+    M_COUNT,
+    M_INTERP,
+    N_OUT,
+    OK,
+    UNREACHABLE,
     ik_near,
+    manipulation_output,
     moving,
     pack_trajectories,
     sample,
@@ -113,10 +122,10 @@ def test_ik_near_matches_finger_ik_near():
         ref_q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 1.5, 3)
         p = hand.params.fingers[f]
         target = finger_fk(p.base, p.base_angle, [link.length for link in p.links], q)
-        ok, *got = ik_near(hand.fingers, f, *target, *ref_q)
+        ok, *got = ik_near(hand.native, f, *target, *ref_q)
         assert ok
         np.testing.assert_allclose(got, finger_ik_near(hand, f, target, ref_q), rtol=1e-12, atol=1e-12)
-    ok, *_ = ik_near(hand.fingers, 1, 1.0, 1.0, 0.0, *hand.q0[3:6])
+    ok, *_ = ik_near(hand.native, 1, 1.0, 1.0, 0.0, *hand.q0[3:6])
     assert not ok
 
 
@@ -173,24 +182,101 @@ def test_unbound_plant_is_rejected_by_every_entry_point():
             call()
 
 
-def test_float64_arrays_with_a_distinct_dtype_object_take_the_compiled_path(monkeypatch):
-    """Arrays from cached numba functions carry an equal but not identical float64 dtype."""
+def test_float64_arrays_with_a_distinct_dtype_object_take_the_native_path(monkeypatch):
+    """Any C-contiguous float64 array goes straight to the native call, also one whose
+    dtype object is equal but not identical to numpy's float64 (as arrays from other
+    libraries carry); nothing is converted and no reference path is taken."""
     dtype = np.dtype(np.float64).newbyteorder("=")
     assert dtype == np.float64 and dtype is not np.dtype(np.float64)
     hand = Hand.default()
 
     def refuse(*args, **kwargs):
-        raise AssertionError("reference path taken")
+        raise AssertionError("conversion or reference path taken")
 
     pd = ManipulationPD(trajectories=REGRASP)
     s = Suppresser()
+    reflex = GraspReflex()
+    reflex.bind(0.001)
     monkeypatch.setattr(pd, "output_reference", refuse)
     monkeypatch.setattr(s, "output_reference", refuse)
+    monkeypatch.setattr(reflex_kernel, "_f64", refuse)
     pd.output(0.2, None, {"q": hand.q0.astype(dtype), "qd": np.zeros(9, dtype), "fn": np.zeros(3, dtype)})
     s.output(0.0, None, {"tau_g": np.ones(9, dtype), "tau_m": np.zeros(9, dtype)})
+    reflex_inputs = {"q": hand.q0.astype(dtype), "tip": hand.tip_poses(hand.q0).ravel().astype(dtype),
+                     "normal": np.zeros(6, dtype), "fn": np.array([1.0, 1.0, 0.0], dtype),
+                     "ft": np.zeros(3, dtype)}
+    reflex.output(0.0, reflex.initial_state().astype(dtype), reflex_inputs)
+    reflex.update(0.0, reflex.initial_state().astype(dtype), reflex_inputs)
     plant = HandPlant()
     plant.bind(1e-4)
     state = plant.initial_state().astype(dtype)
     monkeypatch.setattr(plant, "_check_state", refuse)
-    monkeypatch.setattr(plant, "_inputs", refuse)
+    monkeypatch.setattr(plant, "_arguments", refuse)
     plant.advance(0.0, state, {"tau": np.zeros(9, dtype), "f_ext": np.zeros(3, dtype)}, 2)
+
+
+def test_other_arrays_are_converted_or_take_the_reference_path():
+    """Strided views, other dtypes and lists give what their float64 copies give."""
+    hand = Hand.default()
+    pd = ManipulationPD(trajectories=REGRASP)
+    s = Suppresser(S_a=50.0, S_b=0.2)
+    reflex = GraspReflex()
+    reflex.bind(0.001)
+    rng = np.random.default_rng(11)
+    wide = rng.normal(size=(9, 2))
+    q = hand.q0 + 0.05 * wide[:, 0]
+    manip = {"q": q, "qd": wide[:, 1].copy(), "fn": np.array([0.0, 2.0, 2.0])}
+    strided = {"q": np.column_stack([q, q])[:, 0], "qd": wide[:, 1], "fn": np.array([0, 2, 2])}
+    assert not strided["q"].flags.c_contiguous
+    for port, value in pd.output(0.2, None, strided).items():
+        np.testing.assert_allclose(value, pd.output(0.2, None, manip)[port], rtol=1e-12, atol=1e-15)
+    torques = {"tau_g": wide[:, 0], "tau_m": wide[:, 1].astype(np.float32)}
+    expected = s.output(0.0, None, {k: np.array(v, dtype=float) for k, v in torques.items()})
+    for port, value in s.output(0.0, None, torques).items():
+        np.testing.assert_allclose(value, expected[port], rtol=1e-14)
+    tip = hand.tip_poses(q)
+    normal = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0]])
+    exact = {"q": q, "tip": tip.ravel(), "normal": normal.ravel(), "fn": np.array([1.0, 1.0, 0.0]),
+             "ft": np.array([0.1, 0.2, 0.0])}
+    loose = {"q": list(q), "tip": tip, "normal": normal.T.copy().T, "fn": np.array([1, 1, 0]),
+             "ft": np.array([0.1, 0.2, 0.0], dtype=np.float32)}
+    state = np.array([2.0, 1.0, 1.0, 0.0])
+    for port, value in reflex.output(0.0, state, loose).items():
+        np.testing.assert_array_equal(value, reflex.output(0.0, state, exact)[port])
+    np.testing.assert_allclose(reflex.update(0.0, list(state), loose), reflex.update(0.0, state, exact), rtol=1e-7)
+
+
+def test_native_output_reports_the_unreachable_finger():
+    """The status names the finger (UNREACHABLE + f) whose target, or a neighbour a
+    derivative step away, is out of reach; ``output`` then raises from the reference."""
+    hand = Hand.default()
+    pd = ManipulationPD(trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
+                                                             [1.0, 0.035, -0.038, math.pi / 2]]}})
+    inputs = (hand.q0, np.zeros(9), np.zeros(3))
+    out = np.empty((3, 9))
+    assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, out) == OK
+    assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.5, *inputs, out) == UNREACHABLE + 1
+    with pytest.raises(ValueError, match="out must hold 27 values"):
+        manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, np.empty(N_OUT - 1))
+
+
+def test_trajectory_arrays_are_checked():
+    waypoints, meta = pack_trajectories([None, Trajectory([[0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0]]), None])
+    assert meta.dtype == np.float64 and meta[1, M_COUNT] == 2 and meta[1, M_INTERP] != INTERP_LINEAR
+    with pytest.raises(ValueError, match="finger 0 has no trajectory"):
+        sample(waypoints, meta, 0, 0.5)
+    with pytest.raises(ValueError, match="finger must be 0, 1 or 2"):
+        moving(waypoints, meta, 3, 0.5)
+    for bad in (2.5, 3.0, -1.0, np.nan):
+        wrong = meta.copy()
+        wrong[1, M_COUNT] = bad
+        with pytest.raises(ValueError, match="waypoint count"):
+            sample(waypoints, wrong, 1, 0.5)
+    wrong = meta.copy()
+    wrong[1, M_INTERP] = 7
+    with pytest.raises(ValueError, match="interpolation"):
+        moving(waypoints, wrong, 1, 0.5)
+    with pytest.raises(ValueError, match="3 x n x 4"):
+        sample(waypoints.ravel()[:-1].copy(), meta, 1, 0.5)
+    with pytest.raises(TypeError, match="float64"):
+        sample(waypoints, meta.astype(np.int64), 1, 0.5)

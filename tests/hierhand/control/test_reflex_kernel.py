@@ -1,4 +1,4 @@
-"""The reflex's compiled kernels against the numpy reference (``internal_forces``).
+"""The reflex's native (C) law against the numpy reference (``internal_forces``).
 
 ``reference_*`` below are the reflex's numpy formulation (``project_internal`` with
 ``numpy.linalg.pinv``, ``internal_directions`` as the fallback, ``Hand.tip_jacobians``);
@@ -13,7 +13,22 @@ import pytest
 
 from hierhand.control.grasp_reflex import GraspReflex
 from hierhand.control.internal_forces import internal_directions, project_internal
-from hierhand.control.reflex_kernel import reflex_directions
+from hierhand.control.reflex_kernel import (
+    N_PARAMS,
+    P_APPROACH,
+    P_COINCIDENT_RTOL,
+    P_DT,
+    P_INITIAL,
+    P_KI,
+    P_MAX_FORCE,
+    P_MIN_FORCE,
+    P_RATIO,
+    P_THRESHOLD,
+    pack_params,
+    reflex_directions,
+    reflex_output,
+    reflex_update,
+)
 
 
 def reference_directions(reflex, state, tip, normal, fn):
@@ -185,3 +200,60 @@ def test_kernel_takes_the_packed_parameters():
     assert g.shape == (3, 2) and grasp.dtype == np.bool_ and touching.dtype == np.bool_
     with pytest.raises(ValueError, match="'tip' must have 9 entries"):
         reflex_directions(reflex._params, state, inputs["tip"][:6], inputs["normal"], inputs["fn"])
+
+
+def test_coincident_points_are_an_error_of_every_entry_point():
+    """The C law's status for coincident points becomes the reference's ValueError in
+    output and update too, not only in directions."""
+    reflex = make_reflex(["thumb", "fore"])
+    state = np.array([2.0, 1.0, 1.0, 0.0])
+    tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
+    inputs = {"q": reflex.hand.q0, "tip": tip, "normal": np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
+              "fn": np.array([2.0, 2.0, 0.0]), "ft": np.zeros(3)}
+    message = "^internal forces are undefined: all contact points coincide$"
+    with pytest.raises(ValueError, match=message):
+        reflex.forces(state, inputs)
+    with pytest.raises(ValueError, match=message):
+        reflex.output(0.0, state, inputs)
+    with pytest.raises(ValueError, match=message):
+        reflex.update(0.0, state, inputs)
+
+
+def test_the_period_is_checked_before_the_directions():
+    """An unbound reflex's update names the missing period even where the directions
+    would fail, as the numba kernel did; output needs no period."""
+    reflex = GraspReflex()
+    state = np.array([2.0, 1.0, 1.0, 0.0])
+    tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
+    normal, fn, ft = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0]), np.array([2.0, 2.0, 0.0]), np.zeros(3)
+    with pytest.raises(ValueError, match=r"^GraspReflex needs an explicit period \(the paper's is 1 ms\)$"):
+        reflex_update(reflex._params, state, tip, normal, fn, ft)
+    with pytest.raises(ValueError, match="all contact points coincide"):
+        reflex_output(reflex.hand.native, reflex._params, state, reflex.hand.q0, tip, normal, fn)
+
+
+@pytest.mark.parametrize("port, width", [("tip", 9), ("normal", 6), ("fn", 3), ("q", 9), ("ft", 3)])
+def test_input_widths_are_checked_naming_the_port(port, width):
+    reflex = make_reflex(["thumb", "fore"])
+    state, inputs = random_case(np.random.default_rng(9), reflex, 2, inward=True)
+    inputs[port] = np.zeros(width + 1)
+    call = reflex.update if port == "ft" else reflex.output
+    with pytest.raises(ValueError, match=f"^GraspReflex: input '{port}' must have {width} entries$"):
+        call(0.0, state, inputs)
+    inputs[port] = [0.0] * (width - 1)  # converted first, then refused for its width
+    with pytest.raises(ValueError, match=f"^GraspReflex: input '{port}' must have {width} entries$"):
+        call(0.0, state, inputs)
+    with pytest.raises(ValueError, match=r"state must have 4 entries \[scale, touched\(3\)\]"):
+        reflex.update(0.0, np.zeros(3), random_case(np.random.default_rng(9), reflex, 2, inward=True)[1])
+
+
+def test_packed_parameters_keep_their_slots():
+    """The numba kernels' slots, now defined in control.h, plus the coincidence tolerance
+    that internal_forces defines."""
+    from hierhand.control.internal_forces import _COINCIDENT_RTOL
+
+    assert (P_THRESHOLD, P_APPROACH, P_KI, P_DT, P_MIN_FORCE, P_RATIO, P_MAX_FORCE, P_INITIAL) == tuple(range(8))
+    assert (P_COINCIDENT_RTOL, N_PARAMS) == (10, 11)
+    p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True])
+    assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL
+    assert p[P_INITIAL:P_INITIAL + 3].tolist() == [1.0, 0.0, 1.0] and p[P_KI] == 50.0

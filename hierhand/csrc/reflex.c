@@ -1,0 +1,219 @@
+/* The grasping reflex's law (GraspReflex): directions, forces, output, update.
+ *
+ * The reflex runs every millisecond, so a hit does the grasp matrix solve by hand rather
+ * than through a pseudo-inverse. The internal force among the k fingers of the grasp (2
+ * or 3) is (I - G^+ G) push, with G the 3 x 2k grasp matrix about the grasp points'
+ * centroid c (columns [I2; (-r_iy, r_ix)], r_i = p_i - c). G has full row rank unless all
+ * points coincide, so G^+ G push = G^T x with (G G^T) x = G push, and
+ * G G^T = [[k, 0, a], [0, k, b], [a, b, s]] (a = -sum r_iy, b = sum r_ix, both round-off
+ * about the centroid, s = sum |r_i|^2) is solved by eliminating the two k pivots first.
+ * When the moment row is numerically dependent (Schur complement at or below
+ * numpy.linalg.pinv's cut-off) the moment equation is dropped, as pinv does.
+ *
+ * internal_forces.py is the numpy reference (project_internal, internal_directions);
+ * the tip Jacobians are the plant's (kinematics.h).
+ */
+#include <float.h>
+#include <math.h>
+
+#include "control.h"
+#include "float_ops.h"
+#include "kinematics.h"
+
+/* numpy.linalg.pinv's rcond (1e-15 on the singular values of G) squared: the cut-off on
+ * the eigenvalues of G G^T. */
+static const double PINV_RCOND_SQUARED = 1e-30;
+/* Shortest distance toward the others' centroid that an approaching finger normalises. */
+static const double SHORTEST_APPROACH = 1e-12;
+/* Smallest normal force per unit scale the update divides by. */
+static const double SMALLEST_GAIN = 1e-3;
+/* Shortest direction an approaching finger's force is scaled up from. */
+static const double SHORTEST_DIRECTION = 1e-300;
+
+/* Unit push of a finger approaching the others: toward their centroid. */
+static void approach_push(const double *tip, const int grasp[3], int i, double push[2])
+{
+    double sx = 0.0;
+    double sy = 0.0;
+    int m = 0;
+    for (int j = 0; j < 3; j++)
+        if (j != i && grasp[j]) {
+            sx += tip[3 * j];
+            sy += tip[3 * j + 1];
+            m += 1;
+        }
+    double tx = sx / m - tip[3 * i];
+    double ty = sy / m - tip[3 * i + 1];
+    double d = hh_max(sqrt(tx * tx + ty * ty), SHORTEST_APPROACH);
+    push[0] = tx / d;
+    push[1] = ty / d;
+}
+
+/* g_i = c - p_i over the grasp, divided by its longest row; HH_REFLEX_COINCIDENT when
+ * that is round-off of the points' size. */
+static int centroid_squeeze(const double *params, const double *tip, const int grasp[3], double cx, double cy,
+                            double g[3][2])
+{
+    double spread = 0.0;
+    double size = 0.0;
+    for (int i = 0; i < 3; i++)
+        if (grasp[i]) {
+            g[i][0] = cx - tip[3 * i];
+            g[i][1] = cy - tip[3 * i + 1];
+            spread = hh_max(spread, hypot(g[i][0], g[i][1]));
+            size = hh_max(hh_max(size, fabs(tip[3 * i])), fabs(tip[3 * i + 1]));
+        }
+    if (spread <= params[HH_REFLEX_P_COINCIDENT_RTOL] * hh_max(size, DBL_MIN))
+        return HH_REFLEX_COINCIDENT;
+    for (int i = 0; i < 3; i++) {
+        g[i][0] /= spread;
+        g[i][1] /= spread;
+    }
+    return HH_REFLEX_OK;
+}
+
+int hh_reflex_directions(const double *params, const double *state, const hh_reflex_inputs *in, double g[3][2],
+                         int grasp[3], int touching[3])
+{
+    const double *tip = in->tip;
+    double threshold = params[HH_REFLEX_P_THRESHOLD];
+    int k = 0;
+    for (int i = 0; i < 3; i++) {
+        touching[i] = in->fn[i] > threshold;
+        int approaching =
+            params[HH_REFLEX_P_INITIAL + i] != 0.0 && state[HH_REFLEX_S_TOUCHED + i] == 0.0 && !touching[i];
+        grasp[i] = touching[i] || approaching;
+        g[i][0] = 0.0;
+        g[i][1] = 0.0;
+        if (grasp[i])
+            k += 1;
+    }
+    if (k < 2)
+        return HH_REFLEX_OK;
+    /* push directions: the contact normal, or toward the others' centroid while approaching */
+    double push[3][2];
+    for (int i = 0; i < 3; i++) {
+        if (!grasp[i])
+            continue;
+        if (touching[i]) {
+            push[i][0] = in->normal[2 * i];
+            push[i][1] = in->normal[2 * i + 1];
+        } else {
+            approach_push(tip, grasp, i, push[i]);
+        }
+    }
+    /* centroid of the grasp points */
+    double cx = 0.0;
+    double cy = 0.0;
+    for (int i = 0; i < 3; i++)
+        if (grasp[i]) {
+            cx += tip[3 * i];
+            cy += tip[3 * i + 1];
+        }
+    cx /= k;
+    cy /= k;
+    /* w = G push, and G G^T = [[k, 0, a], [0, k, b], [a, b, s]] */
+    double w0 = 0.0, w1 = 0.0, w2 = 0.0;
+    double a = 0.0, b = 0.0, s = 0.0;
+    for (int i = 0; i < 3; i++)
+        if (grasp[i]) {
+            double rx = tip[3 * i] - cx;
+            double ry = tip[3 * i + 1] - cy;
+            w0 += push[i][0];
+            w1 += push[i][1];
+            w2 += rx * push[i][1] - ry * push[i][0];
+            a -= ry;
+            b += rx;
+            s += rx * rx + ry * ry;
+        }
+    double fk = (double)k;
+    double schur = s - (a * a + b * b) / fk;
+    /* all points coinciding leave the moment row empty: pinv drops it */
+    double x2 = schur > PINV_RCOND_SQUARED * hh_max(fk, s) ? (w2 - (a * w0 + b * w1) / fk) / schur : 0.0;
+    double x0 = (w0 - a * x2) / fk;
+    double x1 = (w1 - b * x2) / fk;
+    /* internal = push - G^T x; the centroid squeeze instead if a finger would not push */
+    int pushing = 1;
+    for (int i = 0; i < 3; i++)
+        if (grasp[i]) {
+            double rx = tip[3 * i] - cx;
+            double ry = tip[3 * i + 1] - cy;
+            g[i][0] = push[i][0] - (x0 - ry * x2);
+            g[i][1] = push[i][1] - (x1 + rx * x2);
+            if (g[i][0] * push[i][0] + g[i][1] * push[i][1] <= 0.0)
+                pushing = 0;
+        }
+    if (!pushing && centroid_squeeze(params, tip, grasp, cx, cy, g) != HH_REFLEX_OK)
+        return HH_REFLEX_COINCIDENT;
+    double longest = 0.0;
+    for (int i = 0; i < 3; i++)
+        longest = hh_max(longest, sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]));
+    for (int i = 0; i < 3; i++) {
+        g[i][0] /= longest;
+        g[i][1] /= longest;
+    }
+    return HH_REFLEX_OK;
+}
+
+void hh_reflex_forces(const double *params, const double *state, const double g[3][2], const int touching[3],
+                      double f[3][2])
+{
+    for (int i = 0; i < 3; i++) {
+        double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
+        double scale = touching[i] ? state[HH_REFLEX_S_SCALE]
+                                   : params[HH_REFLEX_P_APPROACH] / hh_max(length, SHORTEST_DIRECTION);
+        f[i][0] = g[i][0] * scale;
+        f[i][1] = g[i][1] * scale;
+    }
+}
+
+int hh_reflex_output(const hh_model *m, const double *params, const double *state, const hh_reflex_inputs *in,
+                     const double *q, double *out)
+{
+    double g[3][2], f[3][2];
+    int grasp[3], touching[3];
+    int code = hh_reflex_directions(params, state, in, g, grasp, touching);
+    if (code != HH_REFLEX_OK)
+        return code;
+    hh_reflex_forces(params, state, (const double(*)[2])g, touching, f);
+    for (int i = 0; i < 3; i++) {
+        double u[3][2], pts[4][2], jac[2][3];
+        hh_finger_frames(m->fingers[i], q + 3 * i, u, pts);
+        hh_finger_point_jacobian((const double(*)[2])pts, pts[3][0], pts[3][1], jac);
+        for (int j = 0; j < 3; j++)
+            out[HH_REFLEX_O_TAU + 3 * i + j] = jac[0][j] * f[i][0] + jac[1][j] * f[i][1];
+        out[HH_REFLEX_O_FORCE + i] = sqrt(f[i][0] * f[i][0] + f[i][1] * f[i][1]);
+        out[HH_REFLEX_O_ACTIVE + i] = grasp[i] ? 1.0 : 0.0;
+    }
+    return HH_REFLEX_OK;
+}
+
+int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
+                     double *next)
+{
+    double dt = params[HH_REFLEX_P_DT];
+    if (!(dt > 0.0))
+        return HH_REFLEX_NO_PERIOD;
+    double g[3][2];
+    int grasp[3], touching[3];
+    int code = hh_reflex_directions(params, state, in, g, grasp, touching);
+    if (code != HH_REFLEX_OK)
+        return code;
+    double scale = state[HH_REFLEX_S_SCALE];
+    int held = 0;
+    double shortfall = -INFINITY;
+    for (int i = 0; i < 3; i++)
+        if (grasp[i] && touching[i]) {
+            held += 1;
+            double gain = g[i][0] * in->normal[2 * i] + g[i][1] * in->normal[2 * i + 1]; /* per unit scale */
+            double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
+            double need = hh_max(params[HH_REFLEX_P_MIN_FORCE] * length, fabs(ft[i]) / params[HH_REFLEX_P_RATIO]);
+            shortfall = hh_max(shortfall, (need - in->fn[i]) / hh_max(gain, SMALLEST_GAIN));
+        }
+    if (held >= 2)
+        scale = hh_min(hh_max(scale + params[HH_REFLEX_P_KI] * dt * shortfall, 0.0), params[HH_REFLEX_P_MAX_FORCE]);
+    next[HH_REFLEX_S_SCALE] = scale;
+    for (int i = 0; i < 3; i++)
+        next[HH_REFLEX_S_TOUCHED + i] = hh_max(state[HH_REFLEX_S_TOUCHED + i], touching[i] ? 1.0 : 0.0);
+    return HH_REFLEX_OK;
+}
