@@ -14,7 +14,8 @@ CSRC = "hierhand/csrc"
 
 CORE = ["hand_params.c", "contact.c", "plant.c"]
 CORE_HEADERS = ["hand.h", "kinematics.h", "dynamics.h", "contact.h"]
-CONTROL: list[str] = []  # TEMPORARY until the controllers land
+CONTROL = ["reflex.c", "manipulation.c", "suppresser.c"]
+CONTROL_HEADERS = ["control.h", "float_ops.h"]
 BINDING = ["python/module.c", "python/py_common.c", "python/py_model.c", "python/py_plant.c", "python/py_control.c"]
 FMU_COMMON = ["fmu_instance.c"]
 FMU_HEADERS = ["fmu_instance.h"]
