@@ -4,8 +4,7 @@ The grid is suppress.S_b over 4 values times suppress.S_a over 4 values, metric
 separation_time, run from empty folders: serially in this process, then on the default
 LocalCluster (one single-threaded worker process per core). Reports both wall times and
 the speed-up for the whole sweep (cluster start, worker set-up and shutdown included) and
-for the run phase alone (from the first submitted point to the last recorded row), plus
-the numba cache misses on the workers over the sweep (0: nothing was recompiled).
+for the run phase alone (from the first submitted point to the last recorded row).
 
 As a reference it also runs the same points on a bare process pool forked from this
 process (multiprocessing, no Dask, no CSV): the most that 2 processes get out of this
@@ -53,7 +52,6 @@ class Timings:
     pool: list[float] = field(default_factory=list)
     failed: int = 0
     workers: int = 0
-    cache_misses: int = 0
 
 
 def pool_sweep(plan: SweepPlan, workers: int) -> float:
@@ -81,7 +79,7 @@ def measure(plan: SweepPlan, workers: int | None, repeat: int, tmp: Path) -> Tim
         if can_fork:
             timings.pool.append(pool_sweep(plan, dask.workers))
         timings.failed += failed_serial + failed_dask
-        timings.workers, timings.cache_misses = dask.workers, timings.cache_misses + dask.worker_cache_misses
+        timings.workers = dask.workers
     return timings
 
 
@@ -95,7 +93,7 @@ def report(t_end: str, timings: Timings) -> None:
           f"{med(timings.dask_startup):.3f} s, runs {med(timings.dask_runs):.3f} s)")
     if timings.pool:
         print(f"  forked process pool, no Dask:  {med(timings.pool):7.3f} s  (reference: the machine's ceiling)")
-    print(f"  failed runs: {timings.failed}; worker numba cache misses: {timings.cache_misses}")
+    print(f"  failed runs: {timings.failed}")
     print(f"  speed-up, whole sweep:         {speedup:7.2f}x  "
           f"(target >= {TARGET}x: {'met' if speedup >= TARGET else 'NOT met'})")
     print(f"  speed-up, run phase:           {med(timings.serial_runs) / med(timings.dask_runs):7.2f}x")

@@ -409,7 +409,7 @@ class _Run:
 def package_versions() -> dict[str, str]:
     """Versions of Python and the packages that shape a run's numbers."""
     versions = {"python": platform.python_version()}
-    for dist in ("hierhand", "numpy", "networkx", "control", "numba", "fmpy"):
+    for dist in ("hierhand", "numpy", "networkx", "control", "fmpy"):
         try:
             versions[dist] = metadata.version(dist)
         except metadata.PackageNotFoundError:

@@ -9,11 +9,9 @@ waited on that worker. So the points of a lost task are run again one at a time,
 nothing else in flight, and only a point that is lost even then is recorded as failed:
 the point that kills its worker, not its neighbours.
 
-The compiled numba kernels are never compiled per task: ``warm_up`` has loaded them in
-this process before the cluster starts, LocalCluster workers are forked from it where
-the platform can fork (``start_method``) and so start with them loaded, and spawned or
-remote workers load them from the on-disk cache once, at their first point. The report
-counts the workers' cache misses over the sweep (0: nothing was compiled).
+``warm_up`` has run the diagram briefly in this process before the cluster starts
+(modules imported, FMUs unpacked), and LocalCluster workers are forked from it where the
+platform can fork (``start_method``), so they start with all of that done.
 """
 
 from __future__ import annotations
@@ -31,7 +29,7 @@ from typing import Any
 from .chunks import ChunkSizer
 from .errors import SweepError
 from .points import Point
-from .runner import Outcome, Record, SweepJob, SweepReport, default_workers, numba_cache_stats, one_line, run_points
+from .runner import Outcome, Record, SweepJob, SweepReport, default_workers, one_line, run_points
 from .store import FAILED, OK
 
 WORKER_WAIT_S = 30.0
@@ -52,10 +50,10 @@ every 10 s re-grasp run took about 5 % longer on 2 cores."""
 def start_method() -> str:
     """How LocalCluster starts its worker processes: forked where the platform can fork.
 
-    A forked worker starts with this process's modules imported and the kernels already
-    loaded by ``warm_up``: about 0.1 s for two workers here, against over a second for
-    spawned ones that import everything and load the numba cache again, which is longer
-    than a whole sweep of short runs. ``HIERHAND_SWEEP_START`` (fork, spawn, forkserver)
+    A forked worker starts with this process's modules imported and the diagram already
+    run once by ``warm_up``: about 0.1 s for two workers here, against about a second for
+    spawned ones that import everything again, which is longer than a whole sweep of
+    short runs. ``HIERHAND_SWEEP_START`` (fork, spawn, forkserver)
     overrides the choice.
     """
     import multiprocessing
@@ -108,11 +106,10 @@ def _local_cluster(workers: int | None):
 
     from .worker_plugin import IgnoreCtrlC
 
-    env = {"NUMBA_CACHE_DIR": os.environ["NUMBA_CACHE_DIR"]} if os.environ.get("NUMBA_CACHE_DIR") else {}
     settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method()}
     with dask.config.set(settings), _children_ignore_ctrl_c():
         return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
-                            host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL, env=env,
+                            host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL,
                             plugins={IgnoreCtrlC()})
 
 
@@ -136,9 +133,9 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
         else:
             cluster = _local_cluster(workers)
             client = Client(cluster)
-        stats_before = client.run(numba_cache_stats)
-        threads = sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
-        report.workers = len(stats_before)
+        workers_info = client.scheduler_info()["workers"]
+        threads = sum(w["nthreads"] for w in workers_info.values())
+        report.workers = len(workers_info)
         report.startup_s = time.perf_counter() - t0
 
         sizer = ChunkSizer(threads)
@@ -181,9 +178,6 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
                 report.failed += outcome.status != OK
             top_up()
         report.run_s = time.perf_counter() - t0 - report.startup_s
-        stats_after = client.run(numba_cache_stats)
-        report.worker_cache_misses = sum(misses - stats_before.get(worker, (0, 0))[1]
-                                         for worker, (_, misses) in stats_after.items())
     finally:
         if client is not None:
             if in_flight:

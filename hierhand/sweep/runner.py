@@ -4,15 +4,14 @@
 metrics. It never raises for a bad point: an invalid value, a block failure or incomplete
 results come back as a failed outcome with a one-line error, so one bad point cannot stop
 the sweep. Only Ctrl-C stops it: an interrupted run is not a result and is left to be run
-again. ``warm_up`` runs the diagram briefly first, so the numba kernels are compiled (or
-loaded from the on-disk cache) once, before any point is timed. The Dask execution is in
-``cluster``.
+again. ``warm_up`` runs the diagram briefly first, so that imports and one-time set-up
+(an FMU's unpacking, a block's first call) happen once, before any point is timed. The
+Dask execution is in ``cluster``.
 """
 
 from __future__ import annotations
 
 import os
-import sys
 import time
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -56,7 +55,6 @@ class SweepReport:
     startup_s: float = 0.0
     run_s: float = 0.0
     workers: int = 0
-    worker_cache_misses: int = 0
 
 
 def one_line(text: str) -> str:
@@ -87,26 +85,6 @@ def run_point(job: SweepJob, point: Point) -> Outcome:
 def run_points(job: SweepJob, points: list[Point]) -> list[Outcome]:
     """Run several points one after the other: the work of one Dask task."""
     return [run_point(job, point) for point in points]
-
-
-def numba_cache_stats() -> tuple[int, int]:
-    """(hits, misses) of the on-disk cache over the numba functions of blocks and hierhand loaded here."""
-    try:
-        from numba.core.dispatcher import Dispatcher
-    except ImportError:
-        return 0, 0
-    hits = misses = 0
-    seen: set[int] = set()
-    for name, module in list(sys.modules.items()):
-        if not (name.startswith("hierhand.") or name.startswith("blocks.")) or module is None:
-            continue
-        for value in list(vars(module).values()):
-            if isinstance(value, Dispatcher) and id(value) not in seen:
-                seen.add(id(value))
-                stats = value.stats
-                hits += sum(stats.cache_hits.values())
-                misses += sum(stats.cache_misses.values())
-    return hits, misses
 
 
 def warm_up(job: SweepJob, point: Point) -> None:
