@@ -22,9 +22,12 @@ ROOT = Path(__file__).resolve().parent
 sys.path.insert(0, str(ROOT / "hierhand"))
 from native_sources import (  # noqa: E402 - the source lists live in the package, for the exporter
     CFLAGS,
+    EXTENSION_DEPENDS,
     EXTENSION_SOURCES,
+    FMI_DEPENDS,
     FMI_LIBRARIES,
     fmi_headers,
+    sources_digest,
 )
 
 sys.path.pop(0)
@@ -47,6 +50,7 @@ class BuildNative(build_ext):
             sources,
             output_dir=os.path.join(self.build_temp, f"fmi{fmi}"),
             include_dirs=[fmi_headers()],
+            depends=FMI_DEPENDS,
             extra_postargs=CFLAGS + ["-std=c99", "-g0"],  # no debug info in what FMUs carry
         )
         for target in targets:
@@ -65,6 +69,8 @@ setup(
         Extension(
             "hierhand._native",
             sources=EXTENSION_SOURCES,
+            depends=EXTENSION_DEPENDS,
+            define_macros=[("HH_SOURCES_DIGEST", f'"{sources_digest(ROOT)}"')],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         )

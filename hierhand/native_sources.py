@@ -7,6 +7,7 @@ repository root (``CSRC``); the exporter copies ``FMU_SOURCES`` flat into ``sour
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
 from pathlib import Path
 
@@ -30,7 +31,10 @@ def _paths(names: list[str]) -> list[str]:
 
 
 EXTENSION_SOURCES = _paths(CORE + CONTROL + BINDING)
+EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + ["python/py_common.h"])
+"""Headers whose change must rebuild the extension."""
 FMI_LIBRARIES = {fmi: _paths(CORE + FMU_COMMON + [wrapper]) for fmi, wrapper in FMI_WRAPPERS.items()}
+FMI_DEPENDS = _paths(CORE_HEADERS + FMU_HEADERS)
 
 
 def fmu_source_files(fmi: int) -> list[str]:
@@ -52,3 +56,14 @@ def fmi_headers() -> str:
     if not (folder / "fmi2Functions.h").is_file() or not (folder / "fmi3Functions.h").is_file():
         raise RuntimeError(f"fmpy's FMI headers are missing from {folder}")
     return str(folder)
+
+
+def sources_digest(root: Path) -> str:
+    """The hash of every C source and header under ``root / CSRC``: the build stamps it into
+    the extension, so that a checkout whose C sources changed since the build says so."""
+    folder = Path(root) / CSRC
+    h = hashlib.sha256()
+    for path in sorted(folder.rglob("*")):
+        if path.suffix in (".c", ".h"):
+            h.update(path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
+    return h.hexdigest()

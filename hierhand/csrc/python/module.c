@@ -3,11 +3,16 @@
  * Functions take a Model (a packed hand) and float64 arrays that the caller allocates;
  * they return status codes (HH_OK, HH_ERR_*) that the Python side turns into messages.
  * LAYOUT names every slot of the flat arrays (the enums of hand.h and control.h), so that
- * Python reads the layout from the one place it is defined.
+ * Python reads the layout from the one place it is defined. SOURCES_DIGEST is the hash
+ * of the C sources it was built from.
  */
 #include "py_common.h"
 
 #include "../control.h"
+
+#ifndef HH_SOURCES_DIGEST
+#define HH_SOURCES_DIGEST "unknown" /* setup.py stamps the hash of hierhand/csrc */
+#endif
 
 #define LAYOUT_ENTRY(name) {#name, name}
 
@@ -93,6 +98,10 @@ PyMODINIT_FUNC PyInit__native(void)
     if (layout == NULL || add_layout(layout, PLANT_LAYOUT) != 0 || hh_py_control_layout(layout) != 0 ||
         PyModule_AddObject(module, "LAYOUT", layout) != 0) {
         Py_XDECREF(layout);
+        Py_DECREF(module);
+        return NULL;
+    }
+    if (PyModule_AddStringConstant(module, "SOURCES_DIGEST", HH_SOURCES_DIGEST) != 0) {
         Py_DECREF(module);
         return NULL;
     }
