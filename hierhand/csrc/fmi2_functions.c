@@ -230,8 +230,6 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     INSTANCE_OR_ERROR(c);
-    if (FMUstate == NULL)
-        return fmi2Error;
     return (fmi2Status)hh_instance_get_state(inst, (hh_snapshot **)FMUstate);
 }
 
@@ -244,27 +242,18 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     (void)c;
-    if (FMUstate != NULL) {
-        hh_snapshot_free((hh_snapshot *)*FMUstate);
-        *FMUstate = NULL;
-    }
-    return fmi2OK;
+    return (fmi2Status)hh_snapshot_free((hh_snapshot **)FMUstate);
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
 {
     INSTANCE_OR_ERROR(c);
-    if (FMUstate == NULL || size == NULL)
-        return fmi2Error;
-    *size = hh_snapshot_size((const hh_snapshot *)FMUstate);
-    return fmi2OK;
+    return (fmi2Status)hh_snapshot_size(inst, (const hh_snapshot *)FMUstate, size);
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
 {
     INSTANCE_OR_ERROR(c);
-    if (FMUstate == NULL)
-        return fmi2Error;
     return (fmi2Status)hh_snapshot_serialize(inst, (const hh_snapshot *)FMUstate, (unsigned char *)serializedState,
                                              size);
 }
@@ -273,8 +262,6 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
                                    fmi2FMUstate *FMUstate)
 {
     INSTANCE_OR_ERROR(c);
-    if (FMUstate == NULL)
-        return fmi2Error;
     return (fmi2Status)hh_snapshot_deserialize(inst, (const unsigned char *)serializedState, size,
                                                (hh_snapshot **)FMUstate);
 }

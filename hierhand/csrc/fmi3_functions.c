@@ -319,8 +319,6 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     INSTANCE_OR_ERROR(instance);
-    if (FMUState == NULL)
-        return fmi3Error;
     return (fmi3Status)hh_instance_get_state(inst, (hh_snapshot **)FMUState);
 }
 
@@ -333,28 +331,18 @@ fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     (void)instance;
-    if (FMUState != NULL) {
-        hh_snapshot_free((hh_snapshot *)*FMUState);
-        *FMUState = NULL;
-    }
-    return fmi3OK;
+    return (fmi3Status)hh_snapshot_free((hh_snapshot **)FMUState);
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size)
 {
     INSTANCE_OR_ERROR(instance);
-    if (FMUState == NULL || size == NULL)
-        return fmi3Error;
-    *size = hh_snapshot_size((const hh_snapshot *)FMUState);
-    return fmi3OK;
+    return (fmi3Status)hh_snapshot_size(inst, (const hh_snapshot *)FMUState, size);
 }
 
-fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[],
-                                 size_t size)
+fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size)
 {
     INSTANCE_OR_ERROR(instance);
-    if (FMUState == NULL)
-        return fmi3Error;
     return (fmi3Status)hh_snapshot_serialize(inst, (const hh_snapshot *)FMUState, (unsigned char *)serializedState,
                                              size);
 }
@@ -363,8 +351,6 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
                                    fmi3FMUState *FMUState)
 {
     INSTANCE_OR_ERROR(instance);
-    if (FMUState == NULL)
-        return fmi3Error;
     return (fmi3Status)hh_snapshot_deserialize(inst, (const unsigned char *)serializedState, size,
                                                (hh_snapshot **)FMUState);
 }

@@ -472,13 +472,20 @@ struct hh_snapshot {
     double state[]; /* state_size values when model_current */
 };
 
+static hh_status missing_argument(hh_instance *inst, const char *what)
+{
+    LOG_ERROR(inst, "%s is NULL", what);
+    return HH_STATUS_ERROR;
+}
+
 hh_status hh_instance_get_state(hh_instance *inst, hh_snapshot **snapshot)
 {
+    if (snapshot == NULL)
+        return missing_argument(inst, "the pointer for the FMU state");
     size_t values = inst->model_current ? inst->state_size : 0;
     hh_snapshot *s = *snapshot;
     if (s == NULL || s->state_size != values) {
-        hh_snapshot_free(s);
-        *snapshot = NULL;
+        hh_snapshot_free(snapshot);
         s = malloc(sizeof *s + values * sizeof(double));
         if (s == NULL) {
             LOG_ERROR(inst, "out of memory for an FMU state");
@@ -530,19 +537,33 @@ hh_status hh_instance_set_state(hh_instance *inst, const hh_snapshot *s)
     return HH_STATUS_OK;
 }
 
-void hh_snapshot_free(hh_snapshot *snapshot)
+hh_status hh_snapshot_free(hh_snapshot **snapshot)
 {
-    free(snapshot);
+    if (snapshot != NULL) {
+        free(*snapshot);
+        *snapshot = NULL;
+    }
+    return HH_STATUS_OK;
 }
 
-size_t hh_snapshot_size(const hh_snapshot *snapshot)
+static size_t snapshot_bytes(const hh_snapshot *snapshot)
 {
     return sizeof *snapshot + snapshot->state_size * sizeof(double);
 }
 
+hh_status hh_snapshot_size(hh_instance *inst, const hh_snapshot *snapshot, size_t *size)
+{
+    if (snapshot == NULL || size == NULL)
+        return missing_argument(inst, snapshot == NULL ? "the FMU state" : "the pointer for its size");
+    *size = snapshot_bytes(snapshot);
+    return HH_STATUS_OK;
+}
+
 hh_status hh_snapshot_serialize(hh_instance *inst, const hh_snapshot *snapshot, unsigned char *bytes, size_t size)
 {
-    size_t need = hh_snapshot_size(snapshot);
+    if (snapshot == NULL || bytes == NULL)
+        return missing_argument(inst, snapshot == NULL ? "the FMU state" : "the buffer for the serialized state");
+    size_t need = snapshot_bytes(snapshot);
     if (size < need) {
         LOG_ERROR(inst, "the buffer for the serialized FMU state holds %zu bytes, it needs %zu", size, need);
         return HH_STATUS_ERROR;
@@ -553,6 +574,8 @@ hh_status hh_snapshot_serialize(hh_instance *inst, const hh_snapshot *snapshot, 
 
 hh_status hh_snapshot_deserialize(hh_instance *inst, const unsigned char *bytes, size_t size, hh_snapshot **snapshot)
 {
+    if (bytes == NULL || snapshot == NULL)
+        return missing_argument(inst, bytes == NULL ? "the serialized state" : "the pointer for the FMU state");
     hh_snapshot head;
     if (size < sizeof head) {
         LOG_ERROR(inst, "a serialized FMU state of %zu bytes is too short", size);
@@ -571,7 +594,7 @@ hh_status hh_snapshot_deserialize(hh_instance *inst, const unsigned char *bytes,
         return HH_STATUS_ERROR;
     }
     memcpy(s, bytes, size);
-    hh_snapshot_free(*snapshot);
+    hh_snapshot_free(snapshot);
     *snapshot = s;
     return HH_STATUS_OK;
 }

@@ -31,7 +31,13 @@ enum {
 enum { HH_N_INPUTS = 12 };
 
 /* Statuses, numbered as fmi2Status and fmi3Status both are. */
-typedef enum { HH_STATUS_OK = 0, HH_STATUS_WARNING = 1, HH_STATUS_DISCARD = 2, HH_STATUS_ERROR = 3, HH_STATUS_FATAL = 4 } hh_status;
+typedef enum {
+    HH_STATUS_OK = 0,
+    HH_STATUS_WARNING = 1,
+    HH_STATUS_DISCARD = 2,
+    HH_STATUS_ERROR = 3,
+    HH_STATUS_FATAL = 4
+} hh_status;
 
 /* Log categories declared in modelDescription.xml. */
 #define HH_LOG_EVENTS "logEvents"
@@ -93,12 +99,13 @@ double hh_instance_time(const hh_instance *inst);
 hh_status hh_instance_terminate(hh_instance *inst);
 hh_status hh_instance_reset(hh_instance *inst);
 
-/* FMU states: a snapshot of everything an instance computes with. */
+/* FMU states: a snapshot of everything an instance computes with. The functions take
+ * the FMI functions' arguments as they come (NULL pointers included: logged errors). */
 typedef struct hh_snapshot hh_snapshot;
-hh_status hh_instance_get_state(hh_instance *inst, hh_snapshot **snapshot);
+hh_status hh_instance_get_state(hh_instance *inst, hh_snapshot **snapshot); /* reuses *snapshot if set */
 hh_status hh_instance_set_state(hh_instance *inst, const hh_snapshot *snapshot);
-void hh_snapshot_free(hh_snapshot *snapshot);
-size_t hh_snapshot_size(const hh_snapshot *snapshot);
+hh_status hh_snapshot_free(hh_snapshot **snapshot); /* frees *snapshot, sets it to NULL */
+hh_status hh_snapshot_size(hh_instance *inst, const hh_snapshot *snapshot, size_t *size);
 hh_status hh_snapshot_serialize(hh_instance *inst, const hh_snapshot *snapshot, unsigned char *bytes, size_t size);
 hh_status hh_snapshot_deserialize(hh_instance *inst, const unsigned char *bytes, size_t size,
                                   hh_snapshot **snapshot);
