@@ -65,11 +65,8 @@ S_WINDOW: int = _L["S_WINDOW"]
 S_TOUCH: int = _L["S_TOUCH"]
 
 
-def state_size(npts: int) -> int:
-    return S_TOUCH + 9 * npts
-
-
 def anchor_offset(npts: int) -> int:
+    """Where the anchors start in the state, after the touching flags (its length: ``Model.state_size``)."""
     return S_TOUCH + 3 * npts
 
 

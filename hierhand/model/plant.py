@@ -46,7 +46,6 @@ from .layout import (
     W_OBJ_M,
     W_TIP_M,
     anchor_offset,
-    state_size,
 )
 
 _PORT_SLICES = []  # (port, its columns in an output row)
@@ -92,7 +91,7 @@ class HandPlant(Block):
 
     Parameters are the hand file's sections (``gravity``, ``fingers``, ``object``,
     ``contact``), each defaulting to the shipped hand. The period is the integration step
-    of a semi-implicit Euler scheme (see ``kernel.py`` for why not explicit Euler).
+    of a semi-implicit Euler scheme (``hierhand/csrc/plant.c`` says why not explicit Euler).
 
     Inputs: ``tau`` (9 joint torques), ``f_ext`` (fx, fy, torque on the object; zero when
     unconnected). Outputs of the state at a hit: ``q``, ``qd``, ``tip`` (x, y, phi per
@@ -121,7 +120,7 @@ class HandPlant(Block):
         self.input_defaults = {"f_ext": _ZERO3}
         self.outputs = dict(OUTPUT_PORTS)
         self.n_points = self.hand.n_points
-        self._state_shape = (state_size(self.n_points),)
+        self._state_shape = (self.hand.native.state_size,)
         self._model: _native.Model | None = None  # the hand packed with its step, once bound
         self.dt: float | None = None
 

@@ -410,11 +410,13 @@ def test_round_trip_through_the_fmu_import_block(fmus, fmi):
           - {{signal: native.obj, decimate: 10}}
         """))
     results = simulate(diagram)
+    again = simulate(diagram)  # the pooled FMU instance is reset and runs again
     for port in ("q", "obj"):
         t, fmu_values = results[f"fmu.{port}"]
         t_native, native_values = results[f"native.{port}"]
         assert len(t) == N_STEPS + 1 and np.allclose(t, t_native[: len(t)])
         np.testing.assert_array_equal(fmu_values, native_values[: len(t)])
+        np.testing.assert_array_equal(again[f"fmu.{port}"][1], fmu_values)
 
 
 def test_default_output_path():

@@ -221,7 +221,7 @@ def test_coincident_points_are_an_error_of_every_entry_point():
 
 def test_the_period_is_checked_before_the_directions():
     """An unbound reflex's update names the missing period even where the directions
-    would fail, as the numba kernel did; output needs no period."""
+    would fail; output needs no period."""
     reflex = GraspReflex()
     state = np.array([2.0, 1.0, 1.0, 0.0])
     tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
@@ -247,13 +247,14 @@ def test_input_widths_are_checked_naming_the_port(port, width):
         reflex.update(0.0, np.zeros(3), random_case(np.random.default_rng(9), reflex, 2, inward=True)[1])
 
 
-def test_packed_parameters_keep_their_slots():
-    """The numba kernels' slots, now defined in control.h, plus the coincidence tolerance
-    that internal_forces defines."""
+def test_packed_parameters_land_in_the_slots_control_h_defines():
+    """Every value at its own slot (the slots come from control.h), including the
+    coincidence tolerance that internal_forces defines."""
     from hierhand.control.internal_forces import _COINCIDENT_RTOL
 
-    assert (P_THRESHOLD, P_APPROACH, P_KI, P_DT, P_MIN_FORCE, P_RATIO, P_MAX_FORCE, P_INITIAL) == tuple(range(8))
-    assert (P_COINCIDENT_RTOL, N_PARAMS) == (10, 11)
+    slots = [P_THRESHOLD, P_APPROACH, P_KI, P_DT, P_MIN_FORCE, P_RATIO, P_MAX_FORCE, P_INITIAL, P_INITIAL + 1,
+             P_INITIAL + 2, P_COINCIDENT_RTOL]
+    assert sorted(slots) == list(range(N_PARAMS))
     p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True])
     assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL
     assert p[P_INITIAL:P_INITIAL + 3].tolist() == [1.0, 0.0, 1.0] and p[P_KI] == 50.0
