@@ -70,7 +70,7 @@ def heavy_hand() -> dict:
 class Slave:
     """An FMU instance through fmpy's low-level API, its log messages collected."""
 
-    def __init__(self, path: Path, unzip: Path, name: str = "instance"):
+    def __init__(self, path: Path, unzip: Path, name: str = "instance", logging_on: bool = False):
         self.md = read_model_description(str(path))
         self.fmi = int(self.md.fmiVersion[0])
         self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
@@ -82,11 +82,11 @@ class Slave:
             callbacks = fmi2CallbackFunctions()
             callbacks.logger = self._logger2 = fmi2CallbackLoggerTYPE(self._collect2)
             self._callbacks = callbacks
-            self.fmu.instantiate(callbacks=callbacks)
+            self.fmu.instantiate(callbacks=callbacks, loggingOn=logging_on)
             self.fmu.setupExperiment(startTime=0.0)
         else:
             self.fmu = FMU3Slave(**kwargs)
-            self.fmu.instantiate(logMessage=self._collect3)
+            self.fmu.instantiate(loggingOn=logging_on, logMessage=self._collect3)
 
     def _collect2(self, env, name, status, category, message):
         self.messages.append((status, category.decode(), message.decode()))
@@ -185,6 +185,27 @@ def test_invalid_parameters_are_logged_and_fail_initialization(fmus, fmi, tmp_pa
         assert slave.errors() == ["invalid parameter: object.mass must be > 0, got -1"]
     finally:
         slave.close()
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_events_are_logged_only_when_logging_is_on(fmus, fmi, tmp_path):
+    quiet, chatty = Slave(fmus[fmi], tmp_path / "quiet"), Slave(fmus[fmi], tmp_path / "chatty", logging_on=True)
+    try:
+        for slave in (quiet, chatty):
+            slave.initialize()
+        assert quiet.messages == []
+        assert [(status, category) for status, category, _ in chatty.messages] == [(0, "logEvents")] * 2
+        assert chatty.messages[1][2] == "initialized: 200 surface points, state of 1848 values"
+        with pytest.raises(Exception, match="SetDebugLogging"):
+            chatty.fmu.setDebugLogging(True, ["logEverything"])
+        assert "unknown log category 'logEverything'" in chatty.errors()[0]
+        chatty.fmu.setDebugLogging(False, [])
+        chatty.messages.clear()
+        chatty.step(0.0)
+        assert chatty.messages == []
+    finally:
+        quiet.close()
+        chatty.close()
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
