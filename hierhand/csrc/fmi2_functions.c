@@ -5,7 +5,6 @@
  * with a category and returns fmi2Error; nothing here aborts the host.
  */
 #include <stdlib.h>
-#include <string.h>
 
 #include "fmi2Functions.h"
 #include "fmu_instance.h"
@@ -77,20 +76,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
                                const fmi2String categories[])
 {
     INSTANCE_OR_ERROR(c);
-    int events = nCategories == 0;
-    for (size_t i = 0; i < nCategories; i++) {
-        if (categories[i] == NULL)
-            continue;
-        if (strcmp(categories[i], HH_LOG_EVENTS) == 0)
-            events = 1;
-        else if (strcmp(categories[i], HH_LOG_WARNING) != 0 && strcmp(categories[i], HH_LOG_ERROR) != 0) {
-            hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "unknown log category '%s' (this FMU has %s, %s, %s)",
-                            categories[i], HH_LOG_EVENTS, HH_LOG_WARNING, HH_LOG_ERROR);
-            return fmi2Error;
-        }
-    }
-    inst->log_events = loggingOn && events;
-    return fmi2OK;
+    return (fmi2Status)hh_instance_set_logging(inst, loggingOn, nCategories, categories);
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,

@@ -7,7 +7,6 @@
  * here aborts the host.
  */
 #include <stdlib.h>
-#include <string.h>
 
 #include "fmi3Functions.h"
 #include "fmu_instance.h"
@@ -64,20 +63,7 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, siz
                                const fmi3String categories[])
 {
     INSTANCE_OR_ERROR(instance);
-    int events = nCategories == 0;
-    for (size_t i = 0; i < nCategories; i++) {
-        if (categories[i] == NULL)
-            continue;
-        if (strcmp(categories[i], HH_LOG_EVENTS) == 0)
-            events = 1;
-        else if (strcmp(categories[i], HH_LOG_WARNING) != 0 && strcmp(categories[i], HH_LOG_ERROR) != 0) {
-            hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "unknown log category '%s' (this FMU has %s, %s, %s)",
-                            categories[i], HH_LOG_EVENTS, HH_LOG_WARNING, HH_LOG_ERROR);
-            return fmi3Error;
-        }
-    }
-    inst->log_events = loggingOn && events;
-    return fmi3OK;
+    return (fmi3Status)hh_instance_set_logging(inst, loggingOn, nCategories, categories);
 }
 
 static void refuse_interface(fmi3InstanceEnvironment environment, fmi3LogMessageCallback logMessage,

@@ -32,6 +32,24 @@ void hh_instance_log(const hh_instance *inst, hh_status status, const char *cate
 #define LOG_ERROR(inst, ...) hh_instance_log((inst), HH_STATUS_ERROR, HH_LOG_ERROR, __VA_ARGS__)
 #define LOG_EVENT(inst, ...) hh_instance_log((inst), HH_STATUS_OK, HH_LOG_EVENTS, __VA_ARGS__)
 
+hh_status hh_instance_set_logging(hh_instance *inst, int on, size_t n, const char *const categories[])
+{
+    int events = n == 0;
+    for (size_t i = 0; i < n; i++) {
+        if (categories == NULL || categories[i] == NULL)
+            continue;
+        if (strcmp(categories[i], HH_LOG_EVENTS) == 0)
+            events = 1;
+        else if (strcmp(categories[i], HH_LOG_WARNING) != 0 && strcmp(categories[i], HH_LOG_ERROR) != 0) {
+            LOG_ERROR(inst, "unknown log category '%s' (this FMU has %s, %s, %s)", categories[i], HH_LOG_EVENTS,
+                      HH_LOG_WARNING, HH_LOG_ERROR);
+            return HH_STATUS_ERROR;
+        }
+    }
+    inst->log_events = on && events;
+    return HH_STATUS_OK;
+}
+
 /* -- resources ----------------------------------------------------------------------------- */
 
 int hh_path_from_uri(const char *uri, char *out, size_t size)

@@ -86,6 +86,10 @@ void hh_instance_log(const hh_instance *inst, hh_status status, const char *cate
 #endif
     ;
 
+/* fmi2SetDebugLogging / fmi3SetDebugLogging: logEvents on when ``on`` and either no
+ * categories or logEvents among them; an unknown category is a logged error. */
+hh_status hh_instance_set_logging(hh_instance *inst, int on, size_t n, const char *const categories[]);
+
 /* The folder of a file: URI ("file:///a/b/resources" or "file:/a/b"), percent-decoded,
  * into ``out``; 0 on success. */
 int hh_path_from_uri(const char *uri, char *out, size_t size);

@@ -58,3 +58,40 @@ int hh_py_nargs(Py_ssize_t nargs, Py_ssize_t expected, const char *function)
     }
     return 0;
 }
+
+double *hh_py_hold(held_buffers *h, PyObject *obj, Py_ssize_t n, int writable, const char *what)
+{
+    if (h->held == HH_PY_MOST_BUFFERS) {
+        PyErr_SetString(PyExc_SystemError, "hierhand._native: too many buffers in one call");
+        return NULL;
+    }
+    Py_buffer *view = &h->view[h->held];
+    if (hh_py_doubles(obj, view, n, writable, what) != 0)
+        return NULL;
+    h->held += 1;
+    return view->buf;
+}
+
+Py_ssize_t hh_py_last_count(const held_buffers *h)
+{
+    return h->view[h->held - 1].len / (Py_ssize_t)sizeof(double);
+}
+
+void hh_py_release_all(held_buffers *h)
+{
+    while (h->held > 0)
+        PyBuffer_Release(&h->view[--h->held]);
+}
+
+int hh_py_finger(PyObject *obj, int *finger)
+{
+    long f = PyLong_AsLong(obj);
+    if (f == -1 && PyErr_Occurred())
+        return -1;
+    if (f < 0 || f >= HH_FINGERS) {
+        PyErr_Format(PyExc_ValueError, "finger must be 0, 1 or 2, got %ld", f);
+        return -1;
+    }
+    *finger = (int)f;
+    return 0;
+}

@@ -25,6 +25,25 @@ ModelObject *hh_py_model(PyObject *obj, const char *what);
  * PyBuffer_Release. */
 int hh_py_doubles(PyObject *obj, Py_buffer *view, Py_ssize_t n, int writable, const char *what);
 
+enum { HH_PY_MOST_BUFFERS = 8 };
+
+/* The buffers one call holds, released together: start with {.held = 0}. */
+typedef struct {
+    Py_buffer view[HH_PY_MOST_BUFFERS];
+    int held;
+} held_buffers;
+
+/* ``obj`` as ``n`` float64 values (n < 0: any count), held in ``h``; NULL on error. */
+double *hh_py_hold(held_buffers *h, PyObject *obj, Py_ssize_t n, int writable, const char *what);
+
+/* The count of float64 values of the buffer held last. */
+Py_ssize_t hh_py_last_count(const held_buffers *h);
+
+void hh_py_release_all(held_buffers *h);
+
+/* A finger index argument (0, 1 or 2); -1 with ValueError or TypeError. */
+int hh_py_finger(PyObject *obj, int *finger);
+
 /* A float argument; -1 with TypeError on failure (check PyErr_Occurred). */
 int hh_py_double(PyObject *obj, double *out, const char *what);
 

@@ -13,55 +13,6 @@
 
 #include "../control.h"
 
-/* -- holding buffers ---------------------------------------------------------------------- */
-
-enum { MOST_BUFFERS = 8 };
-
-/* The buffers one call holds, released together. */
-typedef struct {
-    Py_buffer view[MOST_BUFFERS];
-    int held;
-} held_buffers;
-
-/* ``obj`` as ``n`` float64 values (n < 0: any count), held in ``h``; NULL on error. */
-static double *hold(held_buffers *h, PyObject *obj, Py_ssize_t n, int writable, const char *what)
-{
-    if (h->held == MOST_BUFFERS) {
-        PyErr_SetString(PyExc_SystemError, "hierhand._native: too many buffers in one call");
-        return NULL;
-    }
-    Py_buffer *view = &h->view[h->held];
-    if (hh_py_doubles(obj, view, n, writable, what) != 0)
-        return NULL;
-    h->held += 1;
-    return view->buf;
-}
-
-/* The count of float64 values of the buffer held last. */
-static Py_ssize_t last_count(const held_buffers *h)
-{
-    return h->view[h->held - 1].len / (Py_ssize_t)sizeof(double);
-}
-
-static void release_all(held_buffers *h)
-{
-    while (h->held > 0)
-        PyBuffer_Release(&h->view[--h->held]);
-}
-
-static int finger_index(PyObject *obj, int *finger)
-{
-    long f = PyLong_AsLong(obj);
-    if (f == -1 && PyErr_Occurred())
-        return -1;
-    if (f < 0 || f >= HH_FINGERS) {
-        PyErr_Format(PyExc_ValueError, "finger must be 0, 1 or 2, got %ld", f);
-        return -1;
-    }
-    *finger = (int)f;
-    return 0;
-}
-
 /* -- grasping reflex ------------------------------------------------------------------------ */
 
 static PyObject *reflex_error(int code)
@@ -78,8 +29,8 @@ static PyObject *reflex_error(int code)
 /* An input port of the reflex, of ``width`` values. */
 static const double *reflex_input(held_buffers *h, PyObject *obj, Py_ssize_t width, const char *port)
 {
-    const double *values = hold(h, obj, -1, 0, port);
-    if (values != NULL && last_count(h) != width) {
+    const double *values = hh_py_hold(h, obj, -1, 0, port);
+    if (values != NULL && hh_py_last_count(h) != width) {
         PyErr_Format(PyExc_ValueError, "GraspReflex: input '%s' must have %zd entries", port, width);
         return NULL;
     }
@@ -90,11 +41,11 @@ static const double *reflex_input(held_buffers *h, PyObject *obj, Py_ssize_t wid
 static int reflex_arguments(held_buffers *h, PyObject *const *args, const double **params, const double **state,
                             hh_reflex_inputs *in)
 {
-    if ((*params = hold(h, args[0], HH_REFLEX_N_PARAMS, 0, "params")) == NULL)
+    if ((*params = hh_py_hold(h, args[0], HH_REFLEX_N_PARAMS, 0, "params")) == NULL)
         return -1;
-    if ((*state = hold(h, args[1], -1, 0, "state")) == NULL)
+    if ((*state = hh_py_hold(h, args[1], -1, 0, "state")) == NULL)
         return -1;
-    if (last_count(h) != HH_REFLEX_N_STATE) {
+    if (hh_py_last_count(h) != HH_REFLEX_N_STATE) {
         PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 4 entries [scale, touched(3)]");
         return -1;
     }
@@ -116,8 +67,8 @@ static PyObject *py_reflex_directions(PyObject *module, PyObject *const *args, P
     if (hh_py_nargs(nargs, 7, "reflex_directions") != 0)
         return NULL;
     if (reflex_arguments(&h, args, &params, &state, &in) == 0 &&
-        (g = hold(&h, args[5], 6, 1, "g")) != NULL &&
-        (flags = hold(&h, args[6], 6, 1, "flags")) != NULL) {
+        (g = hh_py_hold(&h, args[5], 6, 1, "g")) != NULL &&
+        (flags = hh_py_hold(&h, args[6], 6, 1, "flags")) != NULL) {
         int grasp[3], touching[3];
         int code = hh_reflex_directions(params, state, &in, (double(*)[2])g, grasp, touching);
         if (code == HH_REFLEX_OK) {
@@ -130,7 +81,7 @@ static PyObject *py_reflex_directions(PyObject *module, PyObject *const *args, P
             reflex_error(code);
         }
     }
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -145,8 +96,8 @@ static PyObject *py_reflex_forces(PyObject *module, PyObject *const *args, Py_ss
     if (hh_py_nargs(nargs, 7, "reflex_forces") != 0)
         return NULL;
     if (reflex_arguments(&h, args, &params, &state, &in) == 0 &&
-        (f = hold(&h, args[5], 6, 1, "f")) != NULL &&
-        (grasp_flags = hold(&h, args[6], 3, 1, "grasp")) != NULL) {
+        (f = hh_py_hold(&h, args[5], 6, 1, "f")) != NULL &&
+        (grasp_flags = hh_py_hold(&h, args[6], 3, 1, "grasp")) != NULL) {
         double g[3][2];
         int grasp[3], touching[3];
         int code = hh_reflex_directions(params, state, &in, g, grasp, touching);
@@ -159,7 +110,7 @@ static PyObject *py_reflex_forces(PyObject *module, PyObject *const *args, Py_ss
             reflex_error(code);
         }
     }
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -176,11 +127,11 @@ static PyObject *py_reflex_output(PyObject *module, PyObject *const *args, Py_ss
         return NULL;
     if (reflex_arguments(&h, args + 1, &params, &state, &in) == 0 &&
         (q = reflex_input(&h, args[6], 9, "q")) != NULL &&
-        (out = hold(&h, args[7], HH_REFLEX_N_OUT, 1, "out")) != NULL) {
+        (out = hh_py_hold(&h, args[7], HH_REFLEX_N_OUT, 1, "out")) != NULL) {
         int code = hh_reflex_output(&model->model, params, state, &in, q, out);
         result = code == HH_REFLEX_OK ? Py_NewRef(Py_None) : reflex_error(code);
     }
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -196,11 +147,11 @@ static PyObject *py_reflex_update(PyObject *module, PyObject *const *args, Py_ss
         return NULL;
     if (reflex_arguments(&h, args, &params, &state, &in) == 0 &&
         (ft = reflex_input(&h, args[5], 3, "ft")) != NULL &&
-        (next = hold(&h, args[6], HH_REFLEX_N_STATE, 1, "next")) != NULL) {
+        (next = hh_py_hold(&h, args[6], HH_REFLEX_N_STATE, 1, "next")) != NULL) {
         int code = hh_reflex_update(params, state, &in, ft, next);
         result = code == HH_REFLEX_OK ? Py_NewRef(Py_None) : reflex_error(code);
     }
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -210,16 +161,16 @@ static PyObject *py_reflex_update(PyObject *module, PyObject *const *args, Py_ss
  * capacity, interpolations known. */
 static int manip_trajectories(held_buffers *h, PyObject *waypoints, PyObject *meta, hh_trajectories *tr)
 {
-    if ((tr->waypoints = hold(h, waypoints, -1, 0, "waypoints")) == NULL)
+    if ((tr->waypoints = hh_py_hold(h, waypoints, -1, 0, "waypoints")) == NULL)
         return -1;
-    Py_ssize_t values = last_count(h);
+    Py_ssize_t values = hh_py_last_count(h);
     Py_ssize_t row = HH_FINGERS * HH_MANIP_W_COLS;
     if (values == 0 || values % row != 0) {
         PyErr_Format(PyExc_ValueError, "waypoints must hold 3 x n x 4 values (n >= 1), got %zd values", values);
         return -1;
     }
     tr->capacity = (long)(values / row);
-    if ((tr->meta = hold(h, meta, HH_FINGERS * HH_MANIP_N_META, 0, "meta")) == NULL)
+    if ((tr->meta = hh_py_hold(h, meta, HH_FINGERS * HH_MANIP_N_META, 0, "meta")) == NULL)
         return -1;
     for (int f = 0; f < HH_FINGERS; f++) {
         double count = tr->meta[f * HH_MANIP_N_META + HH_MANIP_M_COUNT];
@@ -241,7 +192,7 @@ static int manip_trajectories(held_buffers *h, PyObject *waypoints, PyObject *me
 /* waypoints, meta, finger, t of the trajectory queries; the finger must have waypoints. */
 static int trajectory_query(held_buffers *h, PyObject *const *args, hh_trajectories *tr, int *finger, double *t)
 {
-    if (finger_index(args[2], finger) != 0 || hh_py_double(args[3], t, "t") != 0 ||
+    if (hh_py_finger(args[2], finger) != 0 || hh_py_double(args[3], t, "t") != 0 ||
         manip_trajectories(h, args[0], args[1], tr) != 0)
         return -1;
     if (tr->meta[*finger * HH_MANIP_N_META + HH_MANIP_M_COUNT] == 0.0) {
@@ -266,7 +217,7 @@ static PyObject *py_trajectory_sample(PyObject *module, PyObject *const *args, P
         hh_trajectory_sample(&tr, f, t, pose);
         result = Py_BuildValue("(ddd)", pose[0], pose[1], pose[2]);
     }
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -282,7 +233,7 @@ static PyObject *py_trajectory_moving(PyObject *module, PyObject *const *args, P
         return NULL;
     if (trajectory_query(&h, args, &tr, &f, &t) == 0)
         result = PyBool_FromLong(hh_trajectory_moving(&tr, f, t));
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -293,7 +244,7 @@ static PyObject *py_ik_near(PyObject *module, PyObject *const *args, Py_ssize_t 
     int f;
     double reach_rtol, x, y, phi, ref[3], q[3];
     if (hh_py_nargs(nargs, 9, "ik_near") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
-        finger_index(args[1], &f) != 0 || hh_py_double(args[2], &reach_rtol, "reach_rtol") != 0 ||
+        hh_py_finger(args[1], &f) != 0 || hh_py_double(args[2], &reach_rtol, "reach_rtol") != 0 ||
         hh_py_double(args[3], &x, "x") != 0 || hh_py_double(args[4], &y, "y") != 0 ||
         hh_py_double(args[5], &phi, "phi") != 0 || hh_py_double(args[6], &ref[0], "r0") != 0 ||
         hh_py_double(args[7], &ref[1], "r1") != 0 || hh_py_double(args[8], &ref[2], "r2") != 0)
@@ -316,14 +267,14 @@ static PyObject *py_manipulation_output(PyObject *module, PyObject *const *args,
     if (hh_py_nargs(nargs, 9, "manipulation_output") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
         hh_py_double(args[4], &t, "t") != 0)
         return NULL;
-    if ((params = hold(&h, args[1], HH_MANIP_N_PARAMS, 0, "params")) != NULL &&
+    if ((params = hh_py_hold(&h, args[1], HH_MANIP_N_PARAMS, 0, "params")) != NULL &&
         manip_trajectories(&h, args[2], args[3], &tr) == 0 &&
-        (q = hold(&h, args[5], HH_JOINTS, 0, "q")) != NULL &&
-        (qd = hold(&h, args[6], HH_JOINTS, 0, "qd")) != NULL &&
-        (fn = hold(&h, args[7], HH_FINGERS, 0, "fn")) != NULL &&
-        (out = hold(&h, args[8], HH_MANIP_N_OUT, 1, "out")) != NULL)
+        (q = hh_py_hold(&h, args[5], HH_JOINTS, 0, "q")) != NULL &&
+        (qd = hh_py_hold(&h, args[6], HH_JOINTS, 0, "qd")) != NULL &&
+        (fn = hh_py_hold(&h, args[7], HH_FINGERS, 0, "fn")) != NULL &&
+        (out = hh_py_hold(&h, args[8], HH_MANIP_N_OUT, 1, "out")) != NULL)
         result = PyLong_FromLong(hh_manipulation_output(&model->model, params, &tr, t, q, qd, fn, out));
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -338,15 +289,15 @@ static PyObject *py_suppress(PyObject *module, PyObject *const *args, Py_ssize_t
     PyObject *result = NULL;
     if (hh_py_nargs(nargs, 5, "suppress") != 0)
         return NULL;
-    if ((params = hold(&h, args[0], HH_SUPPRESS_N_PARAMS, 0, "params")) != NULL &&
-        (tau_g = hold(&h, args[1], HH_JOINTS, 0, "tau_g")) != NULL &&
-        (tau_m = hold(&h, args[2], HH_JOINTS, 0, "tau_m")) != NULL &&
-        (tau_ff = hold(&h, args[3], HH_JOINTS, 0, "tau_ff")) != NULL &&
-        (out = hold(&h, args[4], HH_SUPPRESS_N_OUT, 1, "out")) != NULL) {
+    if ((params = hh_py_hold(&h, args[0], HH_SUPPRESS_N_PARAMS, 0, "params")) != NULL &&
+        (tau_g = hh_py_hold(&h, args[1], HH_JOINTS, 0, "tau_g")) != NULL &&
+        (tau_m = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau_m")) != NULL &&
+        (tau_ff = hh_py_hold(&h, args[3], HH_JOINTS, 0, "tau_ff")) != NULL &&
+        (out = hh_py_hold(&h, args[4], HH_SUPPRESS_N_OUT, 1, "out")) != NULL) {
         hh_suppress(params, tau_g, tau_m, tau_ff, out);
         result = Py_NewRef(Py_None);
     }
-    release_all(&h);
+    hh_py_release_all(&h);
     return result;
 }
 

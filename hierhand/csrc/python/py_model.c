@@ -96,13 +96,13 @@ static PyObject *model_with_dt(ModelObject *self, PyObject *arg)
     return (PyObject *)copy;
 }
 
-static int copy_out(PyObject *target, const double *source, Py_ssize_t n, const char *what)
+/* Copy ``n`` values into the float64 buffer ``target`` (held in ``h``); -1 on error. */
+static int copy_out(held_buffers *h, PyObject *target, const double *source, Py_ssize_t n, const char *what)
 {
-    Py_buffer view;
-    if (hh_py_doubles(target, &view, n, 1, what) != 0)
+    double *out = hh_py_hold(h, target, n, 1, what);
+    if (out == NULL)
         return -1;
-    memcpy(view.buf, source, (size_t)n * sizeof(double));
-    PyBuffer_Release(&view);
+    memcpy(out, source, (size_t)n * sizeof(double));
     return 0;
 }
 
@@ -111,12 +111,13 @@ static PyObject *model_pack_into(ModelObject *self, PyObject *const *args, Py_ss
     if (hh_py_nargs(nargs, 5, "pack_into") != 0)
         return NULL;
     const hh_model *m = &self->model;
-    if (copy_out(args[0], &m->fingers[0][0], HH_FINGERS * HH_N_FINGER_PARAMS, "fingers") != 0 ||
-        copy_out(args[1], m->body, HH_N_BODY_PARAMS, "body") != 0 ||
-        copy_out(args[2], &m->edges[0][0], HH_EDGES * HH_N_EDGE_COLS, "edges") != 0 ||
-        copy_out(args[3], m->q0, HH_JOINTS, "q0") != 0 || copy_out(args[4], m->pose0, 3, "pose0") != 0)
-        return NULL;
-    Py_RETURN_NONE;
+    held_buffers h = {.held = 0};
+    int failed = copy_out(&h, args[0], &m->fingers[0][0], HH_FINGERS * HH_N_FINGER_PARAMS, "fingers") != 0 ||
+                 copy_out(&h, args[1], m->body, HH_N_BODY_PARAMS, "body") != 0 ||
+                 copy_out(&h, args[2], &m->edges[0][0], HH_EDGES * HH_N_EDGE_COLS, "edges") != 0 ||
+                 copy_out(&h, args[3], m->q0, HH_JOINTS, "q0") != 0 || copy_out(&h, args[4], m->pose0, 3, "pose0") != 0;
+    hh_py_release_all(&h);
+    return failed ? NULL : Py_NewRef(Py_None);
 }
 
 static PyObject *model_get_npts(ModelObject *self, void *closure)
@@ -195,116 +196,82 @@ static PyObject *py_initial_state(PyObject *module, PyObject *const *args, Py_ss
 {
     (void)module;
     ModelObject *self;
-    Py_buffer state;
-    if (hh_py_nargs(nargs, 2, "initial_state") != 0 || (self = hh_py_model(args[0], "model")) == NULL ||
-        hh_py_doubles(args[1], &state, (Py_ssize_t)hh_state_size(&self->model), 1, "state") != 0)
+    held_buffers h = {.held = 0};
+    double *state;
+    if (hh_py_nargs(nargs, 2, "initial_state") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
         return NULL;
-    hh_initial_state(&self->model, (double *)state.buf);
-    PyBuffer_Release(&state);
-    Py_RETURN_NONE;
+    if ((state = hh_py_hold(&h, args[1], (Py_ssize_t)hh_state_size(&self->model), 1, "state")) != NULL)
+        hh_initial_state(&self->model, state);
+    hh_py_release_all(&h);
+    return state != NULL ? Py_NewRef(Py_None) : NULL;
 }
 
 static PyObject *py_frames(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     ModelObject *self;
-    Py_buffer q, u, pts, phi;
+    held_buffers h = {.held = 0};
+    const double *q;
+    double *u, *pts, *phi = NULL;
     if (hh_py_nargs(nargs, 5, "frames") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
         return NULL;
-    if (hh_py_doubles(args[1], &q, HH_JOINTS, 0, "q") != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &u, 18, 1, "u") != 0)
-        goto fail_q;
-    if (hh_py_doubles(args[3], &pts, 24, 1, "pts") != 0)
-        goto fail_u;
-    if (hh_py_doubles(args[4], &phi, 3, 1, "phi") != 0)
-        goto fail_pts;
-    hh_frames(&self->model, q.buf, u.buf, pts.buf, phi.buf);
-    PyBuffer_Release(&phi);
-    PyBuffer_Release(&pts);
-    PyBuffer_Release(&u);
-    PyBuffer_Release(&q);
-    Py_RETURN_NONE;
-fail_pts:
-    PyBuffer_Release(&pts);
-fail_u:
-    PyBuffer_Release(&u);
-fail_q:
-    PyBuffer_Release(&q);
-    return NULL;
+    if ((q = hh_py_hold(&h, args[1], HH_JOINTS, 0, "q")) != NULL && (u = hh_py_hold(&h, args[2], 18, 1, "u")) != NULL &&
+        (pts = hh_py_hold(&h, args[3], 24, 1, "pts")) != NULL && (phi = hh_py_hold(&h, args[4], 3, 1, "phi")) != NULL)
+        hh_frames(&self->model, q, u, pts, phi);
+    hh_py_release_all(&h);
+    return phi != NULL ? Py_NewRef(Py_None) : NULL;
 }
 
 static PyObject *py_point_jacobian(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     ModelObject *self;
-    Py_buffer q, jac;
-    double px, py;
-    if (hh_py_nargs(nargs, 6, "point_jacobian") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
+    held_buffers h = {.held = 0};
+    const double *q;
+    double *jac = NULL, px, py;
+    int f;
+    if (hh_py_nargs(nargs, 6, "point_jacobian") != 0 || (self = hh_py_model(args[0], "model")) == NULL ||
+        hh_py_finger(args[2], &f) != 0 || hh_py_double(args[3], &px, "px") != 0 ||
+        hh_py_double(args[4], &py, "py") != 0)
         return NULL;
-    long f = PyLong_AsLong(args[2]);
-    if (f == -1 && PyErr_Occurred())
-        return NULL;
-    if (f < 0 || f >= HH_FINGERS) {
-        PyErr_Format(PyExc_ValueError, "finger must be 0, 1 or 2, got %ld", f);
-        return NULL;
-    }
-    if (hh_py_double(args[3], &px, "px") != 0 || hh_py_double(args[4], &py, "py") != 0)
-        return NULL;
-    if (hh_py_doubles(args[1], &q, HH_JOINTS, 0, "q") != 0)
-        return NULL;
-    if (hh_py_doubles(args[5], &jac, 6, 1, "jac") != 0) {
-        PyBuffer_Release(&q);
-        return NULL;
-    }
-    hh_point_jacobian(&self->model, q.buf, (int)f, px, py, jac.buf);
-    PyBuffer_Release(&jac);
-    PyBuffer_Release(&q);
-    Py_RETURN_NONE;
+    if ((q = hh_py_hold(&h, args[1], HH_JOINTS, 0, "q")) != NULL &&
+        (jac = hh_py_hold(&h, args[5], 6, 1, "jac")) != NULL)
+        hh_point_jacobian(&self->model, q, f, px, py, jac);
+    hh_py_release_all(&h);
+    return jac != NULL ? Py_NewRef(Py_None) : NULL;
 }
 
 static PyObject *py_mass_matrix(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     ModelObject *self;
-    Py_buffer q, out;
+    held_buffers h = {.held = 0};
+    const double *q;
+    double *mass = NULL;
     if (hh_py_nargs(nargs, 3, "mass_matrix") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
         return NULL;
-    if (hh_py_doubles(args[1], &q, HH_JOINTS, 0, "q") != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &out, HH_JOINTS * HH_JOINTS, 1, "mass") != 0) {
-        PyBuffer_Release(&q);
-        return NULL;
-    }
-    hh_mass_matrix(&self->model, q.buf, out.buf);
-    PyBuffer_Release(&out);
-    PyBuffer_Release(&q);
-    Py_RETURN_NONE;
+    if ((q = hh_py_hold(&h, args[1], HH_JOINTS, 0, "q")) != NULL &&
+        (mass = hh_py_hold(&h, args[2], HH_JOINTS * HH_JOINTS, 1, "mass")) != NULL)
+        hh_mass_matrix(&self->model, q, mass);
+    hh_py_release_all(&h);
+    return mass != NULL ? Py_NewRef(Py_None) : NULL;
 }
 
 static PyObject *py_bias(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     ModelObject *self;
-    Py_buffer q, qd, out;
+    held_buffers h = {.held = 0};
+    const double *q, *qd;
+    double *bias = NULL;
     if (hh_py_nargs(nargs, 4, "bias") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
         return NULL;
-    if (hh_py_doubles(args[1], &q, HH_JOINTS, 0, "q") != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &qd, HH_JOINTS, 0, "qd") != 0) {
-        PyBuffer_Release(&q);
-        return NULL;
-    }
-    if (hh_py_doubles(args[3], &out, HH_JOINTS, 1, "bias") != 0) {
-        PyBuffer_Release(&qd);
-        PyBuffer_Release(&q);
-        return NULL;
-    }
-    hh_bias(&self->model, q.buf, qd.buf, out.buf);
-    PyBuffer_Release(&out);
-    PyBuffer_Release(&qd);
-    PyBuffer_Release(&q);
-    Py_RETURN_NONE;
+    if ((q = hh_py_hold(&h, args[1], HH_JOINTS, 0, "q")) != NULL &&
+        (qd = hh_py_hold(&h, args[2], HH_JOINTS, 0, "qd")) != NULL &&
+        (bias = hh_py_hold(&h, args[3], HH_JOINTS, 1, "bias")) != NULL)
+        hh_bias(&self->model, q, qd, bias);
+    hh_py_release_all(&h);
+    return bias != NULL ? Py_NewRef(Py_None) : NULL;
 }
 
 PyMethodDef hh_py_model_methods[] = {

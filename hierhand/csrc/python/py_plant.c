@@ -17,45 +17,38 @@ static ModelObject *stepping_model(PyObject *obj)
     return self;
 }
 
-static int state_buffer(ModelObject *self, PyObject *obj, Py_buffer *view, int writable)
+static Py_ssize_t state_size(ModelObject *self)
 {
-    return hh_py_doubles(obj, view, (Py_ssize_t)hh_state_size(&self->model), writable, "state");
+    return (Py_ssize_t)hh_state_size(&self->model);
 }
 
 static PyObject *py_advance(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     ModelObject *self;
-    Py_buffer state, tau, f_ext, rows;
+    held_buffers h = {.held = 0};
+    double *state, *rows;
+    const double *tau, *f_ext;
     PyObject *result = NULL;
     if (hh_py_nargs(nargs, 5, "advance") != 0 || (self = stepping_model(args[0])) == NULL)
         return NULL;
-    if (state_buffer(self, args[1], &state, 1) != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &tau, HH_JOINTS, 0, "tau") != 0)
-        goto release_state;
-    if (hh_py_doubles(args[3], &f_ext, 3, 0, "f_ext") != 0)
-        goto release_tau;
-    if (hh_py_doubles(args[4], &rows, -1, 1, "rows") != 0)
-        goto release_f_ext;
-    Py_ssize_t values = rows.len / 8;
-    if (values % HH_N_OUTPUTS != 0) {
-        PyErr_Format(PyExc_ValueError, "rows must hold whole output rows of %d values, got %zd values",
-                     HH_N_OUTPUTS, values);
-    } else {
-        long done;
-        int which;
-        int code = hh_advance(&self->model, &self->work, state.buf, tau.buf, f_ext.buf,
-                              (long)(values / HH_N_OUTPUTS), rows.buf, HH_N_OUTPUTS, &done, &which);
-        result = status(code, done, which);
+    if ((state = hh_py_hold(&h, args[1], state_size(self), 1, "state")) != NULL &&
+        (tau = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau")) != NULL &&
+        (f_ext = hh_py_hold(&h, args[3], 3, 0, "f_ext")) != NULL &&
+        (rows = hh_py_hold(&h, args[4], -1, 1, "rows")) != NULL) {
+        Py_ssize_t values = hh_py_last_count(&h);
+        if (values % HH_N_OUTPUTS != 0) {
+            PyErr_Format(PyExc_ValueError, "rows must hold whole output rows of %d values, got %zd values",
+                         HH_N_OUTPUTS, values);
+        } else {
+            long done;
+            int which;
+            int code = hh_advance(&self->model, &self->work, state, tau, f_ext, (long)(values / HH_N_OUTPUTS), rows,
+                                  HH_N_OUTPUTS, &done, &which);
+            result = status(code, done, which);
+        }
     }
-    PyBuffer_Release(&rows);
-release_f_ext:
-    PyBuffer_Release(&f_ext);
-release_tau:
-    PyBuffer_Release(&tau);
-release_state:
-    PyBuffer_Release(&state);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -63,23 +56,20 @@ static PyObject *py_step(PyObject *module, PyObject *const *args, Py_ssize_t nar
 {
     (void)module;
     ModelObject *self;
-    Py_buffer state, tau, f_ext;
+    held_buffers h = {.held = 0};
+    double *state;
+    const double *tau, *f_ext;
     PyObject *result = NULL;
     if (hh_py_nargs(nargs, 4, "step") != 0 || (self = stepping_model(args[0])) == NULL)
         return NULL;
-    if (state_buffer(self, args[1], &state, 1) != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &tau, HH_JOINTS, 0, "tau") != 0)
-        goto release_state;
-    if (hh_py_doubles(args[3], &f_ext, 3, 0, "f_ext") == 0) {
+    if ((state = hh_py_hold(&h, args[1], state_size(self), 1, "state")) != NULL &&
+        (tau = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau")) != NULL &&
+        (f_ext = hh_py_hold(&h, args[3], 3, 0, "f_ext")) != NULL) {
         int done, which;
-        int code = hh_step(&self->model, &self->work, state.buf, tau.buf, f_ext.buf, &done, &which);
+        int code = hh_step(&self->model, &self->work, state, tau, f_ext, &done, &which);
         result = status(code, done, which);
-        PyBuffer_Release(&f_ext);
     }
-    PyBuffer_Release(&tau);
-release_state:
-    PyBuffer_Release(&state);
+    hh_py_release_all(&h);
     return result;
 }
 
@@ -87,50 +77,46 @@ static PyObject *py_output(PyObject *module, PyObject *const *args, Py_ssize_t n
 {
     (void)module;
     ModelObject *self;
-    Py_buffer state, row;
+    held_buffers h = {.held = 0};
+    const double *state;
+    double *row;
+    PyObject *result = NULL;
     if (hh_py_nargs(nargs, 3, "output") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
         return NULL;
-    if (state_buffer(self, args[1], &state, 0) != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &row, HH_N_OUTPUTS, 1, "row") != 0) {
-        PyBuffer_Release(&state);
-        return NULL;
+    if ((state = hh_py_hold(&h, args[1], state_size(self), 0, "state")) != NULL &&
+        (row = hh_py_hold(&h, args[2], HH_N_OUTPUTS, 1, "row")) != NULL) {
+        int which;
+        int code = hh_output(&self->model, &self->work, state, row, &which);
+        result = status(code, 0, which);
     }
-    int which;
-    int code = hh_output(&self->model, &self->work, state.buf, row.buf, &which);
-    PyBuffer_Release(&row);
-    PyBuffer_Release(&state);
-    return status(code, 0, which);
+    hh_py_release_all(&h);
+    return result;
 }
 
 static PyObject *py_contact(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     ModelObject *self;
-    Py_buffer state, tips, wrench;
+    held_buffers h = {.held = 0};
+    const double *state;
+    double *tips, *wrench;
     PyObject *result = NULL;
     if (hh_py_nargs(nargs, 4, "contact") != 0 || (self = hh_py_model(args[0], "model")) == NULL)
         return NULL;
-    if (state_buffer(self, args[1], &state, 0) != 0)
-        return NULL;
-    if (hh_py_doubles(args[2], &tips, HH_FINGERS * 3, 1, "tips") != 0)
-        goto release_state;
-    if (hh_py_doubles(args[3], &wrench, HH_FINGERS * HH_N_WRENCH, 1, "wrench") == 0) {
+    if ((state = hh_py_hold(&h, args[1], state_size(self), 0, "state")) != NULL &&
+        (tips = hh_py_hold(&h, args[2], HH_FINGERS * 3, 1, "tips")) != NULL &&
+        (wrench = hh_py_hold(&h, args[3], HH_FINGERS * HH_N_WRENCH, 1, "wrench")) != NULL) {
         int which;
-        int code = hh_contact(&self->model, &self->work, state.buf, &which);
-        double *t = tips.buf, *wr = wrench.buf;
+        int code = hh_contact(&self->model, &self->work, state, &which);
         for (int f = 0; f < HH_FINGERS; f++) {
             for (int i = 0; i < 3; i++)
-                t[3 * f + i] = self->work.tip[f][i];
+                tips[3 * f + i] = self->work.tip[f][i];
             for (int i = 0; i < HH_N_WRENCH; i++)
-                wr[HH_N_WRENCH * f + i] = self->work.wrench[f][i];
+                wrench[HH_N_WRENCH * f + i] = self->work.wrench[f][i];
         }
         result = status(code, 0, which);
-        PyBuffer_Release(&wrench);
     }
-    PyBuffer_Release(&tips);
-release_state:
-    PyBuffer_Release(&state);
+    hh_py_release_all(&h);
     return result;
 }
 
