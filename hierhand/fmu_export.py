@@ -37,7 +37,7 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 import hierhand
-from hierhand import native_sources
+from hierhand import _native, native_sources
 
 FMU_DIR = Path("fmu")
 """Where exports go by default: ``fmu/`` under the current folder, like ``runs/`` for results."""
@@ -45,23 +45,24 @@ FMU_DIR = Path("fmu")
 INTERNAL_STEP = Fraction(1, 10000)
 DEFAULT_COMMUNICATION_STEP = 1e-3
 FMI_VERSIONS = (2, 3)
-RESOURCE_FILE = "hand_parameters.txt"  # as HH_RESOURCE_FILE in fmu_instance.h
+RESOURCE_FILE: str = _native.FMU_RESOURCE_FILE
 
-# value references, as in fmu_instance.h
-VR_TIME = 0
-VR_INPUT = 1
-VR_OUTPUT = 101
-VR_PARAM = 1001
+# value references, defined in fmu_instance.h
+VR_TIME: int = _native.LAYOUT["VR_TIME"]
+VR_INPUT: int = _native.LAYOUT["VR_TAU"]  # tau, then f_ext
+VR_OUTPUT: int = _native.LAYOUT["VR_OUTPUT"]
+VR_PARAM: int = _native.LAYOUT["VR_PARAM"]
 
 PACKAGE_DIR = Path(hierhand.__file__).resolve().parent
 SOURCE_DIR = PACKAGE_DIR / "csrc"
 BINARY_DIR = PACKAGE_DIR / "fmu_binaries"
 
-LOG_CATEGORIES = {
-    "logEvents": "instantiation, initialization and other events (when logging is on)",
-    "logStatusWarning": "warnings",
-    "logStatusError": "errors: invalid parameters, rejected steps, numerical failure",
-}
+LOG_CATEGORIES = dict(zip(_native.FMU_LOG_CATEGORIES, (
+    "instantiation, initialization and other events (when logging is on)",
+    "warnings",
+    "errors: invalid parameters, rejected steps, numerical failure",
+)))
+"""The categories fmu_instance.h logs under (events, warnings, errors), described."""
 
 PORT_DOCS = {
     "tau": "joint torques [N m]: thumb joints 1-3, fore 1-3, middle 1-3 (proximal to distal)",
@@ -97,13 +98,13 @@ def export_plant_fmu(out: Path | None = None, fmi: int = 2, hand: Path | None = 
     from hierhand.model import load_hand
 
     loaded = load_hand(hand if hand is not None else {})
-    library = fmu_library(fmi)
+    library = fmu_library(fmi).read_bytes()
     sources = {name: (SOURCE_DIR / name).read_bytes() for name in native_sources.fmu_source_files(fmi)}
-    identifier = _identifier(fmi, loaded.vector, library.read_bytes(), sources)
+    identifier = _identifier(fmi, loaded.vector, library, sources)
     token = "{" + str(uuid.UUID(hashlib.sha256(identifier.encode()).hexdigest()[:32])) + "}"
     files = {
         "modelDescription.xml": model_description(fmi, identifier, token, loaded),
-        f"binaries/{_platform_folder(fmi)}/{identifier}.so": library.read_bytes(),
+        f"binaries/{_platform_folder(fmi)}/{identifier}.so": library,
         f"resources/{RESOURCE_FILE}": resource_file(token, loaded).encode(),
         **{f"sources/{name}": data for name, data in sources.items()},
     }

@@ -31,7 +31,7 @@ def _paths(names: list[str]) -> list[str]:
 
 
 EXTENSION_SOURCES = _paths(CORE + CONTROL + BINDING)
-EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + ["python/py_common.h"])
+EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + FMU_HEADERS + ["python/py_common.h"])
 """Headers whose change must rebuild the extension."""
 FMI_LIBRARIES = {fmi: _paths(CORE + FMU_COMMON + [wrapper]) for fmi, wrapper in FMI_WRAPPERS.items()}
 FMI_DEPENDS = _paths(CORE_HEADERS + FMU_HEADERS)

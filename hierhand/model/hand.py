@@ -18,7 +18,6 @@ import numpy as np
 
 from .. import _native
 from .handfile import HandParams, merge_with_default, parse_hand, read_hand_file
-from .hand_vector import hand_vector
 from .layout import (
     E_COUNT,
     E_DX,
@@ -69,7 +68,7 @@ class Hand:
     def __init__(self, params: HandParams):
         self.params = params
         self.names = tuple(f.name for f in params.fingers)
-        self.vector = hand_vector(params.to_dict())
+        self.vector = params.vector
         self.native = _native.Model(self.vector)
         self.fingers = np.empty((3, N_FINGER_PARAMS))
         self.body = np.empty(N_BODY_PARAMS)

@@ -21,6 +21,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
+import numpy as np
 import yaml
 
 from .. import _native
@@ -112,6 +113,13 @@ class HandParams:
                 link["com"] = [link.pop("com_along"), link.pop("com_across")]
         return _lists(d)
 
+    @functools.cached_property
+    def vector(self) -> np.ndarray:
+        """The hand's numbers in the C core's order (read-only; computed once)."""
+        vector = hand_vector(self.to_dict())
+        vector.flags.writeable = False
+        return vector
+
 
 def _lists(x: Any) -> Any:
     if isinstance(x, dict):
@@ -190,7 +198,7 @@ def parse_hand(data: Mapping[str, Any], source: str | None = None) -> HandParams
     params = HandParams(gravity=gravity, fingers=fingers, object=obj, contact=contact)
     derived = set() if "inertia" in data["object"] else {"object.inertia"}  # follows mass and size
     names = parameter_names()
-    problems = [f"{hand_file_path(names[i])} {text}" for i, text in _native.check_hand(hand_vector(params.to_dict()))
+    problems = [f"{hand_file_path(names[i])} {text}" for i, text in _native.check_hand(params.vector)
                 if names[i] not in derived]
     if problems:
         raise HandFileError(problems, source)
