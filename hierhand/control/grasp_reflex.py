@@ -39,6 +39,7 @@ from blocks import Block
 from ..model import load_hand
 from .reflex_kernel import (
     N_OUT,
+    WHOLE_SHARE,
     O_ACTIVE,
     O_FORCE,
     O_TAU,
@@ -79,18 +80,23 @@ class GraspReflex(Block):
         "max_force": "largest commanded force per fingertip, N (anti-windup limit)",
         "approach_force": "force, N, that pushes a 'grasp' finger towards the others until it touches",
         "contact_threshold": "normal force, N, above which a finger counts as in contact",
+        "release_share": "a finger whose actuator command keeps less than this share of its grasping torque "
+                         "(input 'share', from the suppresser) is left to voluntary motion: its force need no "
+                         "longer drives the integrator",
     }
 
     def __init__(self, gravity=None, fingers=None, object=None, contact=None,  # noqa: A002
                  grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,
-                 approach_force: float = 0.5, contact_threshold: float = 0.05):
+                 approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.8):
         self.hand = load_hand({"gravity": gravity, "fingers": fingers, "object": object, "contact": contact})
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
                             ("max_force", max_force), ("contact_threshold", contact_threshold)):
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
                 raise ValueError(f"parameter '{name}' must be a positive number, got {value!r}")
+        if not (isinstance(release_share, (int, float)) and 0 <= release_share <= 1):
+            raise ValueError(f"parameter 'release_share' must be in [0, 1], got {release_share!r}")
         if not 0 <= margin < 1:
             raise ValueError(f"parameter 'margin' must be in [0, 1), got {margin!r}")
         if not 0 <= approach_force <= max_force:
@@ -100,10 +106,12 @@ class GraspReflex(Block):
         self.ki, self.min_force, self.max_force = float(ki), float(min_force), float(max_force)
         self.ratio_target = float(safety_ratio) / (1.0 + float(margin))
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
+        self.release_share = float(release_share)
         # the native calls' flat parameter array; the period (P_DT) is set by bind
         self._params = pack_params(self.threshold, self.approach_force, self.ki, np.nan, self.min_force,
-                                   self.ratio_target, self.max_force, self.initial)
-        self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6}
+                                   self.ratio_target, self.max_force, self.initial, self.release_share)
+        self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6, "share": 3}
+        self.input_defaults = {"share": WHOLE_SHARE}
         self.outputs = {"tau_g": 9, "force": 3, "active": 3}
         self.feedthrough = {"tau_g": {"q", "tip", "fn", "normal"}, "force": {"tip", "fn", "normal"},
                             "active": {"fn"}}
@@ -155,4 +163,5 @@ class GraspReflex(Block):
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
         """The integral step of the grasp force scale and the touched flags (a fresh array)."""
-        return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"])
+        return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"],
+                             inputs.get("share", WHOLE_SHARE))

@@ -55,7 +55,7 @@ OK: int = _L["MANIP_OK"]
 UNREACHABLE: int = _L["MANIP_UNREACHABLE"]
 
 manipulation_output = _native.manipulation_output
-"""``manipulation_output(model, params, waypoints, meta, t, q, qd, fn, out) -> status``: fill
+"""``manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, out) -> status``: fill
 ``out`` (3, 9) with the rows tau_m, tau_ff, q_ref (``out`` incomplete unless ``OK``).
 Takes C-contiguous float64 arrays only (``TypeError`` otherwise)."""
 

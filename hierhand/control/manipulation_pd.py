@@ -12,9 +12,12 @@ that raises a descriptive error when a target turns out unreachable during the r
 
 Outputs: ``tau_m``, the PD torque of the voluntary motion (what the suppresser weighs
 against the grasping torque), and ``tau_ff``, a feedforward that keeps the 10 ms loop's
-gains small: the fingers' own gravity torques and the object's weight shared equally by
-the fingers in contact (``J^T`` of ``-m g / k``); without it the soft PD lets a held
-object sag by millimetres. The suppresser adds ``tau_ff`` to the actuator command after
+gains small: the fingers' own gravity torques and the object's load shared equally by
+the fingers in contact (``J^T`` of ``-(m g + f_support) / k``); without it the soft PD lets
+a held object sag by millimetres. The optional input ``support`` is the force something
+else applies to the object (the support that carries it until the hand takes it over):
+the fingers carry only the rest, or they would lift the object a second time and load
+every contact tangentially while the grasp closes. The suppresser adds ``tau_ff`` to the actuator command after
 suppression. Keeping the feedforward out of ``tau_m`` matters: it is not voluntary
 motion, and a finger that merely carries the object must not have its grasp suppressed.
 """
@@ -50,7 +53,7 @@ class ManipulationPD(Block):
         "kp": "joint stiffness, N m/rad (scalar or 9 values)",
         "kd": "joint damping, N m s/rad (scalar or 9 values)",
         "gravity_compensation": "add the fingers' own gravity torques",
-        "load_compensation": "add J^T of the object's weight shared by the fingers in contact",
+        "load_compensation": "add J^T of the object's load (weight plus input support) shared by the fingers in contact",
         "contact_threshold": "normal force, N, above which a finger carries part of the object",
     }
 
@@ -68,7 +71,8 @@ class ManipulationPD(Block):
         self.threshold = float(contact_threshold)
         self.weight = self.hand.params.object.mass * self.hand.gravity
         self.trajectories = self.parse_trajectories(trajectories or {})
-        self.inputs = {"q": 9, "qd": 9, "fn": 3}
+        self.inputs = {"q": 9, "qd": 9, "fn": 3, "support": 3}
+        self.input_defaults = {"support": np.zeros(3)}
         self.outputs = {"tau_m": 9, "tau_ff": 9, "q_ref": 9}
         self.feedthrough = True
         # the native output's flat arrays (built from the attributes above, once)
@@ -131,7 +135,7 @@ class ManipulationPD(Block):
         out = np.empty((3, 9))
         try:
             status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, inputs["q"],
-                                         inputs["qd"], inputs["fn"], out)
+                                         inputs["qd"], inputs["fn"], inputs.get("support", self.input_defaults["support"]), out)
         except (TypeError, ValueError):
             return self.output_reference(t, state, inputs)
         if status != OK:
@@ -146,7 +150,8 @@ class ManipulationPD(Block):
         tau_ff = self.hand.bias(q, np.zeros(9)) if self.gravity_compensation else np.zeros(9)
         carrying = inputs["fn"] > self.threshold
         if self.load_compensation and carrying.any():
-            share = -self.weight / carrying.sum()
+            support = np.asarray(inputs.get("support", self.input_defaults["support"]), dtype=float)
+            share = -(self.weight + support[:2]) / carrying.sum()
             jac = self.hand.tip_jacobians(q)
             for f in np.flatnonzero(carrying):
                 tau_ff[3 * f:3 * f + 3] += jac[f].T @ share

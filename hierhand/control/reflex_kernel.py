@@ -33,6 +33,7 @@ P_RATIO: int = _L["REFLEX_P_RATIO"]  # ratio_target = safety_ratio / (1 + margin
 P_MAX_FORCE: int = _L["REFLEX_P_MAX_FORCE"]
 P_INITIAL: int = _L["REFLEX_P_INITIAL"]  # three slots: 1.0 for the fingers listed in 'grasp'
 P_COINCIDENT_RTOL: int = _L["REFLEX_P_COINCIDENT_RTOL"]  # internal_forces._COINCIDENT_RTOL
+P_RELEASE_SHARE: int = _L["REFLEX_P_RELEASE_SHARE"]  # below this share of its grasp torque a finger is let go
 N_PARAMS: int = _L["REFLEX_N_PARAMS"]
 
 # -- output vector of reflex_output: tau_g(9) force(3) active(3) ------------------------
@@ -48,9 +49,12 @@ _forces = _native.reflex_forces
 _output = _native.reflex_output
 _update = _native.reflex_update
 
+WHOLE_SHARE = np.ones(3)
+"""The ``share`` input when nothing overrides the reflex: every finger's command keeps its whole grasping torque."""
+
 
 def pack_params(threshold: float, approach_force: float, ki: float, dt: float, min_force: float,
-                ratio_target: float, max_force: float, initial) -> np.ndarray:
+                ratio_target: float, max_force: float, initial, release_share: float = 0.8) -> np.ndarray:
     """The reflex parameters as the native calls' flat array (``initial``: 3 booleans)."""
     p = np.empty(N_PARAMS)
     p[P_THRESHOLD] = threshold
@@ -62,6 +66,7 @@ def pack_params(threshold: float, approach_force: float, ki: float, dt: float, m
     p[P_MAX_FORCE] = max_force
     p[P_INITIAL : P_INITIAL + 3] = np.asarray(initial, dtype=bool)
     p[P_COINCIDENT_RTOL] = _COINCIDENT_RTOL
+    p[P_RELEASE_SHARE] = release_share
     return p
 
 
@@ -110,18 +115,20 @@ def reflex_output(model, params, state, q, tip, normal, fn) -> np.ndarray:
     return out
 
 
-def reflex_update(params, state, tip, normal, fn, ft) -> np.ndarray:
+def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.ndarray:
     """(4,) fresh next state ``[scale, touched (3)]``.
 
-    With at least two fingers both in the grasp and touching, the scale moves by
-    ``ki * dt * max_i (need_i - fn_i) / max(g_i . n_i, 1e-3)``, ``need_i =
-    max(min_force |g_i|, |ft_i| / ratio_target)``, clipped to ``[0, max_force]``.
+    With at least two fingers in the grasp, touching and held by the reflex, the scale
+    moves by ``ki * dt * max_i (need_i - fn_i) / max(g_i . n_i, 1e-3)`` over those fingers,
+    ``need_i = max(min_force |g_i|, |ft_i| / ratio_target)``, clipped to
+    ``[0, max_force]``. A finger is held by the reflex unless its actuator command keeps less than
+    ``release_share`` of its grasping torque (``share``, 3 values: the suppresser's output).
     """
     new = np.empty(N_STATE)
     try:
-        _update(params, state, tip, normal, fn, ft, new)
+        _update(params, state, tip, normal, fn, ft, share, new)
     except TypeError:
-        _update(params, _f64(state), _f64(tip), _f64(normal), _f64(fn), _f64(ft), new)
+        _update(params, _f64(state), _f64(tip), _f64(normal), _f64(fn), _f64(ft), _f64(share), new)
     return new
 
 

@@ -9,7 +9,7 @@ import numpy as np
 from blocks import Block
 
 from .. import _native
-from .suppression import MODES, suppress
+from .suppression import MODES, finger_shares, suppress
 
 _L = _native.LAYOUT
 P_S_A: int = _L["SUPPRESS_P_S_A"]  # 9 sigmoid steepnesses
@@ -21,6 +21,7 @@ MAGNITUDE: int = _L["SUPPRESS_MAGNITUDE"]
 SIGNED: int = _L["SUPPRESS_SIGNED"]
 O_TAU: int = _L["SUPPRESS_O_TAU"]
 O_TAU_G_EFF: int = _L["SUPPRESS_O_TAU_G_EFF"]
+O_SHARE: int = _L["SUPPRESS_O_SHARE"]
 N_OUT: int = _L["SUPPRESS_N_OUT"]
 
 suppress_output = _native.suppress
@@ -77,7 +78,7 @@ class Suppresser(Block):
         self.enabled = bool(enabled)
         self.inputs = {"tau_g": 9, "tau_m": 9, "tau_ff": 9}
         self.input_defaults = {"tau_ff": np.zeros(9)}
-        self.outputs = {"tau": 9, "tau_g_eff": 9}
+        self.outputs = {"tau": 9, "tau_g_eff": 9, "share": 3}
         self.feedthrough = True
         self._params = pack_params(self.S_a, self.S_b,
                                    (MAGNITUDE if mode == "magnitude" else SIGNED) if self.enabled else PASS)
@@ -93,11 +94,13 @@ class Suppresser(Block):
                             inputs.get("tau_ff", self.input_defaults["tau_ff"]), out)
         except (TypeError, ValueError):
             return self.output_reference(t, state, inputs)
-        return {"tau": out[O_TAU:O_TAU + 9], "tau_g_eff": out[O_TAU_G_EFF:O_TAU_G_EFF + 9]}
+        return {"tau": out[O_TAU:O_TAU + 9], "tau_g_eff": out[O_TAU_G_EFF:O_TAU_G_EFF + 9],
+                "share": out[O_SHARE:O_SHARE + 3]}
 
     def output_reference(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """``output`` in numpy, on ``suppression.suppress``."""
         tau_g, tau_m = inputs["tau_g"], inputs["tau_m"]
         tau_ff = np.asarray(inputs.get("tau_ff", self.input_defaults["tau_ff"]), dtype=float)
         effective = suppress(tau_g, tau_m, self.S_a, self.S_b, self.mode) if self.enabled else tau_g.copy()
-        return {"tau": (effective + tau_m) + tau_ff, "tau_g_eff": effective}
+        return {"tau": (effective + tau_m) + tau_ff, "tau_g_eff": effective,
+                "share": finger_shares(tau_g, effective, tau_m) if self.enabled else np.ones(3)}

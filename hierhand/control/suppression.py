@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["sigmoid", "suppress", "MODES"]
+__all__ = ["sigmoid", "suppress", "finger_shares", "MODES"]
 
 MODES = ("magnitude", "signed")
 
@@ -53,3 +53,17 @@ def suppress(tau_g: Any, tau_m: Any, S_a: Any, S_b: Any, mode: str = "magnitude"
     g = np.abs(tau_m) if mode == "magnitude" else tau_m
     out = np.asarray(tau_g, dtype=float) * sigmoid(s_a * (np.asarray(S_b, dtype=float) - g))
     return float(out) if np.ndim(out) == 0 else out
+
+
+def finger_shares(tau_g: Any, tau_g_eff: Any, tau_m: Any) -> np.ndarray:
+    """Per finger (3), how much of its grasping torque survives in the voluntary part of its
+    command: ``(tau_g_eff_i + tau_m_i) . tau_g_i / |tau_g_i|^2``, 1 where ``tau_g_i`` is zero.
+
+    1 means the reflex's torque reaches the joints whole; below 1 the suppresser and the
+    manipulation torque are taking the finger over (0: cancelled, negative: pulled back).
+    """
+    g = np.asarray(tau_g, dtype=float).reshape(3, 3)
+    kept = (np.asarray(tau_g_eff, dtype=float) + np.asarray(tau_m, dtype=float)).reshape(3, 3)
+    squared = (g * g).sum(axis=1)
+    along = (kept * g).sum(axis=1)
+    return np.where(squared > 0.0, along / np.where(squared > 0.0, squared, 1.0), 1.0)

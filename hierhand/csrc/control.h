@@ -41,11 +41,12 @@ enum {
     HH_REFLEX_P_MAX_FORCE = 6, /* largest force scale, N */
     HH_REFLEX_P_INITIAL = 7, /* three: non-zero for the fingers listed in 'grasp' */
     HH_REFLEX_P_COINCIDENT_RTOL = 10, /* points this close, relative to their size, coincide */
-    HH_REFLEX_N_PARAMS = 11
+    HH_REFLEX_P_RELEASE_SHARE = 11, /* a finger whose command keeps less of its grasp torque is let go */
+    HH_REFLEX_N_PARAMS = 12
 };
 
-/* -- state: [force scale, has touched the object (3)] ------------------------------------ */
-enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_TOUCHED = 1, HH_REFLEX_N_STATE = 4 };
+/* -- state: [force scale, handed to voluntary motion (3)] --------------------------------- */
+enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_RELEASED = 1, HH_REFLEX_N_STATE = 4 };
 
 /* -- output of hh_reflex_output: tau_g (9), |f_i| (3), in the grasp (3, 0 or 1) ---------- */
 enum { HH_REFLEX_O_TAU = 0, HH_REFLEX_O_FORCE = 9, HH_REFLEX_O_ACTIVE = 12, HH_REFLEX_N_OUT = 15 };
@@ -62,6 +63,9 @@ typedef struct hh_reflex_inputs {
     const double *tip; /* 9: per finger tip centre x, y and link-3 angle */
     const double *normal; /* 6: per finger the contact normal (into the object) */
     const double *fn; /* 3: normal force per finger */
+    const double *share; /* 3: per finger, the share of its grasping torque its actuator command keeps
+                            (the suppresser's output 'share'; 1 when nothing overrides the reflex);
+                            read by hh_reflex_update only */
 } hh_reflex_inputs;
 
 /* The internal force per finger at unit scale, g (3 x 2: largest row length 1, zero
@@ -153,23 +157,28 @@ void hh_trajectory_sample(const hh_trajectories *tr, int f, double t, double pos
  * and from the last waypoint on) has a non-zero component, else 0. */
 int hh_trajectory_moving(const hh_trajectories *tr, int f, double t);
 
-/* out (HH_MANIP_N_OUT) at time t, joint angles q (9), rates qd (9) and normal forces fn
- * (3): tau_m = kp (q_ref - q) + kd (qd_ref - qd), tau_ff the gravity and load
- * feedforward, q_ref. HH_MANIP_OK or HH_MANIP_UNREACHABLE + f (out then incomplete). */
+/* out (HH_MANIP_N_OUT) at time t, joint angles q (9), rates qd (9), normal forces fn (3)
+ * and the force a support applies to the object (support: fx, fy, torque): tau_m = kp
+ * (q_ref - q) + kd (qd_ref - qd), tau_ff the gravity and load feedforward (the load: the
+ * object's weight plus the support force), q_ref. HH_MANIP_OK or HH_MANIP_UNREACHABLE + f
+ * (out then incomplete). */
 int hh_manipulation_output(const hh_model *m, const double *params, const hh_trajectories *tr, double t,
-                           const double *q, const double *qd, const double *fn, double *out);
+                           const double *q, const double *qd, const double *fn, const double *support, double *out);
 
 /* == suppresser (suppresser.c) ===========================================================
  *
  * tau_g_eff = tau_g * sigmoid(S_a (S_b - g(tau_m))) per joint, g = |tau_m| (magnitude) or
- * tau_m (signed), or tau_g unchanged (pass); the command is tau_g_eff + tau_m + tau_ff. */
+ * tau_m (signed), or tau_g unchanged (pass); the command is tau_g_eff + tau_m + tau_ff.
+ * share_i, per finger, is how much of the finger's grasping torque tau_g_i survives in the
+ * voluntary part of its command: (tau_g_eff_i + tau_m_i) . tau_g_i / |tau_g_i|^2, 1 where
+ * tau_g_i is zero or in pass mode (no suppresser: nothing hands a finger over). */
 
 /* -- parameters: params[HH_SUPPRESS_P_*] ------------------------------------------------ */
 enum { HH_SUPPRESS_P_S_A = 0, HH_SUPPRESS_P_S_B = 9, HH_SUPPRESS_P_MODE = 18, HH_SUPPRESS_N_PARAMS = 19 };
 enum { HH_SUPPRESS_PASS = 0, HH_SUPPRESS_MAGNITUDE = 1, HH_SUPPRESS_SIGNED = 2 }; /* params[P_MODE] */
 
-/* -- output: tau (9), tau_g_eff (9) ----------------------------------------------------- */
-enum { HH_SUPPRESS_O_TAU = 0, HH_SUPPRESS_O_TAU_G_EFF = 9, HH_SUPPRESS_N_OUT = 18 };
+/* -- output: tau (9), tau_g_eff (9), share (3) ------------------------------------------ */
+enum { HH_SUPPRESS_O_TAU = 0, HH_SUPPRESS_O_TAU_G_EFF = 9, HH_SUPPRESS_O_SHARE = 18, HH_SUPPRESS_N_OUT = 21 };
 
 /* out (HH_SUPPRESS_N_OUT) from the torques tau_g, tau_m, tau_ff (9 each). */
 void hh_suppress(const double *params, const double *tau_g, const double *tau_m, const double *tau_ff, double *out);

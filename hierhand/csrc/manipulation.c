@@ -177,9 +177,12 @@ static int reference(const hh_model *m, const double *params, const hh_trajector
     return HH_MANIP_OK;
 }
 
-/* The fingers' gravity torques (if enabled) plus J^T of the object's weight shared by the
- * fingers carrying it (if enabled), into tau_ff (9). */
-static void feedforward(const hh_model *m, const double *params, const double *q, const double *fn, double *tau_ff)
+/* The fingers' gravity torques (if enabled) plus J^T of the object's load shared by the
+ * fingers carrying it (if enabled), into tau_ff (9). The load is the weight less what the
+ * support carries: before the hand-over the fingers must not lift the object a second
+ * time, which would load every contact tangentially while the grasp closes. */
+static void feedforward(const hh_model *m, const double *params, const double *q, const double *fn,
+                        const double *support, double *tau_ff)
 {
     for (int j = 0; j < HH_JOINTS; j++)
         tau_ff[j] = 0.0;
@@ -195,8 +198,8 @@ static void feedforward(const hh_model *m, const double *params, const double *q
     static const double at_rest[3] = {0.0, 0.0, 0.0};
     double sx = 0.0, sy = 0.0; /* each carrying finger's share of the weight */
     if (carrying) {
-        sx = -params[HH_MANIP_P_WX] / carrying;
-        sy = -params[HH_MANIP_P_WY] / carrying;
+        sx = -(params[HH_MANIP_P_WX] + support[0]) / carrying;
+        sy = -(params[HH_MANIP_P_WY] + support[1]) / carrying;
     }
     for (int f = 0; f < HH_FINGERS; f++) {
         const double *finger = m->fingers[f];
@@ -215,7 +218,7 @@ static void feedforward(const hh_model *m, const double *params, const double *q
 }
 
 int hh_manipulation_output(const hh_model *m, const double *params, const hh_trajectories *tr, double t,
-                           const double *q, const double *qd, const double *fn, double *out)
+                           const double *q, const double *qd, const double *fn, const double *support, double *out)
 {
     double qd_ref[HH_JOINTS];
     double *q_ref = out + HH_MANIP_O_Q_REF;
@@ -225,6 +228,6 @@ int hh_manipulation_output(const hh_model *m, const double *params, const hh_tra
     for (int j = 0; j < HH_JOINTS; j++)
         out[HH_MANIP_O_TAU_M + j] = params[HH_MANIP_P_KP + j] * (q_ref[j] - q[j]) +
                                      params[HH_MANIP_P_KD + j] * (qd_ref[j] - qd[j]);
-    feedforward(m, params, q, fn, out + HH_MANIP_O_TAU_FF);
+    feedforward(m, params, q, fn, support, out + HH_MANIP_O_TAU_FF);
     return HH_MANIP_OK;
 }

@@ -81,7 +81,7 @@ int hh_reflex_directions(const double *params, const double *state, const hh_ref
     for (int i = 0; i < 3; i++) {
         touching[i] = in->fn[i] > threshold;
         int approaching =
-            params[HH_REFLEX_P_INITIAL + i] != 0.0 && state[HH_REFLEX_S_TOUCHED + i] == 0.0 && !touching[i];
+            params[HH_REFLEX_P_INITIAL + i] != 0.0 && state[HH_REFLEX_S_RELEASED + i] == 0.0 && !touching[i];
         grasp[i] = touching[i] || approaching;
         g[i][0] = 0.0;
         g[i][1] = 0.0;
@@ -188,6 +188,14 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
     return HH_REFLEX_OK;
 }
 
+/* A finger the suppresser has handed to voluntary motion: its command keeps less than
+ * release_share of its grasping torque. Its contact force is no longer the reflex's to
+ * restore; counting it would wind the shared scale up while the finger is pulled off. */
+static int released(const double *params, const double *share, int finger)
+{
+    return share != NULL && share[finger] < params[HH_REFLEX_P_RELEASE_SHARE];
+}
+
 int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
                      double *next)
 {
@@ -203,7 +211,7 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
     int held = 0;
     double shortfall = -INFINITY;
     for (int i = 0; i < 3; i++)
-        if (grasp[i] && touching[i]) {
+        if (grasp[i] && touching[i] && !released(params, in->share, i)) {
             held += 1;
             double gain = g[i][0] * in->normal[2 * i] + g[i][1] * in->normal[2 * i + 1]; /* per unit scale */
             double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
@@ -213,7 +221,11 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
     if (held >= 2)
         scale = hh_min(hh_max(scale + params[HH_REFLEX_P_KI] * dt * shortfall, 0.0), params[HH_REFLEX_P_MAX_FORCE]);
     next[HH_REFLEX_S_SCALE] = scale;
+    /* whether a finger was the reflex's or voluntary motion's when it last touched: a
+     * finger that loses contact while the reflex holds it (a bounce) is pushed back, one
+     * that voluntary motion took off is left alone */
     for (int i = 0; i < 3; i++)
-        next[HH_REFLEX_S_TOUCHED + i] = hh_max(state[HH_REFLEX_S_TOUCHED + i], touching[i] ? 1.0 : 0.0);
+        next[HH_REFLEX_S_RELEASED + i] =
+            touching[i] ? (released(params, in->share, i) ? 1.0 : 0.0) : state[HH_REFLEX_S_RELEASED + i];
     return HH_REFLEX_OK;
 }

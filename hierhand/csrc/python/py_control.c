@@ -46,13 +46,14 @@ static int reflex_arguments(held_buffers *h, PyObject *const *args, const double
     if ((*state = hh_py_hold(h, args[1], -1, 0, "state")) == NULL)
         return -1;
     if (hh_py_last_count(h) != HH_REFLEX_N_STATE) {
-        PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 4 entries [scale, touched(3)]");
+        PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 4 entries [scale, released(3)]");
         return -1;
     }
     if ((in->tip = reflex_input(h, args[2], 9, "tip")) == NULL ||
         (in->normal = reflex_input(h, args[3], 6, "normal")) == NULL ||
         (in->fn = reflex_input(h, args[4], 3, "fn")) == NULL)
         return -1;
+    in->share = NULL;
     return 0;
 }
 
@@ -143,11 +144,12 @@ static PyObject *py_reflex_update(PyObject *module, PyObject *const *args, Py_ss
     hh_reflex_inputs in;
     double *next;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 7, "reflex_update") != 0)
+    if (hh_py_nargs(nargs, 8, "reflex_update") != 0)
         return NULL;
     if (reflex_arguments(&h, args, &params, &state, &in) == 0 &&
         (ft = reflex_input(&h, args[5], 3, "ft")) != NULL &&
-        (next = hh_py_hold(&h, args[6], HH_REFLEX_N_STATE, 1, "next")) != NULL) {
+        (in.share = reflex_input(&h, args[6], 3, "share")) != NULL &&
+        (next = hh_py_hold(&h, args[7], HH_REFLEX_N_STATE, 1, "next")) != NULL) {
         int code = hh_reflex_update(params, state, &in, ft, next);
         result = code == HH_REFLEX_OK ? Py_NewRef(Py_None) : reflex_error(code);
     }
@@ -261,10 +263,10 @@ static PyObject *py_manipulation_output(PyObject *module, PyObject *const *args,
     ModelObject *model;
     hh_trajectories tr;
     double t;
-    const double *params, *q, *qd, *fn;
+    const double *params, *q, *qd, *fn, *support;
     double *out;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 9, "manipulation_output") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
+    if (hh_py_nargs(nargs, 10, "manipulation_output") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
         hh_py_double(args[4], &t, "t") != 0)
         return NULL;
     if ((params = hh_py_hold(&h, args[1], HH_MANIP_N_PARAMS, 0, "params")) != NULL &&
@@ -272,8 +274,9 @@ static PyObject *py_manipulation_output(PyObject *module, PyObject *const *args,
         (q = hh_py_hold(&h, args[5], HH_JOINTS, 0, "q")) != NULL &&
         (qd = hh_py_hold(&h, args[6], HH_JOINTS, 0, "qd")) != NULL &&
         (fn = hh_py_hold(&h, args[7], HH_FINGERS, 0, "fn")) != NULL &&
-        (out = hh_py_hold(&h, args[8], HH_MANIP_N_OUT, 1, "out")) != NULL)
-        result = PyLong_FromLong(hh_manipulation_output(&model->model, params, &tr, t, q, qd, fn, out));
+        (support = hh_py_hold(&h, args[8], 3, 0, "support")) != NULL &&
+        (out = hh_py_hold(&h, args[9], HH_MANIP_N_OUT, 1, "out")) != NULL)
+        result = PyLong_FromLong(hh_manipulation_output(&model->model, params, &tr, t, q, qd, fn, support, out));
     hh_py_release_all(&h);
     return result;
 }
@@ -316,7 +319,7 @@ PyMethodDef hh_py_control_methods[] = {
      "reflex_output(model, params, state, tip, normal, fn, q, out): tau_g (9), |f_i| (3), grasp flags (3) "
      "into out (REFLEX_N_OUT)."},
     {"reflex_update", FASTCALL(py_reflex_update),
-     "reflex_update(params, state, tip, normal, fn, ft, next): the next state (4) into next."},
+     "reflex_update(params, state, tip, normal, fn, ft, share, next): the next state (4) into next."},
     {"ik_near", FASTCALL(py_ik_near),
      "ik_near(model, finger, reach_rtol, x, y, phi, r0, r1, r2) -> (reachable, q1, q2, q3): the finger's joint "
      "angles for a tip target, on the elbow branch nearest the reference, each angle nearest it."},
@@ -325,7 +328,7 @@ PyMethodDef hh_py_control_methods[] = {
     {"trajectory_moving", FASTCALL(py_trajectory_moving),
      "trajectory_moving(waypoints, meta, finger, t) -> bool: whether its velocity at t is non-zero."},
     {"manipulation_output", FASTCALL(py_manipulation_output),
-     "manipulation_output(model, params, waypoints, meta, t, q, qd, fn, out) -> status: rows tau_m, tau_ff, "
+     "manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, out) -> status: rows tau_m, tau_ff, "
      "q_ref into out (3x9); MANIP_OK, or MANIP_UNREACHABLE + f when a target of finger f is out of reach."},
     {"suppress", FASTCALL(py_suppress),
      "suppress(params, tau_g, tau_m, tau_ff, out): tau (9) and tau_g_eff (9) into out (SUPPRESS_N_OUT)."},
@@ -341,7 +344,8 @@ static const struct {
     LAYOUT_ENTRY(HH_REFLEX_P_THRESHOLD), LAYOUT_ENTRY(HH_REFLEX_P_APPROACH), LAYOUT_ENTRY(HH_REFLEX_P_KI),
     LAYOUT_ENTRY(HH_REFLEX_P_DT), LAYOUT_ENTRY(HH_REFLEX_P_MIN_FORCE), LAYOUT_ENTRY(HH_REFLEX_P_RATIO),
     LAYOUT_ENTRY(HH_REFLEX_P_MAX_FORCE), LAYOUT_ENTRY(HH_REFLEX_P_INITIAL), LAYOUT_ENTRY(HH_REFLEX_P_COINCIDENT_RTOL),
-    LAYOUT_ENTRY(HH_REFLEX_N_PARAMS), LAYOUT_ENTRY(HH_REFLEX_S_SCALE), LAYOUT_ENTRY(HH_REFLEX_S_TOUCHED),
+    LAYOUT_ENTRY(HH_REFLEX_P_RELEASE_SHARE),
+    LAYOUT_ENTRY(HH_REFLEX_N_PARAMS), LAYOUT_ENTRY(HH_REFLEX_S_SCALE), LAYOUT_ENTRY(HH_REFLEX_S_RELEASED),
     LAYOUT_ENTRY(HH_REFLEX_N_STATE), LAYOUT_ENTRY(HH_REFLEX_O_TAU), LAYOUT_ENTRY(HH_REFLEX_O_FORCE),
     LAYOUT_ENTRY(HH_REFLEX_O_ACTIVE), LAYOUT_ENTRY(HH_REFLEX_N_OUT), LAYOUT_ENTRY(HH_REFLEX_OK),
     LAYOUT_ENTRY(HH_REFLEX_COINCIDENT), LAYOUT_ENTRY(HH_REFLEX_NO_PERIOD),
@@ -357,7 +361,7 @@ static const struct {
     LAYOUT_ENTRY(HH_SUPPRESS_P_S_A), LAYOUT_ENTRY(HH_SUPPRESS_P_S_B), LAYOUT_ENTRY(HH_SUPPRESS_P_MODE),
     LAYOUT_ENTRY(HH_SUPPRESS_N_PARAMS), LAYOUT_ENTRY(HH_SUPPRESS_PASS), LAYOUT_ENTRY(HH_SUPPRESS_MAGNITUDE),
     LAYOUT_ENTRY(HH_SUPPRESS_SIGNED), LAYOUT_ENTRY(HH_SUPPRESS_O_TAU), LAYOUT_ENTRY(HH_SUPPRESS_O_TAU_G_EFF),
-    LAYOUT_ENTRY(HH_SUPPRESS_N_OUT),
+    LAYOUT_ENTRY(HH_SUPPRESS_O_SHARE), LAYOUT_ENTRY(HH_SUPPRESS_N_OUT),
 };
 
 int hh_py_control_layout(PyObject *layout)

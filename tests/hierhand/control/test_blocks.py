@@ -68,7 +68,6 @@ def test_reflex_integrates_towards_the_force_the_friction_ratio_needs(ft):
     """With the measured normal force standing still, the scale moves at ki * shortfall."""
     reflex = make_reflex(ki=50.0, min_force=1.0, margin=0.05, safety_ratio=0.6)
     state = reflex.initial_state()
-    state[1:3] = 1.0  # thumb and fore have touched
     state[0] = 2.0
     inputs = reflex_inputs(reflex.hand, fn=[2.0, 2.0, 0.0], ft=[ft, -ft, 0.0])
     new = reflex.update(0.0, state, inputs)
@@ -84,10 +83,29 @@ def test_reflex_follows_the_contacts_and_lets_a_finger_go():
     assert grasp.tolist() == [True, True, False]
     assert np.linalg.norm(f[0]) == pytest.approx(reflex.approach_force)
     state = reflex.update(0.0, state, reflex_inputs(reflex.hand, fn=[1, 1, 0]))
-    assert state[1:].tolist() == [1.0, 1.0, 0.0]
-    # the forefinger has let go: it is no longer pushed back
+    assert state[1:].tolist() == [0.0, 0.0, 0.0]  # both held by the reflex
+    # a finger that bounces off while the reflex holds it is pushed back
+    _, grasp = reflex.forces(state, reflex_inputs(reflex.hand, fn=[1, 0, 0]))
+    assert grasp.tolist() == [True, True, False]
+    # voluntary motion takes the forefinger over (its command keeps a third of its grasp torque) ...
+    taken = dict(reflex_inputs(reflex.hand, fn=[1, 1, 1]), share=np.array([1.0, 0.3, 1.0]))
+    state = reflex.update(0.0, state, taken)
+    assert state[1:].tolist() == [0.0, 1.0, 0.0]
+    # ... so once it has let go it is no longer pushed back
     _, grasp = reflex.forces(state, reflex_inputs(reflex.hand, fn=[1, 0, 1], normals=((1, 0), (0, 0), (-1, 0))))
     assert grasp.tolist() == [True, False, True]
+
+
+def test_a_finger_handed_to_voluntary_motion_does_not_drive_the_squeeze():
+    """The forefinger's friction need would raise the scale; once its share of the grasp
+    torque is below release_share only the thumb's need counts (the anti-windup)."""
+    reflex = make_reflex(ki=50.0, min_force=1.0, release_share=0.8)
+    state = reflex.initial_state()
+    state[0] = 2.0
+    inputs = reflex_inputs(reflex.hand, fn=[2.0, 2.0, 2.0], ft=[0.0, 3.0, 0.0])
+    held = reflex.update(0.0, state, dict(inputs, share=np.ones(3)))
+    taken = reflex.update(0.0, state, dict(inputs, share=np.array([1.0, 0.79, 1.0])))
+    assert held[0] > 2.0 > taken[0]
 
 
 def test_reflex_rejects_unknown_fingers():
@@ -120,6 +138,20 @@ def test_manipulation_pd_shares_the_object_weight_among_touching_fingers():
     lift = -hand.params.object.mass * hand.gravity / 2
     np.testing.assert_allclose(out["tau_ff"][:3], jac[0].T @ lift, rtol=1e-12)
     np.testing.assert_allclose(out["tau_ff"][6:], 0.0)
+
+
+def test_manipulation_pd_carries_only_what_the_support_does_not():
+    hand = Hand.default()
+    pd = ManipulationPD(gravity_compensation=False)
+    weight = hand.params.object.mass * hand.gravity
+    inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.array([2.0, 2.0, 0.0])}
+    carried = pd.output(0.0, None, dict(inputs, support=np.array([-weight[0], -weight[1], 0.0])))
+    np.testing.assert_allclose(carried["tau_ff"], 0.0, atol=1e-15)
+    half = pd.output(0.0, None, dict(inputs, support=np.array([0.0, -weight[1] / 2, 0.0])))
+    full = pd.output(0.0, None, inputs)
+    np.testing.assert_allclose(half["tau_ff"], full["tau_ff"] / 2, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(half["tau_ff"], pd.output_reference(0.0, None, dict(inputs, support=np.array(
+        [0.0, -weight[1] / 2, 0.0])))["tau_ff"], rtol=1e-12, atol=1e-15)
 
 
 def test_manipulation_pd_rejects_an_unreachable_waypoint_naming_finger_and_time():

@@ -252,7 +252,7 @@ def test_native_output_reports_the_unreachable_finger():
     hand = Hand.default()
     pd = ManipulationPD(trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
                                                              [1.0, 0.035, -0.038, math.pi / 2]]}})
-    inputs = (hand.q0, np.zeros(9), np.zeros(3))
+    inputs = (hand.q0, np.zeros(9), np.zeros(3), np.zeros(3))
     out = np.empty((3, 9))
     assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, out) == OK
     assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.5, *inputs, out) == UNREACHABLE + 1

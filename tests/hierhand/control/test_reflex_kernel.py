@@ -23,6 +23,7 @@ from hierhand.control.reflex_kernel import (
     P_MAX_FORCE,
     P_MIN_FORCE,
     P_RATIO,
+    P_RELEASE_SHARE,
     P_THRESHOLD,
     pack_params,
     reflex_directions,
@@ -67,7 +68,8 @@ def reference_output(reflex, state, inputs):
 def reference_update(reflex, state, inputs):
     fn, ft = inputs["fn"], inputs["ft"]
     g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], fn)
-    held = grasp & touching
+    released = inputs.get("share", np.ones(3)) < reflex.release_share
+    held = grasp & touching & ~released
     scale = state[0]
     if held.sum() >= 2:
         normal = inputs["normal"].reshape(3, 2)[held]
@@ -76,7 +78,7 @@ def reference_update(reflex, state, inputs):
                           np.abs(ft[held]) / reflex.ratio_target)
         shortfall = float(np.max((need - fn[held]) / np.maximum(gain, 1e-3)))
         scale = min(max(scale + reflex.ki * reflex.dt * shortfall, 0.0), reflex.max_force)
-    return np.concatenate(([scale], np.maximum(state[1:], touching)))
+    return np.concatenate(([scale], np.where(touching, released.astype(float), state[1:])))
 
 
 def make_reflex(grasp):
@@ -97,7 +99,7 @@ def random_case(rng, reflex, k, inward: bool):
     initial = reflex.initial
     for i in chosen:
         if initial[i] and rng.random() < 0.3:
-            continue  # still approaching: listed in 'grasp', never touched, not touching
+            continue  # still approaching: listed in 'grasp', not handed over, not touching
         fn[i] = rng.uniform(0.1, 8.0)
         state[1 + i] = float(rng.random() < 0.8)
     for i in set(range(3)) - set(chosen):
@@ -111,7 +113,7 @@ def random_case(rng, reflex, k, inward: bool):
             d = rng.normal(size=2)
         normal[i] = d / np.linalg.norm(d)
     inputs = {"q": q, "tip": tip.ravel(), "fn": fn, "ft": rng.normal(scale=2.0, size=3),
-              "normal": normal.ravel()}
+              "normal": normal.ravel(), "share": rng.uniform(0.4, 1.2, size=3)}
     return state, inputs
 
 
@@ -243,7 +245,7 @@ def test_input_widths_are_checked_naming_the_port(port, width):
     inputs[port] = [0.0] * (width - 1)  # converted first, then refused for its width
     with pytest.raises(ValueError, match=f"^GraspReflex: input '{port}' must have {width} entries$"):
         call(0.0, state, inputs)
-    with pytest.raises(ValueError, match=r"state must have 4 entries \[scale, touched\(3\)\]"):
+    with pytest.raises(ValueError, match=r"state must have 4 entries \[scale, released\(3\)\]"):
         reflex.update(0.0, np.zeros(3), random_case(np.random.default_rng(9), reflex, 2, inward=True)[1])
 
 
@@ -253,8 +255,8 @@ def test_packed_parameters_land_in_the_slots_control_h_defines():
     from hierhand.control.internal_forces import _COINCIDENT_RTOL
 
     slots = [P_THRESHOLD, P_APPROACH, P_KI, P_DT, P_MIN_FORCE, P_RATIO, P_MAX_FORCE, P_INITIAL, P_INITIAL + 1,
-             P_INITIAL + 2, P_COINCIDENT_RTOL]
+             P_INITIAL + 2, P_COINCIDENT_RTOL, P_RELEASE_SHARE]
     assert sorted(slots) == list(range(N_PARAMS))
-    p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True])
-    assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL
+    p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True], release_share=0.75)
+    assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL and p[P_RELEASE_SHARE] == 0.75
     assert p[P_INITIAL:P_INITIAL + 3].tolist() == [1.0, 0.0, 1.0] and p[P_KI] == 50.0
