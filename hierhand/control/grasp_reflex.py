@@ -3,8 +3,9 @@
 At every hit (1 ms in the paper) the reflex
 
 1. finds the fingers in contact from the fingertip force sensors (``fn``), so it follows
-   the grasp through a re-grasp; fingers listed in ``grasp`` that have not touched yet
-   are pushed towards the others with ``approach_force`` until they do;
+   the grasp through a re-grasp; fingers listed in ``grasp`` that are not touching are
+   pushed towards the others with ``approach_force`` until they do (again, after a
+   bounce), unless voluntary motion had taken them over when they last touched;
 2. takes the internal ("squeeze") forces among those fingertips (Yoshikawa-Nagai): the
    internal force nearest to every finger pushing along its contact normal,
    ``(I - G^+ G) n``; for two contacts this is the squeeze along their line;
@@ -16,6 +17,18 @@ At every hit (1 ms in the paper) the reflex
    mapped to joint torques by ``J_i^T``. One integrator for the whole grasp, not one per
    finger: in a pinch both normal forces respond alike to a difference between the
    fingers' pushes (the object just moves), so per-finger integrators would drift apart.
+   Only the fingers the reflex still holds count: a finger whose actuator command keeps
+   less than ``release_share`` of its grasping torque (input ``share``, from the
+   suppresser) has been handed to voluntary motion. Counting it would wind the integrator
+   up while the finger is pulled off the object (its |f_t| / f_n climbs as it lets go of
+   its load), raising the squeeze of every finger and its own grasp torque.
+
+The minimum force: a grasp that must take a load suddenly (the hand-over of the object
+at 0.1 s in the task diagrams) needs its squeeze in place beforehand, ``m g / (k
+safety_ratio)`` per finger for k fingers carrying weight m g by friction (2.45 N for the
+0.3 kg object in a two-finger pinch); the task diagrams use 3 N. The default 1 N closes
+the fingers just as cleanly, but the ratio then exceeds the safety ratio for some 20 ms
+after the hand-over while the integrator catches up.
 
 Why a margin: an integral loop approaches its target exponentially, so aiming exactly at
 the safety ratio would leave ``|f_t| / f_n`` just above it for ever; aiming at

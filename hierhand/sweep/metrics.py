@@ -8,7 +8,7 @@ hand tasks (hierhand.tasks.metrics), computed with the task diagrams' block name
 (plant, reflex, manip, suppress):
 
 - ``separation_time``: when the forefinger lets go after the middle finger's contact
-  (regrasp_summary); empty if it never does;
+  (regrasp_events); empty if it never does;
 - ``object_dropped``: 1 if the object was dropped, else 0;
 - ``peak_ratio`` / ``recovery_time``: peak |f_t|/f_n after the disturbance and the time
   until it is back under the safety ratio (grasp_summary); the disturbance time is the
@@ -91,7 +91,7 @@ class Metric:
         from hierhand.tasks import metrics as task
 
         if self.kind == "separation_time":
-            return task.regrasp_summary(results)["fore_separation_time_s"]
+            return task.regrasp_events(results)["fore_separation_time_s"]
         if self.kind == "object_dropped":
             return float(task.object_dropped(results))
         if self.kind in ("peak_ratio", "recovery_time"):

@@ -38,10 +38,11 @@ def _torque_axes(ax, results: Results, joint: int, b: TaskBlocks, title: str) ->
     t_g, tau_g = results[f"{b.reflex}.tau_g"]
     t_m, tau_m = results[f"{b.manipulation}.tau_m"]
     applied = f"{b.suppresser}.tau_g_eff"
-    if applied in results:
+    suppressing = results.info.get("parameters", {}).get(b.suppresser, {}).get("enabled", True) is not False
+    if applied in results and suppressing:
         ax.plot(t_g, tau_g[:, joint], lw=0.8, ls="--", color="C0", label="grasp torque from the reflex")
         t_a, tau_a = results[applied]
-        ax.plot(t_a, tau_a[:, joint], lw=1.2, color="C0", label="grasp torque applied (suppressed)")
+        ax.plot(t_a, tau_a[:, joint], lw=1.2, color="C0", label="grasp torque applied (after the suppresser)")
     else:
         ax.plot(t_g, tau_g[:, joint], lw=1.2, label="grasp torque (reflex)")
     ax.step(t_m, tau_m[:, joint], where="post", lw=1.2, color="C1", label="manipulation torque (PD)")

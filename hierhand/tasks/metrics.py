@@ -19,6 +19,11 @@ DROP_DISTANCE = 0.02
 
 THUMB, FORE, MIDDLE = 0, 1, 2
 
+CONTACT_FADE = 0.005
+"""Seconds before a separation left out of the torque window: the contact force fades out
+over the last milliseconds and the reflex drops the finger, so its torque there says nothing
+about suppression."""
+
 
 @dataclass(frozen=True)
 class TaskBlocks:
@@ -51,9 +56,12 @@ def first_time(t: np.ndarray, condition: np.ndarray, after: float = -math.inf) -
 
 
 def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = TaskBlocks(),
-                  fingers: tuple[int, ...] = (THUMB, FORE), steady_window: float = 0.2) -> dict:
+                  fingers: tuple[int, ...] = (THUMB, FORE), steady_window: float = 0.2,
+                  handover_time: float | None = None) -> dict:
     """Peak |f_t|/f_n after the disturbance, when it is back under the safety ratio for
-    good, its maximum over the last ``steady_window`` seconds, and how far the object moved."""
+    good, its maximum over the last ``steady_window`` seconds, how far the object moved,
+    and the peak while the fingers close (before ``handover_time``, when the support lets
+    the object go; None without one)."""
     t, ratio = _signal(results, f"{b.plant}.ratio")
     worst = ratio[:, list(fingers)].max(axis=1)
     after = t >= disturbance_time
@@ -68,11 +76,13 @@ def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = Tas
     steady = t >= t[-1] - steady_window
     t_obj, obj = _signal(results, f"{b.plant}.obj")
     i0 = max(int(np.searchsorted(t_obj, disturbance_time)) - 1, 0)  # the last pose before the push
+    closing = t < handover_time if handover_time is not None else np.zeros(t.size, dtype=bool)
     return {
         "disturbance_time_s": float(disturbance_time),
         "peak_ratio": peak,
         "recovery_time_s": recovery,
         "steady_ratio_max": float(worst[steady].max()),
+        "closing_peak_ratio": float(worst[closing].max()) if closing.any() else None,
         "object_displacement_m": float(np.linalg.norm(obj[-1, :2] - obj[i0, :2])),
         "object_dropped": object_dropped(results, b),
     }
@@ -111,13 +121,53 @@ def manipulation_summary(results: Results, trajectories: dict, initial_pose: np.
     }
 
 
-def regrasp_summary(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
-    """When the middle finger first touches the object, and when the forefinger then lets go."""
+def regrasp_events(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
+    """When the middle finger first touches the object, when the forefinger then lets go,
+    whether it stays off, and whether the object was dropped (from the contact flags)."""
     t, contact = _signal(results, f"{b.plant}.contact")
     middle = first_time(t, contact[:, MIDDLE] > 0)
     separation = first_time(t, contact[:, FORE] == 0, after=middle) if middle is not None else None
     return {
         "middle_contact_time_s": middle,
         "fore_separation_time_s": separation,
+        "fore_stays_off": bool(separation is not None and not contact[t > separation, FORE].any()),
         "object_dropped": object_dropped(results, b),
     }
+
+
+def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBlocks = TaskBlocks(),
+                    joint: int = 3 * FORE) -> dict:
+    """``regrasp_events`` and the paper's Fig. 14 relation on the forefinger's ``joint`` (its
+    MP joint by default) while it withdraws: the applied grasp torque
+    (``suppress.tau_g_eff``) at the start of the withdrawal, its peak and its last value
+    CONTACT_FADE before separation, and its correlation with |tau_m| over that window (negative: the
+    grasp torque falls as the manipulation torque grows). ``withdrawal`` is the forefinger
+    trajectory's (start, end) time."""
+    events = regrasp_events(results, b)
+    t_g, tau_g = _signal(results, f"{b.suppresser}.tau_g_eff")
+    t_m, tau_m = _signal(results, f"{b.manipulation}.tau_m")
+    held_m = np.abs(tau_m[np.clip(np.searchsorted(t_m, t_g, side="right") - 1, 0, None), joint])
+    separation = events["fore_separation_time_s"]
+    end = separation - CONTACT_FADE if separation is not None else math.inf
+    window = (t_g >= withdrawal[0]) & (t_g < end)
+    grasp, manipulation = tau_g[window, joint], held_m[window]
+    varied = grasp.size > 2 and np.ptp(grasp) > 0 and np.ptp(manipulation) > 0
+    return {
+        **events,
+        "withdrawal_start_s": float(withdrawal[0]),
+        "withdrawal_end_s": float(withdrawal[1]),
+        "fore_grasp_torque_at_withdrawal_Nm": float(grasp[0]) if grasp.size else None,
+        "fore_grasp_torque_peak_Nm": float(grasp.max()) if grasp.size else None,
+        "fore_grasp_torque_last_Nm": float(grasp[-1]) if grasp.size else None,
+        "fore_manipulation_torque_last_Nm": float(manipulation[-1]) if grasp.size else None,
+        "grasp_vs_manipulation_correlation": float(np.corrcoef(grasp, manipulation)[0, 1]) if varied else None,
+    }
+
+
+def regrasp_succeeded(summary: dict) -> bool:
+    """The re-grasp as the paper describes it: the middle finger touches, the forefinger
+    then lets go while it withdraws and stays off, and the object is not dropped."""
+    sep = summary["fore_separation_time_s"]
+    return (summary["middle_contact_time_s"] is not None and sep is not None
+            and summary["withdrawal_start_s"] <= sep <= summary["withdrawal_end_s"]
+            and summary["fore_stays_off"] and not summary["object_dropped"])

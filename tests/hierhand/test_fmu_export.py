@@ -502,7 +502,7 @@ def native_regrasp():
 def test_regrasp_with_the_exported_plant_matches_the_native_run(fmus, native_regrasp, fmi):
     """diagrams/regrasp_fmu.yaml: the same task with the plant as an FMU, at 1 ms steps."""
     import blocks
-    from hierhand.tasks.metrics import regrasp_summary
+    from hierhand.tasks.metrics import regrasp_events
 
     diagram = blocks.load_diagram(REPO / "diagrams" / "regrasp_fmu.yaml",
                                   overrides={"plant.path": str(fmus[fmi])})
@@ -514,6 +514,6 @@ def test_regrasp_with_the_exported_plant_matches_the_native_run(fmus, native_reg
         np.testing.assert_array_equal(t_fmu, t_native)
         scale = np.maximum(np.abs(native_values), 1e-300)
         assert (np.abs(fmu_values - native_values) / scale).max() <= 1e-12, signal
-    fmu_events, native_events = regrasp_summary(via_fmu), regrasp_summary(native_regrasp)
+    fmu_events, native_events = regrasp_events(via_fmu), regrasp_events(native_regrasp)
     assert fmu_events == native_events
     assert fmu_events["fore_separation_time_s"] is not None

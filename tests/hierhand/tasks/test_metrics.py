@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from blocks import Results
-from hierhand.tasks.metrics import grasp_summary, regrasp_summary, rigid_target
+from hierhand.tasks.metrics import grasp_summary, regrasp_events, regrasp_succeeded, regrasp_summary, rigid_target
 
 
 def test_rigid_target_recovers_a_known_motion():
@@ -33,21 +33,62 @@ def test_grasp_summary_measures_peak_recovery_and_steady_ratio():
     contact = np.tile([1.0, 1.0, 0.0], (t.size, 1))
     obj = np.tile([0.0, 0.06, 0.0], (t.size, 1))
     obj[t >= 0.5, 1] = 0.059
-    s = grasp_summary(fake_results(t, ratio, contact, obj), 0.5)
+    s = grasp_summary(fake_results(t, ratio, contact, obj), 0.5, handover_time=0.1)
     assert s["peak_ratio"] == 0.8
     assert s["recovery_time_s"] == pytest.approx(0.06)
     assert s["steady_ratio_max"] == 0.5
+    assert s["closing_peak_ratio"] == 0.5
     assert s["object_displacement_m"] == pytest.approx(0.001)
     assert s["object_dropped"] is False
 
 
-def test_regrasp_summary_times_and_a_drop():
+def test_regrasp_events_times_and_a_drop():
     t = np.arange(0, 1.0001, 0.001)
     contact = np.tile([1.0, 1.0, 0.0], (t.size, 1))
     contact[t >= 0.3, 2] = 1.0
     contact[t >= 0.55, 1] = 0.0
     contact[t >= 0.9, :] = 0.0
     obj = np.tile([0.0, 0.06, 0.0], (t.size, 1))
-    s = regrasp_summary(fake_results(t, np.zeros((t.size, 3)), contact, obj))
+    s = regrasp_events(fake_results(t, np.zeros((t.size, 3)), contact, obj))
     assert s == {"middle_contact_time_s": pytest.approx(0.3), "fore_separation_time_s": pytest.approx(0.55),
-                 "object_dropped": True}
+                 "fore_stays_off": True, "object_dropped": True}
+
+
+def regrasp_results(grasp_torque, touch_again=False):
+    """A re-grasp whose forefinger lets go at 0.55 s; its MP joint's applied grasp torque is
+    ``grasp_torque(t)`` and its manipulation torque -(t - 0.4) during the withdrawal."""
+    t = np.arange(0, 1.0001, 0.001)
+    contact = np.tile([1.0, 1.0, 0.0], (t.size, 1))
+    contact[t >= 0.3, 2] = 1.0
+    contact[t >= 0.55, 1] = 0.0
+    if touch_again:
+        contact[t >= 0.8, 1] = 1.0
+    obj = np.tile([0.0, 0.06, 0.0], (t.size, 1))
+    tau_g = np.zeros((t.size, 9))
+    tau_g[:, 3] = np.where(t < 0.55, grasp_torque(t), 0.0)
+    t_m = t[::10]
+    tau_m = np.zeros((t_m.size, 9))
+    tau_m[:, 3] = -np.clip(t_m - 0.4, 0.0, 0.3)
+    signals = {"plant.ratio": (t, np.zeros((t.size, 3))), "plant.contact": (t, contact), "plant.obj": (t, obj),
+               "suppress.tau_g_eff": (t, tau_g), "manip.tau_m": (t_m, tau_m)}
+    return Results(signals, {})
+
+
+def test_regrasp_summary_measures_the_grasp_torque_against_the_manipulation_torque():
+    falling = regrasp_summary(regrasp_results(lambda t: 0.2 - 0.5 * np.clip(t - 0.4, 0, None)), (0.4, 0.7))
+    assert falling["fore_grasp_torque_at_withdrawal_Nm"] == pytest.approx(0.2)
+    assert falling["fore_grasp_torque_peak_Nm"] == pytest.approx(0.2)
+    assert falling["fore_grasp_torque_last_Nm"] == pytest.approx(0.2 - 0.5 * 0.144)  # CONTACT_FADE before 0.55 s
+    assert falling["grasp_vs_manipulation_correlation"] < -0.99
+    assert regrasp_succeeded(falling)
+    rising = regrasp_summary(regrasp_results(lambda t: 0.2 + np.clip(t - 0.4, 0, None)), (0.4, 0.7))
+    assert rising["grasp_vs_manipulation_correlation"] > 0.99
+    assert rising["fore_grasp_torque_peak_Nm"] == pytest.approx(0.344)
+
+
+def test_a_regrasp_fails_when_the_forefinger_comes_back_or_leaves_outside_its_withdrawal():
+    back = regrasp_summary(regrasp_results(lambda t: 0.2 + 0 * t, touch_again=True), (0.4, 0.7))
+    assert back["fore_stays_off"] is False and not regrasp_succeeded(back)
+    early = regrasp_summary(regrasp_results(lambda t: 0.2 + 0 * t), (0.6, 0.9))
+    assert early["grasp_vs_manipulation_correlation"] is None  # no sample between 0.6 s and the separation
+    assert not regrasp_succeeded(early)
