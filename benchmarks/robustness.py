@@ -67,6 +67,7 @@ def run_point(args: tuple[dict, dict, dict]) -> dict:
     return {**point, "succeeded": regrasp_succeeded(summary) and suppressed.complete,
             "separation": summary["fore_separation_time_s"], "dropped": summary["object_dropped"],
             "falls": (summary["grasp_vs_manipulation_correlation"] or 0.0) < 0.0,
+            "kept": summary["holding_grasp_torque_kept"],
             "held_without": unsuppressed["fore_separation_time_s"] is None and not unsuppressed["object_dropped"]}
 
 
@@ -111,8 +112,10 @@ def rates(rows: list[dict]) -> str:
     ok = sum(r["succeeded"] for r in rows)
     held = sum(r["held_without"] for r in rows)
     falls = sum(r["falls"] for r in rows if r["succeeded"])
+    kept = [r["kept"] for r in rows if r["kept"] is not None]
     return (f"with suppresser {ok}/{n} succeed ({100 * ok / n:.1f} %), grasp torque falls with |tau_m| in "
-            f"{falls}/{ok}; without suppresser the forefinger holds on in {held}/{n}")
+            f"{falls}/{ok}, holding fingers keep >= {100 * min(kept):.0f} % of their grasp torque (median of the "
+            f"least {100 * np.median(kept):.0f} %); without suppresser the forefinger holds on in {held}/{n}")
 
 
 def main() -> None:

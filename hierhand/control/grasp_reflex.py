@@ -137,7 +137,7 @@ class GraspReflex(Block):
         self._params[P_DT] = self.dt
 
     def initial_state(self) -> np.ndarray:
-        """[grasp force scale s (N), has touched the object (3)]."""
+        """[grasp force scale s (N), handed to voluntary motion when it last touched (3)]."""
         return np.concatenate(([self.approach_force], np.zeros(3)))
 
     def members(self, state: np.ndarray, fn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -175,6 +175,6 @@ class GraspReflex(Block):
         return {"tau_g": out[O_TAU:O_FORCE], "force": out[O_FORCE:O_ACTIVE], "active": out[O_ACTIVE:N_OUT]}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
-        """The integral step of the grasp force scale and the touched flags (a fresh array)."""
+        """The integral step of the grasp force scale and the released flags (a fresh array)."""
         return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"],
                              inputs.get("share", WHOLE_SHARE))

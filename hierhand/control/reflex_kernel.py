@@ -42,7 +42,7 @@ O_FORCE: int = _L["REFLEX_O_FORCE"]
 O_ACTIVE: int = _L["REFLEX_O_ACTIVE"]
 N_OUT: int = _L["REFLEX_N_OUT"]
 
-N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, touched (3)]
+N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, released (3)]
 
 _directions = _native.reflex_directions
 _forces = _native.reflex_forces
@@ -74,7 +74,8 @@ def reflex_directions(params, state, tip, normal, fn) -> tuple[np.ndarray, np.nd
     """(g (3, 2), grasp (3,) bool, touching (3,) bool): ``GraspReflex.directions``.
 
     ``touching``: ``fn > contact_threshold``; ``grasp``: touching, or listed in 'grasp',
-    not touched yet and not touching. With fewer than two fingers in the grasp ``g`` is 0.
+    not released (handed to voluntary motion when it last touched) and not touching. With
+    fewer than two fingers in the grasp ``g`` is 0.
     Otherwise every finger pushes along its normal, an approaching one toward the others'
     centroid, and ``g`` is ``(I - G^+ G) push`` over the grasp, or the centroid squeeze
     ``c - p_i`` when that projection leaves some finger not pushing (``g_i . push_i <= 0``);
@@ -116,7 +117,7 @@ def reflex_output(model, params, state, q, tip, normal, fn) -> np.ndarray:
 
 
 def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.ndarray:
-    """(4,) fresh next state ``[scale, touched (3)]``.
+    """(4,) fresh next state ``[scale, released (3)]``.
 
     With at least two fingers in the grasp, touching and held by the reflex, the scale
     moves by ``ki * dt * max_i (need_i - fn_i) / max(g_i . n_i, 1e-3)`` over those fingers,

@@ -25,10 +25,10 @@
 /* == grasping reflex (reflex.c) =========================================================
  *
  * The fingers in contact (fn > threshold), and those listed in the block's 'grasp' that
- * have not touched yet, are squeezed together by the internal force (I - G^+ G) push,
- * each finger pushing along its contact normal (an approaching one toward the others'
- * centroid); one integral loop scales it until every contact has the normal force it
- * needs. */
+ * are not touching and were not handed to voluntary motion when they last touched, are
+ * squeezed together by the internal force (I - G^+ G) push, each finger pushing along its
+ * contact normal (an approaching one toward the others' centroid); one integral loop
+ * scales it until every contact the reflex still holds has the normal force it needs. */
 
 /* -- parameters: params[HH_REFLEX_P_*] -------------------------------------------------- */
 enum {
@@ -87,10 +87,12 @@ void hh_reflex_forces(const double *params, const double *state, const double g[
 int hh_reflex_output(const hh_model *m, const double *params, const double *state, const hh_reflex_inputs *in,
                      const double *q, double *out);
 
-/* next (HH_REFLEX_N_STATE): with two or more fingers in the grasp and touching, the scale
- * moves by ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3), need_i =
- * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; the touched flags
- * latch. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
+/* next (HH_REFLEX_N_STATE): with two or more fingers in the grasp, touching and held
+ * (in->share[i] >= release_share, or in->share NULL), the scale moves by
+ * ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3) over them, need_i =
+ * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; a touching finger's
+ * released flag becomes whether it is handed over (share below release_share), a finger
+ * out of contact keeps its flag. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
 int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
                      double *next);
 

@@ -135,14 +135,30 @@ def regrasp_events(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
     }
 
 
+def holding_kept(results: Results, since: float | None, b: TaskBlocks = TaskBlocks()) -> float | None:
+    """The smallest share of its grasp torque that any joint of the holding fingers (thumb
+    and middle) kept through the suppresser from ``since`` on, over the samples where that
+    joint's grasp torque is at least a tenth of the largest among those joints; None
+    without such samples."""
+    if since is None:
+        return None
+    t, tau_g = _signal(results, f"{b.reflex}.tau_g")
+    _, applied = _signal(results, f"{b.suppresser}.tau_g_eff")
+    joints = [*range(3 * THUMB, 3 * THUMB + 3), *range(3 * MIDDLE, 3 * MIDDLE + 3)]
+    g, a = tau_g[t >= since][:, joints], applied[t >= since][:, joints]
+    large = np.abs(g) >= 0.1 * np.abs(g).max() if g.size and np.abs(g).max() > 0 else np.zeros(g.shape, bool)
+    return float((a[large] / g[large]).min()) if large.any() else None
+
+
 def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBlocks = TaskBlocks(),
                     joint: int = 3 * FORE) -> dict:
-    """``regrasp_events`` and the paper's Fig. 14 relation on the forefinger's ``joint`` (its
-    MP joint by default) while it withdraws: the applied grasp torque
-    (``suppress.tau_g_eff``) at the start of the withdrawal, its peak and its last value
-    CONTACT_FADE before separation, and its correlation with |tau_m| over that window (negative: the
-    grasp torque falls as the manipulation torque grows). ``withdrawal`` is the forefinger
-    trajectory's (start, end) time."""
+    """``regrasp_events``, ``holding_kept`` from the middle finger's first contact, and the
+    paper's Fig. 14 relation on the forefinger's ``joint`` (its MP joint by default) while it
+    withdraws: the applied grasp torque (``suppress.tau_g_eff``) at the start of the
+    withdrawal, its peak and its last value CONTACT_FADE before separation, and its
+    correlation with |tau_m| over that window (negative: the grasp torque falls as the
+    manipulation torque grows). ``withdrawal`` is the forefinger trajectory's (start, end)
+    time."""
     events = regrasp_events(results, b)
     t_g, tau_g = _signal(results, f"{b.suppresser}.tau_g_eff")
     t_m, tau_m = _signal(results, f"{b.manipulation}.tau_m")
@@ -154,6 +170,7 @@ def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBl
     varied = grasp.size > 2 and np.ptp(grasp) > 0 and np.ptp(manipulation) > 0
     return {
         **events,
+        "holding_grasp_torque_kept": holding_kept(results, events["middle_contact_time_s"], b),
         "withdrawal_start_s": float(withdrawal[0]),
         "withdrawal_end_s": float(withdrawal[1]),
         "fore_grasp_torque_at_withdrawal_Nm": float(grasp[0]) if grasp.size else None,

@@ -141,6 +141,10 @@ def claim_rows(summary: dict) -> list[tuple[str, str, str, str]]:
          f"{_num(s['grasp_vs_manipulation_correlation'], digits=2)}",
          _verdict(s["grasp_vs_manipulation_correlation"] is not None and s["grasp_vs_manipulation_correlation"] < 0
                   and s["fore_grasp_torque_last_Nm"] < s["fore_grasp_torque_at_withdrawal_Nm"])),
+        ("Re-grasp with suppresser: the holding fingers keep their grasp torque", "only the leaving finger is suppressed",
+         f"thumb and middle finger keep at least {_num(100 * (s['holding_grasp_torque_kept'] or 0), ' %')} of "
+         "their grasp torque after the middle finger's contact",
+         _verdict(s["holding_grasp_torque_kept"] is not None and s["holding_grasp_torque_kept"] >= 0.9)),
         ("Re-grasp without suppresser: the forefinger never separates; the torques grow against each other",
          "never separates",
          f"forefinger separates: {_num(u['fore_separation_time_s'], ' s')}; MP grasp torque "

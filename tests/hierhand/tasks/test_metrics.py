@@ -69,8 +69,12 @@ def regrasp_results(grasp_torque, touch_again=False):
     t_m = t[::10]
     tau_m = np.zeros((t_m.size, 9))
     tau_m[:, 3] = -np.clip(t_m - 0.4, 0.0, 0.3)
+    reflex = tau_g.copy()
+    reflex[:, 0] = 0.1  # the thumb's MP joint: 0.1 N m from the reflex, 0.08 applied after 0.7 s
+    tau_g[:, 0] = np.where(t >= 0.7, 0.08, 0.1)
+    reflex[:, 1] = 0.001  # too small a torque to judge suppression by
     signals = {"plant.ratio": (t, np.zeros((t.size, 3))), "plant.contact": (t, contact), "plant.obj": (t, obj),
-               "suppress.tau_g_eff": (t, tau_g), "manip.tau_m": (t_m, tau_m)}
+               "suppress.tau_g_eff": (t, tau_g), "manip.tau_m": (t_m, tau_m), "reflex.tau_g": (t, reflex)}
     return Results(signals, {})
 
 
@@ -80,6 +84,7 @@ def test_regrasp_summary_measures_the_grasp_torque_against_the_manipulation_torq
     assert falling["fore_grasp_torque_peak_Nm"] == pytest.approx(0.2)
     assert falling["fore_grasp_torque_last_Nm"] == pytest.approx(0.2 - 0.5 * 0.144)  # CONTACT_FADE before 0.55 s
     assert falling["grasp_vs_manipulation_correlation"] < -0.99
+    assert falling["holding_grasp_torque_kept"] == pytest.approx(0.8)
     assert regrasp_succeeded(falling)
     rising = regrasp_summary(regrasp_results(lambda t: 0.2 + np.clip(t - 0.4, 0, None)), (0.4, 0.7))
     assert rising["grasp_vs_manipulation_correlation"] > 0.99

@@ -33,7 +33,7 @@ def test_summary_has_exactly_the_documented_keys(reproduced):
             "middle_contact_time_s", "fore_separation_time_s", "fore_stays_off", "object_dropped",
             "withdrawal_start_s", "withdrawal_end_s", "fore_grasp_torque_at_withdrawal_Nm",
             "fore_grasp_torque_peak_Nm", "fore_grasp_torque_last_Nm", "fore_manipulation_torque_last_Nm",
-            "grasp_vs_manipulation_correlation", "succeeded"}
+            "grasp_vs_manipulation_correlation", "holding_grasp_torque_kept", "succeeded"}
 
 
 def test_grasp_closes_within_the_safety_ratio_and_recovers_from_the_disturbance(reproduced):
@@ -58,6 +58,7 @@ def test_regrasp_forefinger_separates_only_with_the_suppresser(reproduced):
     s, u = r["suppressed"], r["unsuppressed"]
     assert s["middle_contact_time_s"] < s["withdrawal_start_s"] < s["fore_separation_time_s"] < s["withdrawal_end_s"]
     assert s["fore_stays_off"] and not s["object_dropped"] and s["succeeded"]
+    assert s["holding_grasp_torque_kept"] >= 0.9  # suppression leaves thumb and middle finger alone
     assert u["middle_contact_time_s"] is not None
     assert u["fore_separation_time_s"] is None  # held on through t = 1.0 s
     assert not u["object_dropped"] and not u["succeeded"]
@@ -90,6 +91,6 @@ def test_figures_and_report_are_written(reproduced):
         assert (out / f"fig{n:02d}.png").stat().st_size > 10_000
     report = (out / "report.md").read_text()
     assert "![Fig. 14](fig14.png)" in report
-    assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 8
+    assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 9
     for task in ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed"):
         assert (out / "runs" / task / "signals.npz").is_file()
