@@ -9,6 +9,7 @@ checkpointed or batched by copying its state.
 
 from __future__ import annotations
 
+import copy
 import functools
 import inspect
 from fractions import Fraction
@@ -139,6 +140,18 @@ class Block:
         ``hierhand validate`` prints beside the block (e.g. the model a plant simulates);
         empty for nothing to say."""
         return ""
+
+    @classmethod
+    def param_default(cls, name: str) -> Any:
+        """The value a ``--set`` path into parameter ``name`` starts from when the diagram
+        does not give that parameter (``--set b.gains.1=2``): here the ``__init__`` default
+        if it is a list, tuple or mapping (a tuple as a list), else None, which starts an
+        empty mapping. A block whose ``None`` default stands for a larger value overrides it."""
+        param = cls.parameters().get(name)
+        default = None if param is None else param.default
+        if isinstance(default, tuple):
+            return list(default)
+        return copy.deepcopy(default) if isinstance(default, (list, Mapping)) else None
 
     @classmethod
     def registered_name(cls) -> str:

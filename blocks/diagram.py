@@ -19,6 +19,7 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from .block import Block
+from .param_paths import PathError, set_path
 from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
 from .timebase import DurationError, parse_duration
@@ -518,17 +519,11 @@ class _Loader:
                                     f"parameters: {_known(declared)}")
                 ok = False
                 continue
-            target = params
-            for part in parts[:-1]:
-                if not isinstance(target.get(part), dict):
-                    target[part] = {} if part not in target else target[part]
-                if not isinstance(target[part], dict):
-                    self.override_error(key, f"'{name}.{part}' is not a mapping")
-                    ok = False
-                    break
-                target = target[part]
-            else:
-                target[parts[-1]] = value
+            try:
+                set_path(params, name, parts, value, cls.param_default)
+            except PathError as exc:
+                self.override_error(key, str(exc), exc.hint)
+                ok = False
         for key in cls.path_params:
             value = params.get(key)
             if isinstance(value, str) and value.strip() and not Path(value).expanduser().is_absolute():

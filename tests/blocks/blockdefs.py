@@ -132,3 +132,20 @@ class ScaleByModel(Block):
     def output(self, t, state, inputs):
         return {"y": self.source.value * inputs["u"] + self.offset}
 
+
+class Weights(Block):
+    """y = weights (a list parameter with a tuple default); ``extra`` defaults to None but
+    stands for the list [1.0, 2.0, 3.0] (its ``param_default``)."""
+
+    def __init__(self, weights=(1.0, 2.0), extra=None):
+        self.weights = np.asarray(weights, dtype=float)
+        self.extra = np.asarray([1.0, 2.0, 3.0] if extra is None else extra, dtype=float)
+        self.outputs = {"y": self.weights.size, "extra": self.extra.size}
+        self.feedthrough = False
+
+    @classmethod
+    def param_default(cls, name):
+        return [1.0, 2.0, 3.0] if name == "extra" else super().param_default(name)
+
+    def output(self, t, state, inputs):
+        return {"y": self.weights.copy(), "extra": self.extra.copy()}
