@@ -46,17 +46,23 @@ def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda 
 def summarize(runs: dict[str, Results], b: TaskBlocks = TaskBlocks()) -> dict:
     """summary.json's content from the four runs."""
     grasp_params = runs["grasp"].info["parameters"]
-    manip_params = runs["manipulate"].info["parameters"]
-    from ..model import load_hand
-
-    hand = load_hand(manip_params.get(b.plant, {}))
+    manipulate_params = runs["manipulate"].info["parameters"]
     return {
         "grasp": grasp_summary(runs["grasp"], float(grasp_params["push"]["time"]), b),
-        "manipulation": manipulation_summary(runs["manipulate"], manip_params[b.manipulation]["trajectories"],
-                                             hand.object_pose0, b),
+        "manipulation": manipulation_summary(runs["manipulate"], manipulate_params[b.manipulation]["trajectories"],
+                                             run_hand(manipulate_params, b).object_pose0, b),
         "regrasp": {"suppressed": regrasp_summary(runs["regrasp"], b),
                     "unsuppressed": regrasp_summary(runs["regrasp_unsuppressed"], b)},
     }
+
+
+def run_hand(parameters: dict, b: TaskBlocks = TaskBlocks()):
+    """The hand of a task run, from its run.json parameters: the hand of the plant that
+    the manipulation controller refers to (``hand: plant``), whose parameters are the
+    hand file's sections."""
+    from ..model import load_hand
+
+    return load_hand(parameters[parameters[b.manipulation]["hand"]])
 
 
 def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[str], None] = lambda s: None) -> dict:
