@@ -50,9 +50,9 @@ def without(path: Path, parameter: str, out: Path) -> Path:
 
 def test_every_block_of_a_diagram_models_the_plants_hand_after_overrides():
     d = blocks.load_diagram(REGRASP, overrides=HEAVY)
-    plant, reflex, manip = (d.blocks[n].block for n in ("plant", "reflex", "manip"))
+    plant, reflex, manip, support = (d.blocks[n].block for n in ("plant", "reflex", "manip", "support"))
     hand = plant.hand
-    assert reflex.hand is hand and manip.hand is hand
+    assert reflex.hand is hand and manip.hand is hand and support.hand is hand
     assert hand.params.object.mass == 0.36
     assert (hand.params.contact.mu_s, hand.params.contact.mu_d) == (1.1, 1.0)
     assert hand.params.fingers[1].links[0].length == 0.041
@@ -68,19 +68,20 @@ def test_every_block_of_a_diagram_models_the_plants_hand_after_overrides():
     state = reflex.initial_state()
     np.testing.assert_array_equal(reflex.output(0.0, state, inputs)["tau_g"], own.output(0.0, state, inputs)["tau_g"])
 
-    # the PD's load feedforward carries 0.36 kg
+    # the PD's load feedforward and the support carry 0.36 kg
     fn = np.array([2.0, 2.0, 0.0])
     tau_ff = manip.output(0.0, None, {"q": hand.q0, "qd": np.zeros(9), "fn": fn})["tau_ff"]
     jac = hand.tip_jacobians(hand.q0)
     share = -0.36 * hand.gravity / 2
     expected = hand.bias(hand.q0, np.zeros(9)) + np.concatenate([jac[0].T @ share, jac[1].T @ share, np.zeros(3)])
     np.testing.assert_allclose(tau_ff, expected, rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(support.output(0.0, None, {})["y"], [0.0, 0.36 * 9.81, 0.0])
 
 
 def test_the_diagrams_record_the_plants_name_and_the_overridden_hand():
     d = blocks.load_diagram(REGRASP, overrides=HEAVY)
     params = d.parameters()
-    assert params["reflex"]["hand"] == params["manip"]["hand"] == "plant"
+    assert params["reflex"]["hand"] == params["manip"]["hand"] == params["support"]["hand"] == "plant"
     assert params["plant"]["object"] == {"mass": 0.36}
     assert params["plant"]["fingers"][1]["links"][0]["length"] == 0.041
     assert params["plant"]["fingers"][2] == default_hand_dict()["fingers"][2]
@@ -90,7 +91,8 @@ def test_the_diagrams_record_the_plants_name_and_the_overridden_hand():
 def test_every_shipped_diagram_gives_its_hand_once(name):
     d = blocks.load_diagram(ROOT / "diagrams" / f"{name}.yaml")
     refs = {str(r) for r in d.references()}
-    assert refs == {"reflex.hand -> plant", "manip.hand -> plant"}
+    assert refs == {"reflex.hand -> plant", "manip.hand -> plant", "support.hand -> plant"}
+    assert d.blocks["support"].type_name == "ObjectSupport"
     assert set(d.parameters()["reflex"]) & {"gravity", "fingers", "object", "contact"} == set()
 
 
@@ -163,8 +165,9 @@ def test_the_fmu_diagram_models_the_fmus_hand(fmu):
     d = blocks.load_diagram(ROOT / "diagrams" / "regrasp_fmu.yaml",
                             overrides={"plant.path": str(fmu), "plant.start_values": {"object.mass": 0.36}})
     hand = d.blocks["reflex"].block.hand
-    assert d.blocks["manip"].block.hand is hand
+    assert d.blocks["manip"].block.hand is hand and d.blocks["support"].block.hand is hand
     assert hand.params.object.mass == 0.36
+    np.testing.assert_array_equal(d.blocks["support"].block.force, [0.0, 0.36 * 9.81, 0.0])
 
 
 # -- validate ------------------------------------------------------------------------------------------
@@ -179,12 +182,13 @@ def validate(path: Path, cwd: Path) -> str:
 
 def test_validate_shows_where_the_hand_comes_from_and_who_uses_it(tmp_path):
     out = validate(REGRASP, tmp_path)
-    assert "references:\n  reflex.hand -> plant\n  manip.hand -> plant\n" in out
-    assert "  plant: hand: the built-in default hand; referenced by reflex.hand, manip.hand\n" in out
+    assert "references:\n  reflex.hand -> plant\n  manip.hand -> plant\n  support.hand -> plant\n" in out
+    assert ("  plant: hand: the built-in default hand; referenced by reflex.hand, manip.hand, support.hand\n"
+            in out)
     (tmp_path / "heavy.yaml").write_text("object: {mass: 0.36}\n")
     text = REGRASP.read_text().replace("plant:    {type: HandPlant, period: 0.1 ms}",
                                        "plant:    {type: HandPlant, period: 0.1 ms, params_file: heavy.yaml}")
     (tmp_path / "regrasp.yaml").write_text(text)
     out = validate(tmp_path / "regrasp.yaml", tmp_path)
     assert (f"  plant: params_file {tmp_path / 'heavy.yaml'}; hand: object from the diagram, the rest from the "
-            "built-in default hand; referenced by reflex.hand, manip.hand\n") in out
+            "built-in default hand; referenced by reflex.hand, manip.hand, support.hand\n") in out
