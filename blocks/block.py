@@ -9,6 +9,7 @@ checkpointed or batched by copying its state.
 
 from __future__ import annotations
 
+import copy
 import functools
 import inspect
 from fractions import Fraction
@@ -48,6 +49,14 @@ class Block:
 
     and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
     Parameters are the keyword arguments of ``__init__``; ``param_docs`` documents them.
+
+    Block references. A parameter named in ``block_params`` takes another block of the
+    same diagram, as Drake's controllers take the ``MultibodyPlant`` they model: in the
+    diagram its value is that block's name (``hand: plant``), and the loader builds the
+    referenced block first and passes the ``Block`` object itself to ``__init__``. So a
+    model given once, on one block, is the model every block referring to it uses, and
+    ``--set plant.mass=...`` reaches them all. ``Diagram.parameters()`` and run.json keep
+    the name. References must not form a cycle. From Python, pass the block object.
     """
 
     type_name: ClassVar[str | None] = None
@@ -55,7 +64,13 @@ class Block:
     path_params: ClassVar[tuple[str, ...]] = ()
     """Parameters holding file paths: the loader resolves relative ones against the
     diagram's folder, as it does ``params_file``."""
+    block_params: ClassVar[tuple[str, ...]] = ()
+    """Parameters whose diagram value is the name of another block of the diagram; the
+    constructor receives that block (built and bound before this one)."""
     time_varying: ClassVar[bool] = False
+    name: str | None = None
+    """The block's name in its diagram, set by the loader once the block is built (None
+    for a block made from Python); for messages of blocks that refer to it."""
 
     inputs: dict[str, int | None] = {}
     outputs: dict[str, int | None] = {}
@@ -119,6 +134,24 @@ class Block:
         return state, {p: np.asarray(v, dtype=float).reshape(n, self.outputs[p]) for p, v in rows.items()}
 
     # -- introspection helpers used by the loader, the scheduler and the CLI --------
+
+    def describe(self) -> str:
+        """A short note on where this block's configuration comes from, which
+        ``hierhand validate`` prints beside the block (e.g. the model a plant simulates);
+        empty for nothing to say."""
+        return ""
+
+    @classmethod
+    def param_default(cls, name: str) -> Any:
+        """The value a ``--set`` path into parameter ``name`` starts from when the diagram
+        does not give that parameter (``--set b.gains.1=2``): here the ``__init__`` default
+        if it is a list, tuple or mapping (a tuple as a list), else None, which starts an
+        empty mapping. A block whose ``None`` default stands for a larger value overrides it."""
+        param = cls.parameters().get(name)
+        default = None if param is None else param.default
+        if isinstance(default, tuple):
+            return list(default)
+        return copy.deepcopy(default) if isinstance(default, (list, Mapping)) else None
 
     @classmethod
     def registered_name(cls) -> str:

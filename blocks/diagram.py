@@ -19,6 +19,8 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from .block import Block
+from .param_paths import PathError, set_path
+from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
 from .timebase import DurationError, parse_duration
 from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml
@@ -66,6 +68,27 @@ class BlockSpec:
     offset: Fraction
     params: dict
     line: int
+    params_file: str | None = None
+    """The block's params_file (resolved against the diagram's folder), if it has one."""
+
+    @property
+    def references(self) -> dict[str, str]:
+        """This block's block references: parameter -> name of the block it refers to."""
+        return {p: self.params[p] for p in type(self.block).block_params if p in self.params}
+
+
+@dataclass
+class _Entry:
+    """A block of the file checked up to its constructor call (built once its references are)."""
+
+    name: str
+    spec: LineDict
+    line: int
+    cls: type[Block]
+    period: Fraction | None
+    offset: Fraction | None
+    params: dict
+    references: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -137,6 +160,11 @@ class Diagram:
         """Width of an output signal ``block.port``."""
         block, port = signal.split(".")
         return self.blocks[block].block.outputs[port]
+
+    def references(self) -> list[Reference]:
+        """Every block reference of the diagram (``reflex.hand -> plant``), in block order."""
+        return [Reference(name, param, target) for name, spec in self.blocks.items()
+                for param, target in spec.references.items()]
 
     def parameters(self) -> dict[str, dict]:
         """Parameters of every block after params files and overrides (JSON-friendly)."""
@@ -309,25 +337,46 @@ class _Loader:
             self.error(line_of(data, "blocks", 1), "the diagram needs a non-empty 'blocks' mapping",
                        "blocks: {name: {type: Gain, params: {k: 2}}, ...}")
             return {}
-        blocks: dict[str, BlockSpec] = {}
+        names: list[str] = []
+        entries: dict[str, _Entry] = {}
         for name, spec in section.items():
             line = section.line_of(name)
             if not isinstance(name, str) or not _NAME.match(name):
                 self.error(line, f"invalid block name {name!r}",
                            "use letters, digits and '_' (not starting with a digit)")
                 continue
+            names.append(name)
             if not isinstance(spec, LineDict):
                 self.error(line, f"block '{name}' must be a mapping with at least 'type'",
                            f"{name}: {{type: Gain, params: {{k: 2}}}}")
+                self.failed_blocks.add(name)
                 continue
-            built = self.block(name, spec, line)
-            if built is None:
+            entry = self.entry(name, spec, line)
+            if entry is None or not self.references(entry, names=section):
                 self.failed_blocks.add(name)
             else:
-                blocks[name] = built
-        return blocks
+                entries[name] = entry
+        order, cycles = build_order({name: e.references for name, e in entries.items()})
+        cyclic = {r.block for cycle in cycles for r in cycle}
+        for cycle in cycles:
+            first = entries[cycle[0].block]
+            self.param_error(first, cycle[0].param, f"block references form a cycle: {chain_text(cycle)}",
+                             "a referenced block is built before the blocks that refer to it; "
+                             "remove one of these references")
+        built: dict[str, BlockSpec] = {}
+        for name in order:
+            entry = entries[name]
+            # a block on a cycle, or referring to a block that failed (reported there), is not built
+            spec = None if name in cyclic or any(t not in built for t in entry.references.values()) \
+                else self.build(entry, built)
+            if spec is None:
+                self.failed_blocks.add(name)
+            else:
+                built[name] = spec
+        return {name: built[name] for name in names if name in built}
 
-    def block(self, name: str, spec: LineDict, line: int) -> BlockSpec | None:
+    def entry(self, name: str, spec: LineDict, line: int) -> _Entry | None:
+        """Check a block's keys, type, timing and parameters, up to its constructor call."""
         self.check_keys(spec, BLOCK_KEYS, "key", f" in block '{name}'")
         type_name = spec.get("type")
         if not isinstance(type_name, str):
@@ -364,8 +413,53 @@ class _Loader:
         params = self.params(name, spec, cls, line)
         if params is None:
             return None
+        return _Entry(name, spec, line, cls, period, offset, params)
+
+    def references(self, entry: _Entry, names: Mapping) -> bool:
+        """Check the block's block-reference parameters against the diagram's block names
+        and record them in ``entry.references``; False (reported) if one is bad."""
+        ok = True
+        for key in entry.cls.block_params:
+            if key not in entry.params:
+                continue
+            target = entry.params[key]
+            if not isinstance(target, str):
+                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' must be the name of "
+                                 f"a block of this diagram, got {target!r}", f"e.g. {key}: <block name>")
+            elif target == entry.name:
+                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' refers to the block "
+                                 "itself", f"name another block of this diagram; blocks are: {_known(names)}")
+            elif target not in names:
+                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' names no block "
+                                 f"'{target}'", _suggest(target, names) or f"blocks are: {_known(names)}")
+            else:
+                entry.references[key] = target
+                continue
+            ok = False
+        return ok
+
+    def param_error(self, entry: _Entry, key: str, message: str, hint: str = "") -> None:
+        """An issue about one parameter, reported where its value comes from: the --set
+        that gave it, or its line in the diagram."""
+        override = f"{entry.name}.{key}"
+        if override in self.overrides:
+            self.override_error(override, message, hint)
+            return
+        inline = entry.spec.get("params")
+        if isinstance(inline, LineDict) and key in inline:
+            line = inline.line_of(key)
+        else:
+            line = entry.spec.line_of("params_file") if "params_file" in entry.spec else entry.line
+        self.error(line, message, hint)
+
+    def build(self, entry: _Entry, built: Mapping[str, BlockSpec]) -> BlockSpec | None:
+        """Construct and bind the block, its references given as the blocks they name."""
+        name, spec, line, cls, period = entry.name, entry.spec, entry.line, entry.cls, entry.period
+        type_name = spec["type"]
+        arguments = dict(entry.params)
+        arguments.update({key: built[target].block for key, target in entry.references.items()})
         try:
-            block = cls(**params)
+            block = cls(**arguments)
             block.bind(period)
             if period is None and block.period is not None:
                 period = block.period  # a block with a natural rate (an FMU's default step)
@@ -374,6 +468,7 @@ class _Loader:
             self.error(where, f"block '{name}' ({type_name}): {exc}",
                        f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
             return None
+        block.name = name
         for kind in ("inputs", "outputs"):
             ports = getattr(block, kind)
             if not isinstance(ports, Mapping) or not all(
@@ -382,7 +477,9 @@ class _Loader:
                 self.error(line, f"block '{name}' ({type_name}) declares invalid {kind}: {ports!r}",
                            f"ports map names to integer widths from 1 to {MAX_PORT_WIDTH} (or None to infer)")
                 return None
-        return BlockSpec(name, cls.registered_name(), block, period, offset or Fraction(0), params, line)
+        params_file = str(self.base_dir / spec["params_file"]) if "params_file" in spec else None
+        return BlockSpec(name, cls.registered_name(), block, period, entry.offset or Fraction(0), entry.params,
+                         line, params_file)
 
     def params(self, name: str, spec: LineDict, cls: type[Block], line: int) -> dict | None:
         params: dict = {}
@@ -422,17 +519,11 @@ class _Loader:
                                     f"parameters: {_known(declared)}")
                 ok = False
                 continue
-            target = params
-            for part in parts[:-1]:
-                if not isinstance(target.get(part), dict):
-                    target[part] = {} if part not in target else target[part]
-                if not isinstance(target[part], dict):
-                    self.override_error(key, f"'{name}.{part}' is not a mapping")
-                    ok = False
-                    break
-                target = target[part]
-            else:
-                target[parts[-1]] = value
+            try:
+                set_path(params, name, parts, value, cls.param_default)
+            except PathError as exc:
+                self.override_error(key, str(exc), exc.hint)
+                ok = False
         for key in cls.path_params:
             value = params.get(key)
             if isinstance(value, str) and value.strip() and not Path(value).expanduser().is_absolute():

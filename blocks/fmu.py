@@ -245,6 +245,24 @@ def _convert(kind: str, value: Any, name: str) -> Any:
     raise ValueError(f"start values of {kind} variables such as '{name}' are not supported")
 
 
+def _start_of(v: Any) -> list | None:
+    """A variable's modelDescription start, converted to its type (None if it has none,
+    or one that does not read as its type)."""
+    if v.start is None:
+        return None
+    text = str(v.start)
+    if v.type == "String":
+        return [text]
+    try:
+        if v.type == "Boolean":
+            return [{"true": True, "false": False, "1": True, "0": False}[x] for x in text.split()]
+        if v.type in _INT_RANGES:
+            return [int(x) for x in text.split()]
+        return [float(x) for x in text.split()]
+    except (KeyError, ValueError):
+        return None
+
+
 def _settable(v: Any) -> str | None:
     """Why ``v`` cannot be given a start value, or None if it can."""
     if v.variability == "constant":
@@ -838,6 +856,29 @@ class FMU(Block):
     def default_step(self) -> Fraction | None:
         """The FMU's DefaultExperiment stepSize, if it declares one."""
         return self._model.default_step
+
+    def describe(self) -> str:
+        given = len(self._assignments)
+        return (f"FMI {self.fmi_version} co-simulation {self._model.shown}"
+                + (f" ({given} start value{'s' if given != 1 else ''} set)" if given else ""))
+
+    def parameter_values(self) -> dict[str, Any]:
+        """Every parameter variable (causality ``parameter``) with the value a run starts
+        it with: the block's ``start_values`` over the modelDescription's start. Real and
+        Float values as float, integers as int, Boolean as bool, String as str, an FMI 3
+        array as a list. A parameter with neither is left out. For tools that model what
+        the FMU simulates (a controller built for an exported plant)."""
+        given = {a.vr: a.values for a in self._assignments}
+        out: dict[str, Any] = {}
+        for v in self._model.md.modelVariables:
+            if v.causality != "parameter":
+                continue
+            values = given.get(v.valueReference)
+            if values is None:
+                values = _start_of(v)
+            if values:
+                out[v.name] = values if v.dimensions else values[0]
+        return out
 
     def variable_of(self, port: str) -> str:
         """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""

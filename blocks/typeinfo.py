@@ -23,12 +23,16 @@ def describe_type(cls: type[Block]) -> str:
         lines.append("  parameters:")
         for name, p in params.items():
             default = "required" if p.default is p.empty else f"default {p.default!r}"
+            if name in cls.block_params:
+                default += "; the name of another block of the diagram"
             doc = cls.param_docs.get(name, "")
             lines.append(f"    {name} ({default})" + (f": {doc}" if doc else ""))
     try:
         block = cls()
     except Exception:
-        lines.append("  ports: depend on the parameters")
+        needs = [n for n in cls.block_params if n in params and params[n].default is params[n].empty]
+        lines.append(f"  ports: see 'hierhand validate' of a diagram using it (it needs the block named by "
+                     f"{', '.join(needs)})" if needs else "  ports: depend on the parameters")
     else:
         def ports(d: dict) -> str:
             return ", ".join(f"{p}[{'n' if w is None else w}]" for p, w in d.items()) or "none"

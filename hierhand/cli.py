@@ -309,6 +309,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
             notes.append("feedthrough")
         print(f"  {name:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
               + (f"  ({', '.join(notes)})" if notes else ""))
+    print_references_and_notes(diagram)
     print("execution order:")
     print(f"  t = 0: {s.initial.describe()}")
     seen: dict[int, list[int]] = {}
@@ -320,6 +321,26 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if not s.event_ticks.size and s.advanced:
         print(f"  no other events: {', '.join(sorted(s.advanced))} advanced from t = 0 to t_end")
     return EXIT_OK
+
+
+def print_references_and_notes(diagram) -> None:
+    """``validate``'s block references (``reflex.hand -> plant``) and, per block, where its
+    configuration comes from: its params_file, its own ``describe()``, who refers to it."""
+    references = diagram.references()
+    if references:
+        print("references:")
+        for ref in references:
+            print(f"  {ref}")
+    notes = []
+    for name, spec in diagram.blocks.items():
+        users = [f"{r.block}.{r.param}" for r in references if r.target == name]
+        parts = [f"params_file {spec.params_file}" if spec.params_file else "", spec.block.describe(),
+                 f"referenced by {', '.join(users)}" if users else ""]
+        if any(parts):
+            notes.append(f"  {name}: {'; '.join(p for p in parts if p)}")
+    if notes:
+        print("notes:")
+        print("\n".join(notes))
 
 
 def cmd_graph(args: argparse.Namespace) -> int:

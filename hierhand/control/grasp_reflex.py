@@ -49,7 +49,7 @@ import numpy as np
 
 from blocks import Block
 
-from ..model import load_hand
+from ..model.hand_source import HAND_DOC, hand_of
 from .reflex_kernel import (
     N_OUT,
     WHOLE_SHARE,
@@ -77,14 +77,16 @@ def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray
 
 class GraspReflex(Block):
     """Grasping reflex: internal forces among the fingers in contact, kept inside the
-    friction cone at the safety ratio by integral control of the fingertip forces."""
+    friction cone at the safety ratio by integral control of the fingertip forces.
+
+    Its hand (finger geometry for the tip Jacobians, finger names) is the plant's:
+    ``hand: plant`` names the block that simulates the hand (see ``hand_of``).
+    """
 
     type_name = "GraspReflex"
+    block_params = ("hand",)
     param_docs = {
-        "gravity": "hand file section (the reflex uses the finger geometry; default hand if omitted)",
-        "fingers": "hand file section: the three fingers",
-        "object": "hand file section (unused by the reflex; accepted so one params_file serves all blocks)",
-        "contact": "hand file section (unused by the reflex)",
+        "hand": HAND_DOC,
         "grasp": "fingers that close on the object at the start, e.g. [thumb, fore]",
         "ki": "integral gain of the fingertip force loop, 1/s (30-100 gives a 10-30 ms recovery)",
         "safety_ratio": "largest |f_t|/f_n the reflex allows (the paper's 0.6)",
@@ -98,11 +100,10 @@ class GraspReflex(Block):
                          "longer drives the integrator",
     }
 
-    def __init__(self, gravity=None, fingers=None, object=None, contact=None,  # noqa: A002
-                 grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,
+    def __init__(self, hand, grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,
                  approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.8):
-        self.hand = load_hand({"gravity": gravity, "fingers": fingers, "object": object, "contact": contact})
+        self.hand = hand_of(hand)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
                             ("max_force", max_force), ("contact_threshold", contact_threshold)):

@@ -30,7 +30,7 @@ import numpy as np
 
 from blocks import Block
 
-from ..model import load_hand
+from ..model.hand_source import HAND_DOC, hand_of
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
@@ -40,15 +40,18 @@ DERIVATIVE_STEP = 1e-3
 
 
 class ManipulationPD(Block):
-    """Manipulation controller: fingertip trajectories -> inverse kinematics -> joint PD."""
+    """Manipulation controller: fingertip trajectories -> inverse kinematics -> joint PD.
+
+    Its hand (finger geometry and q0, gravity, the object's mass for the load
+    feedforward) is the plant's: ``hand: plant`` names the block that simulates the hand
+    (see ``hand_of``).
+    """
 
     type_name = "ManipulationPD"
+    block_params = ("hand",)
     time_varying = True
     param_docs = {
-        "gravity": "hand file section (default hand if omitted; share the plant's params_file)",
-        "fingers": "hand file section: the three fingers (geometry, q0)",
-        "object": "hand file section: the object's mass is used for the load feedforward",
-        "contact": "hand file section (unused)",
+        "hand": HAND_DOC,
         "trajectories": "per finger name: {waypoints: [[t, x, y, phi], ...], interpolation: minjerk|linear}",
         "kp": "joint stiffness, N m/rad (scalar or 9 values)",
         "kd": "joint damping, N m s/rad (scalar or 9 values)",
@@ -57,11 +60,10 @@ class ManipulationPD(Block):
         "contact_threshold": "normal force, N, above which a finger carries part of the object",
     }
 
-    def __init__(self, gravity=None, fingers=None, object=None, contact=None,  # noqa: A002
-                 trajectories: Mapping[str, Any] | None = None, kp: Any = 2.0, kd: Any = 0.01,
+    def __init__(self, hand, trajectories: Mapping[str, Any] | None = None, kp: Any = 2.0, kd: Any = 0.01,
                  gravity_compensation: bool = True, load_compensation: bool = True,
                  contact_threshold: float = 0.05):
-        self.hand = load_hand({"gravity": gravity, "fingers": fingers, "object": object, "contact": contact})
+        self.hand = hand_of(hand)
         self.kp = np.broadcast_to(np.asarray(kp, dtype=float), (9,)).copy()
         self.kd = np.broadcast_to(np.asarray(kd, dtype=float), (9,)).copy()
         if np.any(self.kp < 0) or np.any(self.kd < 0) or not np.all(np.isfinite(self.kp + self.kd)):

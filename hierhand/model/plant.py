@@ -19,7 +19,7 @@ from blocks.block import Block, BlockError
 
 from .. import _native
 from .hand import Hand
-from .handfile import merge_with_default, parse_hand
+from .handfile import SECTIONS, default_hand_dict, merge_with_default, parse_hand
 from .layout import (
     ERR_F_EXT,
     ERR_OBJ,
@@ -87,10 +87,13 @@ class ContactWrenches:
 
 
 class HandPlant(Block):
-    """Three-fingered planar hand grasping a square object, with the paper's contact law.
+    """Three-fingered planar hand grasping a square object, with the paper's contact law;
+    the diagram's one hand, which the other blocks use by naming this block (hand: plant).
 
     Parameters are the hand file's sections (``gravity``, ``fingers``, ``object``,
-    ``contact``), each defaulting to the shipped hand. The period is the integration step
+    ``contact``), each defaulting to the shipped hand. This is the one place a diagram
+    gives its hand: the controllers and the object support refer to this block
+    (``hand: plant``) and model the same ``Hand``. The period is the integration step
     of a semi-implicit Euler scheme (``hierhand/csrc/plant.c`` says why not explicit Euler).
 
     Inputs: ``tau`` (9 joint torques), ``f_ext`` (fx, fy, torque on the object; zero when
@@ -116,6 +119,7 @@ class HandPlant(Block):
     def __init__(self, gravity=None, fingers=None, object=None, contact=None):  # noqa: A002 - hand file name
         sections = {"gravity": gravity, "fingers": fingers, "object": object, "contact": contact}
         self.hand = Hand(parse_hand(merge_with_default(sections), "HandPlant parameters"))
+        self._given = tuple(key for key in SECTIONS if sections[key] is not None)
         self.inputs = {"tau": 9, "f_ext": 3}
         self.input_defaults = {"f_ext": _ZERO3}
         self.outputs = dict(OUTPUT_PORTS)
@@ -123,6 +127,23 @@ class HandPlant(Block):
         self._state_shape = (self.hand.native.state_size,)
         self._model: _native.Model | None = None  # the hand packed with its step, once bound
         self.dt: float | None = None
+
+    @classmethod
+    def param_default(cls, name: str) -> Any:
+        """``gravity`` and ``fingers`` replace the default hand's as a whole, so a ``--set``
+        path into them (``plant.fingers.1.links.0.length``) starts from the default hand's;
+        ``object`` and ``contact`` are merged key by key, so one starts empty and the keys
+        it does not give keep following the default (an object's inertia its mass)."""
+        return default_hand_dict()[name] if name in ("gravity", "fingers") else None
+
+    def describe(self) -> str:
+        """Where the hand comes from: the built-in default hand, or which sections the
+        diagram gives."""
+        if not self._given:
+            return "hand: the built-in default hand"
+        if len(self._given) == len(SECTIONS):
+            return "hand: all from the diagram"
+        return f"hand: {', '.join(self._given)} from the diagram, the rest from the built-in default hand"
 
     @classmethod
     def from_hand(cls, hand: Hand) -> "HandPlant":

@@ -23,7 +23,8 @@ from .errors import SweepError
 
 Point = dict[str, Any]
 
-_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)+$")
+_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*\.[A-Za-z_][A-Za-z0-9_]*(\.([A-Za-z_][A-Za-z0-9_]*|[0-9]+))*$")
+"""``block.param``, then keys or list indices as ``--set`` takes them: ``plant.fingers.1.links.0.length``."""
 _DIST = re.compile(r"^\s*(uniform|normal)\s*\(\s*([^,()]+?)\s*,\s*([^,()]+?)\s*\)\s*$")
 _FLOAT = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)[eE][-+]?\d+$")
 """Exponent numbers YAML 1.1 leaves as strings ('1e-3'): read as the floats they mean."""

@@ -62,10 +62,7 @@ def withdrawal(parameters: dict, b: TaskBlocks = TaskBlocks()) -> tuple[float, f
 def summarize(runs: dict[str, Results], b: TaskBlocks = TaskBlocks()) -> dict:
     """summary.json's content from the four runs."""
     grasp_params = runs["grasp"].info["parameters"]
-    manip_params = runs["manipulate"].info["parameters"]
-    from ..model import load_hand
-
-    hand = load_hand(manip_params.get(b.plant, {}))
+    manipulate_params = runs["manipulate"].info["parameters"]
     regrasp = {key: regrasp_summary(runs[task], withdrawal(runs[task].info["parameters"], b), b)
                for key, task in (("suppressed", "regrasp"), ("unsuppressed", "regrasp_unsuppressed"))}
     for case in regrasp.values():
@@ -73,10 +70,19 @@ def summarize(runs: dict[str, Results], b: TaskBlocks = TaskBlocks()) -> dict:
     return {
         "grasp": grasp_summary(runs["grasp"], float(grasp_params["push"]["time"]), b,
                                handover_time=handover_time(grasp_params)),
-        "manipulation": manipulation_summary(runs["manipulate"], manip_params[b.manipulation]["trajectories"],
-                                             hand.object_pose0, b),
+        "manipulation": manipulation_summary(runs["manipulate"], manipulate_params[b.manipulation]["trajectories"],
+                                             run_hand(manipulate_params, b).object_pose0, b),
         "regrasp": regrasp,
     }
+
+
+def run_hand(parameters: dict, b: TaskBlocks = TaskBlocks()):
+    """The hand of a task run, from its run.json parameters: the hand of the plant that
+    the manipulation controller refers to (``hand: plant``), whose parameters are the
+    hand file's sections."""
+    from ..model import load_hand
+
+    return load_hand(parameters[parameters[b.manipulation]["hand"]])
 
 
 def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[str], None] = lambda s: None) -> dict:

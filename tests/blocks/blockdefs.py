@@ -100,3 +100,52 @@ class FastCappedAccumulator(CappedAccumulator):
         if over.size:
             raise BlockError(f"state passes {self.limit:g}", port="y", rows={"y": rows[:over[0]]})
         return rows[-1].copy(), {"y": rows}
+
+
+class Model(Block):
+    """y = value: a block that other blocks refer to (its ``value`` is their model)."""
+
+    def __init__(self, value: float = 1.0):
+        self.value = float(value)
+        self.outputs = {"y": 1}
+        self.feedthrough = False
+
+    def describe(self):
+        return f"value {self.value:g}"
+
+    def output(self, t, state, inputs):
+        return {"y": np.array([self.value])}
+
+
+class ScaleByModel(Block):
+    """y = source.value * u: ``source`` (and the optional ``spare``) are block references."""
+
+    block_params = ("source", "spare")
+
+    def __init__(self, source, spare=None, offset: float = 0.0):
+        if not isinstance(source, Model):
+            raise ValueError(f"parameter 'source' must be a Model block, got {type(source).__name__}")
+        self.source, self.spare, self.offset = source, spare, float(offset)
+        self.inputs = {"u": 1}
+        self.outputs = {"y": 1}
+
+    def output(self, t, state, inputs):
+        return {"y": self.source.value * inputs["u"] + self.offset}
+
+
+class Weights(Block):
+    """y = weights (a list parameter with a tuple default); ``extra`` defaults to None but
+    stands for the list [1.0, 2.0, 3.0] (its ``param_default``)."""
+
+    def __init__(self, weights=(1.0, 2.0), extra=None):
+        self.weights = np.asarray(weights, dtype=float)
+        self.extra = np.asarray([1.0, 2.0, 3.0] if extra is None else extra, dtype=float)
+        self.outputs = {"y": self.weights.size, "extra": self.extra.size}
+        self.feedthrough = False
+
+    @classmethod
+    def param_default(cls, name):
+        return [1.0, 2.0, 3.0] if name == "extra" else super().param_default(name)
+
+    def output(self, t, state, inputs):
+        return {"y": self.weights.copy(), "extra": self.extra.copy()}

@@ -155,6 +155,16 @@ def test_start_values_of_every_type_change_the_result(fmus):
     np.testing.assert_array_equal(frozen["f.y"][1], 2.0)
 
 
+@pytest.mark.parametrize("version", [2, 3])
+def test_parameter_values_are_the_start_values_over_the_model_description(fmus, version):
+    path = fmus.fmi2 if version == 2 else fmus.fmi3
+    block = diagram(path, start_values="{a: 0.9, scale: 3, frozen: true}").blocks["f"].block
+    values = block.parameter_values()
+    assert values == {"a": 0.9, "b": 1.0, "x0": 0.0, "threshold": 100.0, "scale": 3, "frozen": True}
+    assert [type(values[k]) for k in ("a", "scale", "frozen")] == [float, int, bool]
+    assert diagram(path).blocks["f"].block.parameter_values()["a"] == 0.5
+
+
 def test_fmu_in_a_feedback_loop_has_no_algebraic_loop(fmus):
     """Co-simulation outputs do not depend on the same instant's input: u = r - y is fine."""
     d = loads_diagram(f"""

@@ -24,7 +24,7 @@ def reflex_inputs(hand, fn, ft=(0.0, 0.0, 0.0), normals=((1, 0), (-1, 0), (0, 0)
 
 
 def make_reflex(**params):
-    reflex = GraspReflex(**params)
+    reflex = GraspReflex(hand=Hand.default(), **params)
     reflex.bind(0.001)
     return reflex
 
@@ -110,14 +110,14 @@ def test_a_finger_handed_to_voluntary_motion_does_not_drive_the_squeeze():
 
 def test_reflex_rejects_unknown_fingers():
     with pytest.raises(ValueError, match="unknown finger"):
-        GraspReflex(grasp=["thumb", "pinky"])
+        GraspReflex(hand=Hand.default(), grasp=["thumb", "pinky"])
 
 
 def test_manipulation_pd_tracks_its_trajectory_with_gravity_feedforward():
     hand = Hand.default()
     tips = hand.tip_poses(hand.q0)
     goal = tips[1] + [0.004, 0.0, -0.1]
-    pd = ManipulationPD(kp=1.0, kd=0.0, load_compensation=False,
+    pd = ManipulationPD(hand=hand, kp=1.0, kd=0.0, load_compensation=False,
                         trajectories={"fore": {"waypoints": [[0.0, *tips[1]], [0.1, *goal]]}})
     pd.bind(0.01)
     inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)}
@@ -132,7 +132,7 @@ def test_manipulation_pd_tracks_its_trajectory_with_gravity_feedforward():
 
 def test_manipulation_pd_shares_the_object_weight_among_touching_fingers():
     hand = Hand.default()
-    pd = ManipulationPD(gravity_compensation=False)
+    pd = ManipulationPD(hand=hand, gravity_compensation=False)
     out = pd.output(0.0, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.array([2.0, 2.0, 0.0])})
     jac = hand.tip_jacobians(hand.q0)
     lift = -hand.params.object.mass * hand.gravity / 2
@@ -142,7 +142,7 @@ def test_manipulation_pd_shares_the_object_weight_among_touching_fingers():
 
 def test_manipulation_pd_carries_only_what_the_support_does_not():
     hand = Hand.default()
-    pd = ManipulationPD(gravity_compensation=False)
+    pd = ManipulationPD(hand=hand, gravity_compensation=False)
     weight = hand.params.object.mass * hand.gravity
     inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.array([2.0, 2.0, 0.0])}
     carried = pd.output(0.0, None, dict(inputs, support=np.array([-weight[0], -weight[1], 0.0])))
@@ -156,7 +156,8 @@ def test_manipulation_pd_carries_only_what_the_support_does_not():
 
 def test_manipulation_pd_rejects_an_unreachable_waypoint_naming_finger_and_time():
     with pytest.raises(ValueError, match=r"finger 'fore': the waypoint at t = 0.5 s .* unreachable"):
-        ManipulationPD(trajectories={"fore": {"waypoints": [[0.0, 0.033, 0.06, 3.0], [0.5, 0.2, 0.2, 0.0]]}})
+        ManipulationPD(hand=Hand.default(),
+                       trajectories={"fore": {"waypoints": [[0.0, 0.033, 0.06, 3.0], [0.5, 0.2, 0.2, 0.0]]}})
 
 
 @pytest.mark.parametrize("mode", ["magnitude", "signed"])

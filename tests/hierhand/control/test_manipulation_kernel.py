@@ -63,7 +63,7 @@ def _times(trajectories):
 @pytest.mark.parametrize("flags", [(True, True), (False, True), (True, False), (False, False)])
 def test_compiled_output_matches_the_numpy_reference(trajectories, flags):
     hand = Hand.default()
-    pd = ManipulationPD(kp=[1.0, 2.0, 0.5] * 3, kd=0.015, trajectories=trajectories,
+    pd = ManipulationPD(hand=hand, kp=[1.0, 2.0, 0.5] * 3, kd=0.015, trajectories=trajectories,
                         gravity_compensation=flags[0], load_compensation=flags[1])
     rng = np.random.default_rng(7)
     for t in _times(trajectories):
@@ -79,7 +79,7 @@ def test_compiled_output_matches_the_numpy_reference(trajectories, flags):
 
 def test_outputs_are_fresh_arrays():
     hand = Hand.default()
-    pd = ManipulationPD(trajectories=REGRASP)
+    pd = ManipulationPD(hand=hand, trajectories=REGRASP)
     inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.ones(3)}
     a = pd.output(0.2, None, inputs)
     kept = {k: v.copy() for k, v in a.items()}
@@ -91,7 +91,7 @@ def test_outputs_are_fresh_arrays():
 
 def test_unusual_inputs_take_the_reference_path():
     hand = Hand.default()
-    pd = ManipulationPD(trajectories=REGRASP)
+    pd = ManipulationPD(hand=hand, trajectories=REGRASP)
     ref = pd.output(0.25, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)})
     listed = pd.output(0.25, None, {"q": list(hand.q0), "qd": [0] * 9, "fn": np.zeros(3, dtype=np.float32)})
     for k in ref:
@@ -105,8 +105,8 @@ def test_a_target_unreachable_between_waypoints_raises_naming_the_finger():
     # fore finger: wrist points 50 mm above and below the base (reachable), whose
     # straight-line interpolation passes the base itself (inside the inner radius)
     hand = Hand.default()
-    pd = ManipulationPD(trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
-                                                             [1.0, 0.035, -0.038, math.pi / 2]]}})
+    pd = ManipulationPD(hand=hand, trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
+                                                                        [1.0, 0.035, -0.038, math.pi / 2]]}})
     inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)}
     pd.output(0.1, None, inputs)
     with pytest.raises(UnreachableError, match="fore: unreachable fingertip target"):
@@ -193,9 +193,9 @@ def test_float64_arrays_with_a_distinct_dtype_object_take_the_native_path(monkey
     def refuse(*args, **kwargs):
         raise AssertionError("conversion or reference path taken")
 
-    pd = ManipulationPD(trajectories=REGRASP)
+    pd = ManipulationPD(hand=hand, trajectories=REGRASP)
     s = Suppresser()
-    reflex = GraspReflex()
+    reflex = GraspReflex(hand=hand)
     reflex.bind(0.001)
     monkeypatch.setattr(pd, "output_reference", refuse)
     monkeypatch.setattr(s, "output_reference", refuse)
@@ -218,9 +218,9 @@ def test_float64_arrays_with_a_distinct_dtype_object_take_the_native_path(monkey
 def test_other_arrays_are_converted_or_take_the_reference_path():
     """Strided views, other dtypes and lists give what their float64 copies give."""
     hand = Hand.default()
-    pd = ManipulationPD(trajectories=REGRASP)
+    pd = ManipulationPD(hand=hand, trajectories=REGRASP)
     s = Suppresser(S_a=50.0, S_b=0.2)
-    reflex = GraspReflex()
+    reflex = GraspReflex(hand=hand)
     reflex.bind(0.001)
     rng = np.random.default_rng(11)
     wide = rng.normal(size=(9, 2))
@@ -250,8 +250,8 @@ def test_native_output_reports_the_unreachable_finger():
     """The status names the finger (UNREACHABLE + f) whose target, or a neighbour a
     derivative step away, is out of reach; ``output`` then raises from the reference."""
     hand = Hand.default()
-    pd = ManipulationPD(trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
-                                                             [1.0, 0.035, -0.038, math.pi / 2]]}})
+    pd = ManipulationPD(hand=hand, trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
+                                                                        [1.0, 0.035, -0.038, math.pi / 2]]}})
     inputs = (hand.q0, np.zeros(9), np.zeros(3), np.zeros(3))
     out = np.empty((3, 9))
     assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, out) == OK

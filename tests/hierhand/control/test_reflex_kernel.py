@@ -30,6 +30,7 @@ from hierhand.control.reflex_kernel import (
     reflex_output,
     reflex_update,
 )
+from hierhand.model import Hand
 
 
 def reference_directions(reflex, state, tip, normal, fn):
@@ -82,7 +83,7 @@ def reference_update(reflex, state, inputs):
 
 
 def make_reflex(grasp):
-    reflex = GraspReflex(grasp=grasp, ki=50.0, min_force=3.0, approach_force=0.5)
+    reflex = GraspReflex(hand=Hand.default(), grasp=grasp, ki=50.0, min_force=3.0, approach_force=0.5)
     reflex.bind(0.001)
     return reflex
 
@@ -190,7 +191,7 @@ def test_output_ports_are_fresh_and_update_needs_the_period():
         assert not np.shares_memory(a[port], b[port]) and not np.shares_memory(a[port], state)
     new = reflex.update(0.0, state, inputs)
     assert new is not state and new.shape == (4,)
-    unbound = GraspReflex()
+    unbound = GraspReflex(hand=Hand.default())
     with pytest.raises(ValueError, match="explicit period"):
         unbound.update(0.0, unbound.initial_state(), inputs)
 
@@ -224,7 +225,7 @@ def test_coincident_points_are_an_error_of_every_entry_point():
 def test_the_period_is_checked_before_the_directions():
     """An unbound reflex's update names the missing period even where the directions
     would fail; output needs no period."""
-    reflex = GraspReflex()
+    reflex = GraspReflex(hand=Hand.default())
     state = np.array([2.0, 1.0, 1.0, 0.0])
     tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
     normal, fn, ft = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0]), np.array([2.0, 2.0, 0.0]), np.zeros(3)

@@ -184,3 +184,21 @@ def test_plant_from_a_loaded_hand_has_the_same_parameters(tmp_path):
     plant = HandPlant.from_hand(hand)
     assert plant.hand.params == hand.params
     assert np.array_equal(plant.hand.body, hand.body)
+
+
+def test_describe_says_where_the_hand_comes_from():
+    assert HandPlant().describe() == "hand: the built-in default hand"
+    assert HandPlant(object={"mass": 0.36}, contact={"mu_s": 1.1, "mu_d": 1.0}).describe() == \
+        "hand: object, contact from the diagram, the rest from the built-in default hand"
+    full = HandPlant().hand.params.to_dict()
+    assert HandPlant.from_hand(HandPlant(**full).hand).describe() == "hand: all from the diagram"
+
+
+def test_a_set_path_into_the_whole_sections_starts_from_the_default_hand():
+    from hierhand.model.handfile import default_hand_dict
+
+    assert HandPlant.param_default("fingers") == default_hand_dict()["fingers"]
+    assert HandPlant.param_default("gravity") == [0.0, -9.81]
+    # merged key by key: a partial object keeps deriving its inertia from its own mass
+    assert HandPlant.param_default("object") is None and HandPlant.param_default("contact") is None
+    assert HandPlant(object={"mass": 0.6}).hand.params.object.inertia == pytest.approx(0.6 * 0.005 / 12)

@@ -20,12 +20,18 @@ def test_grid_is_the_cartesian_product_with_yaml_values():
                                                               for v in ((1, 2), (3, 4))}
 
 
+def test_a_key_may_index_a_list_as_set_does():
+    assert parse_grid(["plant.fingers.1.links.0.length=0.040,0.041"]) == {
+        "plant.fingers.1.links.0.length": [0.040, 0.041]}
+
+
 def test_split_keeps_brackets_and_quotes_together():
     assert split_top_level("1,[2,3],{a: 1, b: 2},'x,y'") == ["1", "[2,3]", "{a: 1, b: 2}", "'x,y'"]
 
 
 @pytest.mark.parametrize("item, message", [
     ("k=1,2", "not BLOCK.PARAM"),
+    ("a.0=1,2", "not BLOCK.PARAM"),
     ("a.k", "expected BLOCK.PARAM=V1,V2"),
     ("a.k=1,,2", "empty value"),
     ("a.k=[1,", "not valid YAML"),

@@ -94,3 +94,10 @@ def test_figures_and_report_are_written(reproduced):
     assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 9
     for task in ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed"):
         assert (out / "runs" / task / "signals.npz").is_file()
+
+
+def test_the_summary_takes_the_hand_of_the_plant_the_controller_refers_to():
+    from hierhand.tasks.reproduce import run_hand
+
+    parameters = {"manip": {"hand": "arm", "kp": 1.0}, "arm": {"object": {"pos": [0.01, 0.07]}}, "plant": {}}
+    assert run_hand(parameters).object_pose0.tolist() == [0.01, 0.07, 0.0]

@@ -1,0 +1,52 @@
+"""``ObjectSupport``: the support that carries the object until the fingers take it over.
+
+The shipped tasks start with the object resting on a support while the fingers close on
+it, and hand it over at 0.1 s. The support force is the object's weight turned upwards,
+``-m g``, computed from the plant's own hand, so a heavier object (``--set
+plant.object.mass=0.36``) is carried by a larger force without editing the diagram.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+
+from blocks import Block
+
+from .hand_source import HAND_DOC, hand_of
+
+
+class ObjectSupport(Block):
+    """The force of a support carrying the object's weight, removed at ``until``.
+
+    Output ``y`` in the plant's ``f_ext`` layout (fx, fy, torque about the object's
+    centre): ``-m g`` with torque 0 while ``t < until``, zero from ``until`` on (as a
+    ``Step`` switches). ``m`` and ``g`` are those of the hand of the block named by
+    ``hand`` (``hand: plant``).
+    """
+
+    type_name = "ObjectSupport"
+    block_params = ("hand",)
+    time_varying = True
+    param_docs = {
+        "hand": HAND_DOC + "; the support carries the weight of its object",
+        "until": "time, s, from which the support is gone (the hand-over); the force is zero from then on",
+    }
+
+    def __init__(self, hand, until: float = 0.1):
+        self.hand = hand_of(hand)
+        if isinstance(until, bool) or not isinstance(until, (int, float)) or not math.isfinite(until):
+            raise ValueError(f"parameter 'until' must be a finite time in seconds, got {until!r}")
+        self.until = float(until)
+        force = np.zeros(3)
+        force[:2] = 0.0 - self.hand.params.object.mass * self.hand.gravity
+        self.force = force
+        self.force.flags.writeable = False
+        self.inputs = {}
+        self.outputs = {"y": 3}
+        self.feedthrough = False
+
+    def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        return {"y": self.force.copy() if t < self.until else np.zeros(3)}
