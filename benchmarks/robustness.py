@@ -9,9 +9,10 @@ middle finger touches, the forefinger lets go during its withdrawal and stays of
 object is not dropped (``hierhand.tasks.metrics.regrasp_succeeded``). Without the suppresser
 the forefinger must never let go.
 
-Prints the success rates, the worst points and the same rates for other values of the
-reflex's ``release_share``, and draws success over mass and kp into
-docs/regrasp_robustness.png. Runs on all cores with a process pool.
+Prints the success rates, the failed points, the same rates for other values of the
+reflex's ``release_share`` and where, on a wider grid of mass and kp, the re-grasp stops
+working and why; draws those into docs/regrasp_robustness.png. Runs on all cores with a
+process pool.
 
     python benchmarks/robustness.py [--points 300] [--seed 2026] [--workers 2]
 """
@@ -19,6 +20,7 @@ docs/regrasp_robustness.png. Runs on all cores with a process pool.
 from __future__ import annotations
 
 import argparse
+import collections
 import os
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -36,7 +38,7 @@ FIGURE = ROOT / "docs" / "regrasp_robustness.png"
 RANGES = {"mass": (0.24, 0.36), "friction": (0.9, 1.1), "S_a": (0.8, 1.2), "S_b": (0.8, 1.2),
           "stiffness": (0.7, 1.3), "kp": (0.8, 1.2)}
 """The object mass in kg, the others factors on the shipped values."""
-RELEASE_SHARES = (0.6, 0.7, 0.9)
+RELEASE_SHARES = (0.6, 0.7, 0.8, 0.93, 0.95)
 """release_share values checked beside the shipped one, to show the result is not tuned."""
 
 
@@ -64,11 +66,33 @@ def run_point(args: tuple[dict, dict, dict]) -> dict:
     suppressed = blocks.simulate(blocks.load_diagram(WITH, overrides=ov))
     summary = regrasp_summary(suppressed, withdrawal(suppressed.info["parameters"]))
     unsuppressed = regrasp_events(blocks.simulate(blocks.load_diagram(WITHOUT, overrides=ov)))
-    return {**point, "succeeded": regrasp_succeeded(summary) and suppressed.complete,
+    return {**point, "succeeded": regrasp_succeeded(summary) and suppressed.complete, "why": why_failed(summary),
             "separation": summary["fore_separation_time_s"], "dropped": summary["object_dropped"],
             "falls": (summary["grasp_vs_manipulation_correlation"] or 0.0) < 0.0,
             "kept": summary["holding_grasp_torque_kept"],
             "held_without": unsuppressed["fore_separation_time_s"] is None and not unsuppressed["object_dropped"]}
+
+
+def why_failed(summary: dict) -> str:
+    """The first thing that went wrong in a re-grasp, or "" when it succeeded."""
+    if summary["object_dropped"]:
+        return "object dropped"
+    if summary["middle_contact_time_s"] is None:
+        return "middle finger never touches"
+    if summary["fore_separation_time_s"] is None:
+        return "forefinger holds on"
+    if not summary["fore_stays_off"]:
+        return "forefinger comes back"
+    if not regrasp_succeeded(summary):
+        return "separates outside the withdrawal"
+    return ""
+
+
+def wide_grid(n: int = 11) -> list[dict]:
+    """Mass 0.1-0.6 kg against kp x0.5-2, everything else at the shipped values: where the
+    re-grasp stops working."""
+    return [{"mass": float(m), "kp": float(k), "friction": 1.0, "S_a": 1.0, "S_b": 1.0, "stiffness": 1.0}
+            for m in np.linspace(0.1, 0.6, n) for k in np.linspace(0.5, 2.0, n)]
 
 
 def sweep(points: list[dict], extra: dict, workers: int) -> list[dict]:
@@ -77,30 +101,33 @@ def sweep(points: list[dict], extra: dict, workers: int) -> list[dict]:
         return list(pool.map(run_point, [(p, base, extra) for p in points], chunksize=8))
 
 
-def plot(rows: list[dict], path: Path) -> None:
+def plot(rows: list[dict], wide: list[dict], path: Path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    ok = np.array([r["succeeded"] for r in rows])
-    mass = np.array([r["mass"] for r in rows])
-    kp = np.array([r["kp"] for r in rows])
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    ax = axes[0]
-    ax.scatter(mass[ok], kp[ok], s=14, c="C2", label=f"re-grasp succeeded ({ok.sum()})")
-    ax.scatter(mass[~ok], kp[~ok], s=30, c="C3", marker="x", label=f"failed ({(~ok).sum()})")
-    ax.set_xlabel("object mass (kg)")
-    ax.set_ylabel("PD kp (x shipped value)")
-    ax.set_title(f"Re-grasp with suppresser, {len(rows)} random points")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2, fontsize="small")
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    for ax, data, title in ((axes[0], rows, f"{len(rows)} random points of the audited ranges"),
+                            (axes[1], wide, "beyond them: mass x kp, the rest as shipped")):
+        reasons = sorted({r["why"] for r in data}, key=lambda w: (w != "", w))
+        for n, why in enumerate(reasons):
+            pick = [r for r in data if r["why"] == why]
+            ax.scatter([r["mass"] for r in pick], [r["kp"] for r in pick], s=16 if why == "" else 30,
+                       marker="o" if why == "" else "x", color="C2" if why == "" else f"C{n + 2}",
+                       label=f"{why or 're-grasp succeeded'} ({len(pick)})")
+        ax.set_xlabel("object mass (kg)")
+        ax.set_ylabel("PD kp (x shipped value)")
+        ax.set_title(title)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize="small")
     sep = np.array([np.nan if r["separation"] is None else r["separation"] for r in rows])
-    ax = axes[1]
-    ax.scatter(np.array([r["S_b"] for r in rows]), sep, s=14, c=mass, cmap="viridis")
+    ax = axes[2]
+    ax.scatter(np.array([r["S_b"] for r in rows]), sep, s=14, c=[r["mass"] for r in rows], cmap="viridis")
     ax.set_xlabel("S_b (x shipped value)")
     ax.set_ylabel("forefinger separation time (s)")
-    ax.set_title("Separation time: set by the withdrawal and S_b")
+    ax.set_title("separation time: set by the withdrawal and S_b")
     fig.colorbar(ax.collections[0], ax=ax, label="object mass (kg)")
+    fig.suptitle("Re-grasp with the suppresser (diagrams/regrasp.yaml), benchmarks/robustness.py")
     fig.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
@@ -135,8 +162,16 @@ def main() -> None:
         print("  failed:", {k: (round(v, 3) if isinstance(v, float) else v) for k, v in r.items()})
     for share in RELEASE_SHARES:
         print(f"release_share {share}: {rates(sweep(points, {'reflex.release_share': share}, args.workers))}")
+    wide = sweep(wide_grid(), {}, args.workers)
+    failures = collections.Counter(r["why"] for r in wide if r["why"])
+    print(f"wide grid (mass 0.1-0.6 kg x kp x0.5-2): {sum(not r['why'] for r in wide)}/{len(wide)} succeed; "
+          + (", ".join(f"{why}: {n}" for why, n in failures.most_common()) or "no failures"))
+    for why in failures:
+        masses = [r["mass"] for r in wide if r["why"] == why]
+        kps = [r["kp"] for r in wide if r["why"] == why]
+        print(f"  {why}: mass {min(masses):.2f}-{max(masses):.2f} kg, kp x{min(kps):.2f}-{max(kps):.2f}")
     if not args.no_plot:
-        plot(rows, FIGURE)
+        plot(rows, wide, FIGURE)
         print(f"wrote {FIGURE.relative_to(ROOT)}")
 
 

@@ -188,12 +188,33 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
     return HH_REFLEX_OK;
 }
 
-/* A finger the suppresser has handed to voluntary motion: its command keeps less than
- * release_share of its grasping torque. Its contact force is no longer the reflex's to
- * restore; counting it would wind the shared scale up while the finger is pulled off. */
-static int released(const double *params, const double *share, int finger)
+/* The fingers the suppresser has handed to voluntary motion: among those held (in the
+ * grasp and touching), a finger whose command keeps less than release_share of its
+ * grasping torque, least share first, as long as two others stay held. Its contact force
+ * is no longer the reflex's to restore; counting it would wind the shared scale up while
+ * the finger is pulled off. Two fingers always stay with the reflex: they are the grasp
+ * (a pinch whose posture PD resists the squeeze keeps only about 0.9 of its torque). */
+static void hand_over(const double *params, const double *share, const int grasp[3], const int touching[3],
+                      int released[3])
 {
-    return share != NULL && share[finger] < params[HH_REFLEX_P_RELEASE_SHARE];
+    int held = 0;
+    for (int i = 0; i < 3; i++) {
+        released[i] = 0;
+        held += grasp[i] && touching[i];
+    }
+    if (share == NULL)
+        return;
+    while (held > 2) {
+        int least = -1;
+        for (int i = 0; i < 3; i++)
+            if (grasp[i] && touching[i] && !released[i] && share[i] < params[HH_REFLEX_P_RELEASE_SHARE] &&
+                (least < 0 || share[i] < share[least]))
+                least = i;
+        if (least < 0)
+            return;
+        released[least] = 1;
+        held -= 1;
+    }
 }
 
 int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
@@ -207,11 +228,13 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
     int code = hh_reflex_directions(params, state, in, g, grasp, touching);
     if (code != HH_REFLEX_OK)
         return code;
+    int released[3];
+    hand_over(params, in->share, grasp, touching, released);
     double scale = state[HH_REFLEX_S_SCALE];
     int held = 0;
     double shortfall = -INFINITY;
     for (int i = 0; i < 3; i++)
-        if (grasp[i] && touching[i] && !released(params, in->share, i)) {
+        if (grasp[i] && touching[i] && !released[i]) {
             held += 1;
             double gain = g[i][0] * in->normal[2 * i] + g[i][1] * in->normal[2 * i + 1]; /* per unit scale */
             double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
@@ -226,6 +249,6 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
      * that voluntary motion took off is left alone */
     for (int i = 0; i < 3; i++)
         next[HH_REFLEX_S_RELEASED + i] =
-            touching[i] ? (released(params, in->share, i) ? 1.0 : 0.0) : state[HH_REFLEX_S_RELEASED + i];
+            touching[i] ? (released[i] ? 1.0 : 0.0) : state[HH_REFLEX_S_RELEASED + i];
     return HH_REFLEX_OK;
 }

@@ -175,7 +175,7 @@ DEVIATIONS = """\
   integrator raises the squeeze of every finger, so the forefinger's grasp torque *rose* during
   the withdrawal (0.13 to about 0.3 N m) and its sudden release at the end threw the object
   (about 1 in 6 random re-grasps dropped it). A finger whose actuator command keeps less than
-  `release_share` (0.8) of its grasp torque no longer drives the integrator: the squeeze follows
+  `release_share` (0.9) of its grasp torque no longer drives the integrator: the squeeze follows
   the thumb and the middle finger, and the forefinger's grasp torque falls as its manipulation
   torque grows, as in the paper's Fig. 14. This is anti-windup for a loop whose actuator is
   shared with a higher level; the paper's control law itself is unchanged.

@@ -108,6 +108,19 @@ def test_a_finger_handed_to_voluntary_motion_does_not_drive_the_squeeze():
     assert held[0] > 2.0 > taken[0]
 
 
+def test_a_pinch_keeps_both_fingers_whatever_their_share():
+    """Two fingers are the grasp: a posture PD that resists the squeeze lowers both shares,
+    but handing either over would leave the reflex nothing to hold the object with."""
+    reflex = make_reflex(ki=50.0, min_force=3.0, release_share=0.8)
+    state = reflex.initial_state()
+    state[0] = 2.0
+    inputs = reflex_inputs(reflex.hand, fn=[1.0, 1.5, 0.0], ft=[0.5, -0.5, 0.0])
+    low = reflex.update(0.0, state, dict(inputs, share=np.array([0.5, 0.6, 1.0])))
+    whole = reflex.update(0.0, state, dict(inputs, share=np.ones(3)))
+    assert low[0] > 2.0  # the squeeze still rises towards min_force
+    np.testing.assert_array_equal(low, whole)
+
+
 def test_reflex_rejects_unknown_fingers():
     with pytest.raises(ValueError, match="unknown finger"):
         GraspReflex(hand=Hand.default(), grasp=["thumb", "pinky"])

@@ -69,7 +69,11 @@ def reference_output(reflex, state, inputs):
 def reference_update(reflex, state, inputs):
     fn, ft = inputs["fn"], inputs["ft"]
     g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], fn)
-    released = inputs.get("share", np.ones(3)) < reflex.release_share
+    share = inputs.get("share", np.ones(3))
+    released = np.zeros(3, dtype=bool)
+    for i in np.argsort(share, kind="stable"):  # the least share first, while two others stay held
+        if grasp[i] and touching[i] and share[i] < reflex.release_share and (grasp & touching & ~released).sum() > 2:
+            released[i] = True
     held = grasp & touching & ~released
     scale = state[0]
     if held.sum() >= 2:
