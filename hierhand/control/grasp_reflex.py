@@ -19,7 +19,9 @@ At every hit (1 ms in the paper) the reflex
    fingers' pushes (the object just moves), so per-finger integrators would drift apart.
    Only the fingers the reflex still holds count: a finger whose actuator command keeps
    less than ``release_share`` of its grasping torque (input ``share``, from the
-   suppresser) has been handed to voluntary motion. Counting it would wind the integrator
+   suppresser) has been handed to voluntary motion, the least share first and never more
+   than leaves two fingers held (two are the grasp; a pinch whose posture PD resists the
+   squeeze keeps only about 0.9 of its torque, and must still be squeezed). Counting it would wind the integrator
    up while the finger is pulled off the object (its |f_t| / f_n climbs as it lets go of
    its load), raising the squeeze of every finger and its own grasp torque.
 
@@ -97,7 +99,7 @@ class GraspReflex(Block):
         "contact_threshold": "normal force, N, above which a finger counts as in contact",
         "release_share": "a finger whose actuator command keeps less than this share of its grasping torque "
                          "(input 'share', from the suppresser) is left to voluntary motion: its force need no "
-                         "longer drives the integrator",
+                         "longer drives the integrator (never more than leaves two fingers held)",
     }
 
     def __init__(self, hand, grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,

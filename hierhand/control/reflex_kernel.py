@@ -123,7 +123,8 @@ def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.n
     moves by ``ki * dt * max_i (need_i - fn_i) / max(g_i . n_i, 1e-3)`` over those fingers,
     ``need_i = max(min_force |g_i|, |ft_i| / ratio_target)``, clipped to
     ``[0, max_force]``. A finger is held by the reflex unless its actuator command keeps less than
-    ``release_share`` of its grasping torque (``share``, 3 values: the suppresser's output).
+    ``release_share`` of its grasping torque (``share``, 3 values: the suppresser's output);
+    the least share is handed over first, and two fingers always stay held.
     """
     new = np.empty(N_STATE)
     try:

@@ -88,11 +88,11 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
                      const double *q, double *out);
 
 /* next (HH_REFLEX_N_STATE): with two or more fingers in the grasp, touching and held
- * (in->share[i] >= release_share, or in->share NULL), the scale moves by
+ * (not handed over: in->share[i] below release_share, least share first, while two others
+ * stay held; in->share NULL hands none over), the scale moves by
  * ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3) over them, need_i =
  * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; a touching finger's
- * released flag becomes whether it is handed over (share below release_share), a finger
- * out of contact keeps its flag. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
+ * released flag becomes whether it is handed over, a finger out of contact keeps its flag. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
 int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
                      double *next);
 

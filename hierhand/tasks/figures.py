@@ -50,7 +50,7 @@ def _torque_axes(ax, results: Results, joint: int, b: TaskBlocks, title: str) ->
     ax.set_ylabel("torque (N m)")
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", fontsize="small")
+    ax.legend(loc="best", fontsize="small")
 
 
 def _mark(ax, t: float | None, text: str) -> None:

@@ -175,10 +175,17 @@ DEVIATIONS = """\
   integrator raises the squeeze of every finger, so the forefinger's grasp torque *rose* during
   the withdrawal (0.13 to about 0.3 N m) and its sudden release at the end threw the object
   (about 1 in 6 random re-grasps dropped it). A finger whose actuator command keeps less than
-  `release_share` (0.9) of its grasp torque no longer drives the integrator: the squeeze follows
-  the thumb and the middle finger, and the forefinger's grasp torque falls as its manipulation
-  torque grows, as in the paper's Fig. 14. This is anti-windup for a loop whose actuator is
-  shared with a higher level; the paper's control law itself is unchanged.
+  `release_share` (0.8) of its grasp torque no longer drives the integrator (two fingers always
+  stay with it): the squeeze follows the thumb and the middle finger, and the forefinger's grasp
+  torque falls as its manipulation torque grows, as in the paper's Fig. 14. This is anti-windup
+  for a loop whose actuator is shared with a higher level; the paper's control law itself is
+  unchanged.
+- **The middle finger's path** goes down past the forefinger's tip before moving in, and sits
+  17 mm below it: the model has no finger-finger contact, and a straight path passed 6.7 mm
+  through the forefinger's tip. Lower on the face (20 mm) the thumb-middle pinch axis tilts more
+  against the faces; once the forefinger has gone the object then turns by up to 16 degrees, the
+  holding fingers' posture errors exceed S_b and the suppresser, which reads |tau_m|, weakens
+  their grasp too (in 26 of 300 random re-grasps a holding joint fell below half its grasp torque).
 - **Feedforward**: the manipulation PD adds the fingers' gravity torques and J^T of the
   object's load (weight less what the support carries), so that its 10 ms loop can keep
   small gains; it is added after the suppresser, as it is not voluntary motion.
