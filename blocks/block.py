@@ -158,6 +158,13 @@ class Block:
         return cls.type_name or cls.__name__
 
     @classmethod
+    def example(cls) -> "Block":
+        """An instance for documentation (``hierhand blocks`` lists its ports): by default
+        the block with its default parameters. A block whose parameters are required, such
+        as a reference to another block, overrides it with a typical instance."""
+        return cls()
+
+    @classmethod
     def parameters(cls) -> dict[str, inspect.Parameter]:
         """The block's parameters: the keyword arguments of its ``__init__``."""
         return _init_parameters(cls.__init__)

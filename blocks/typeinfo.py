@@ -28,7 +28,7 @@ def describe_type(cls: type[Block]) -> str:
             doc = cls.param_docs.get(name, "")
             lines.append(f"    {name} ({default})" + (f": {doc}" if doc else ""))
     try:
-        block = cls()
+        block = cls.example()
     except Exception:
         needs = [n for n in cls.block_params if n in params and params[n].default is params[n].empty]
         lines.append(f"  ports: see 'hierhand validate' of a diagram using it (it needs the block named by "

@@ -21,7 +21,9 @@ At every hit (1 ms in the paper) the reflex
    less than ``release_share`` of its grasping torque (input ``share``, from the
    suppresser) has been handed to voluntary motion, the least share first and never more
    than leaves two fingers held (two are the grasp; a pinch whose posture PD resists the
-   squeeze keeps only about 0.9 of its torque, and must still be squeezed). Counting it would wind the integrator
+   squeeze keeps only about 0.9 of its torque, and must still be squeezed). A finger handed
+   over keeps at most the squeeze it had then: as the others take its load over they need
+   more squeeze, which must not press the leaving finger back onto the object. Counting it would wind the integrator
    up while the finger is pulled off the object (its |f_t| / f_n climbs as it lets go of
    its load), raising the squeeze of every finger and its own grasp torque.
 
@@ -51,7 +53,7 @@ import numpy as np
 
 from blocks import Block
 
-from ..model.hand_source import HAND_DOC, hand_of
+from ..model.hand_source import HAND_DOC, ModelsTheHand, hand_of
 from .reflex_kernel import (
     N_OUT,
     WHOLE_SHARE,
@@ -77,7 +79,7 @@ def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray
     return np.array([n in chosen for n in names])
 
 
-class GraspReflex(Block):
+class GraspReflex(ModelsTheHand, Block):
     """Grasping reflex: internal forces among the fingers in contact, kept inside the
     friction cone at the safety ratio by integral control of the fingertip forces.
 
@@ -86,7 +88,6 @@ class GraspReflex(Block):
     """
 
     type_name = "GraspReflex"
-    block_params = ("hand",)
     param_docs = {
         "hand": HAND_DOC,
         "grasp": "fingers that close on the object at the start, e.g. [thumb, fore]",
@@ -140,7 +141,8 @@ class GraspReflex(Block):
         self._params[P_DT] = self.dt
 
     def initial_state(self) -> np.ndarray:
-        """[grasp force scale s (N), handed to voluntary motion when it last touched (3)]."""
+        """[grasp force scale s (N), per finger the scale it was handed to voluntary motion at when
+        it last touched, 0 while the reflex holds it (3)]."""
         return np.concatenate(([self.approach_force], np.zeros(3)))
 
     def members(self, state: np.ndarray, fn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -178,6 +180,6 @@ class GraspReflex(Block):
         return {"tau_g": out[O_TAU:O_FORCE], "force": out[O_FORCE:O_ACTIVE], "active": out[O_ACTIVE:N_OUT]}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
-        """The integral step of the grasp force scale and the released flags (a fresh array)."""
+        """The integral step of the grasp force scale and the hand-over scales (a fresh array)."""
         return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"],
                              inputs.get("share", WHOLE_SHARE))

@@ -30,7 +30,7 @@ import numpy as np
 
 from blocks import Block
 
-from ..model.hand_source import HAND_DOC, hand_of
+from ..model.hand_source import HAND_DOC, ModelsTheHand, hand_of
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
@@ -39,7 +39,7 @@ DERIVATIVE_STEP = 1e-3
 """Seconds either side of t for the joint-velocity target (central difference of the IK)."""
 
 
-class ManipulationPD(Block):
+class ManipulationPD(ModelsTheHand, Block):
     """Manipulation controller: fingertip trajectories -> inverse kinematics -> joint PD.
 
     Its hand (finger geometry and q0, gravity, the object's mass for the load
@@ -48,7 +48,6 @@ class ManipulationPD(Block):
     """
 
     type_name = "ManipulationPD"
-    block_params = ("hand",)
     time_varying = True
     param_docs = {
         "hand": HAND_DOC,

@@ -42,7 +42,7 @@ O_FORCE: int = _L["REFLEX_O_FORCE"]
 O_ACTIVE: int = _L["REFLEX_O_ACTIVE"]
 N_OUT: int = _L["REFLEX_N_OUT"]
 
-N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, released (3)]
+N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, scale at hand-over (3), 0 while held]
 
 _directions = _native.reflex_directions
 _forces = _native.reflex_forces
@@ -74,7 +74,7 @@ def reflex_directions(params, state, tip, normal, fn) -> tuple[np.ndarray, np.nd
     """(g (3, 2), grasp (3,) bool, touching (3,) bool): ``GraspReflex.directions``.
 
     ``touching``: ``fn > contact_threshold``; ``grasp``: touching, or listed in 'grasp',
-    not released (handed to voluntary motion when it last touched) and not touching. With
+    not handed to voluntary motion when it last touched (state[1 + i] == 0) and not touching. With
     fewer than two fingers in the grasp ``g`` is 0.
     Otherwise every finger pushes along its normal, an approaching one toward the others'
     centroid, and ``g`` is ``(I - G^+ G) push`` over the grasp, or the centroid squeeze
@@ -117,14 +117,16 @@ def reflex_output(model, params, state, q, tip, normal, fn) -> np.ndarray:
 
 
 def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.ndarray:
-    """(4,) fresh next state ``[scale, released (3)]``.
+    """(4,) fresh next state ``[scale, scale at hand-over (3)]``.
 
     With at least two fingers in the grasp, touching and held by the reflex, the scale
     moves by ``ki * dt * max_i (need_i - fn_i) / max(g_i . n_i, 1e-3)`` over those fingers,
     ``need_i = max(min_force |g_i|, |ft_i| / ratio_target)``, clipped to
     ``[0, max_force]``. A finger is held by the reflex unless its actuator command keeps less than
     ``release_share`` of its grasping torque (``share``, 3 values: the suppresser's output);
-    the least share is handed over first, and two fingers always stay held.
+    the least share is handed over first, and two fingers always stay held. A touching
+    finger handed over keeps the scale it was first handed over at (0 when held), one out of
+    contact keeps its entry.
     """
     new = np.empty(N_STATE)
     try:

@@ -45,8 +45,9 @@ enum {
     HH_REFLEX_N_PARAMS = 12
 };
 
-/* -- state: [force scale, handed to voluntary motion (3)] --------------------------------- */
-enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_RELEASED = 1, HH_REFLEX_N_STATE = 4 };
+/* -- state: [force scale, per finger the scale it was handed to voluntary motion at (3),
+ *    0 while the reflex holds it] ---------------------------------------------------------- */
+enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_HANDED = 1, HH_REFLEX_N_STATE = 4 };
 
 /* -- output of hh_reflex_output: tau_g (9), |f_i| (3), in the grasp (3, 0 or 1) ---------- */
 enum { HH_REFLEX_O_TAU = 0, HH_REFLEX_O_FORCE = 9, HH_REFLEX_O_ACTIVE = 12, HH_REFLEX_N_OUT = 15 };
@@ -77,7 +78,8 @@ int hh_reflex_directions(const double *params, const double *state, const hh_ref
                          int grasp[3], int touching[3]);
 
 /* Fingertip force commands f (3 x 2) from the directions: g_i times the state's scale for
- * a touching finger, g_i scaled to the approach force otherwise. */
+ * a touching finger (at most the scale it was handed over at, for a finger voluntary motion
+ * has taken), g_i scaled to the approach force otherwise. */
 void hh_reflex_forces(const double *params, const double *state, const double g[3][2], const int touching[3],
                       double f[3][2]);
 
@@ -91,8 +93,9 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
  * (not handed over: in->share[i] below release_share, least share first, while two others
  * stay held; in->share NULL hands none over), the scale moves by
  * ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3) over them, need_i =
- * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; a touching finger's
- * released flag becomes whether it is handed over, a finger out of contact keeps its flag. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
+ * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; a touching finger
+ * handed over keeps the scale it was first handed over at (the state's scale then), one
+ * held gets 0, a finger out of contact keeps its entry. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
 int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
                      double *next);
 

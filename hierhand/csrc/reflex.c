@@ -81,7 +81,7 @@ int hh_reflex_directions(const double *params, const double *state, const hh_ref
     for (int i = 0; i < 3; i++) {
         touching[i] = in->fn[i] > threshold;
         int approaching =
-            params[HH_REFLEX_P_INITIAL + i] != 0.0 && state[HH_REFLEX_S_RELEASED + i] == 0.0 && !touching[i];
+            params[HH_REFLEX_P_INITIAL + i] != 0.0 && state[HH_REFLEX_S_HANDED + i] == 0.0 && !touching[i];
         grasp[i] = touching[i] || approaching;
         g[i][0] = 0.0;
         g[i][1] = 0.0;
@@ -160,8 +160,10 @@ void hh_reflex_forces(const double *params, const double *state, const double g[
 {
     for (int i = 0; i < 3; i++) {
         double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
-        double scale = touching[i] ? state[HH_REFLEX_S_SCALE]
-                                   : params[HH_REFLEX_P_APPROACH] / hh_max(length, SHORTEST_DIRECTION);
+        double handed = state[HH_REFLEX_S_HANDED + i];
+        double scale = !touching[i] ? params[HH_REFLEX_P_APPROACH] / hh_max(length, SHORTEST_DIRECTION)
+                       : handed > 0.0 ? hh_min(state[HH_REFLEX_S_SCALE], handed)
+                                      : state[HH_REFLEX_S_SCALE];
         f[i][0] = g[i][0] * scale;
         f[i][1] = g[i][1] * scale;
     }
@@ -246,9 +248,14 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
     next[HH_REFLEX_S_SCALE] = scale;
     /* whether a finger was the reflex's or voluntary motion's when it last touched: a
      * finger that loses contact while the reflex holds it (a bounce) is pushed back, one
-     * that voluntary motion took off is left alone */
-    for (int i = 0; i < 3; i++)
-        next[HH_REFLEX_S_RELEASED + i] =
-            touching[i] ? (released[i] ? 1.0 : 0.0) : state[HH_REFLEX_S_RELEASED + i];
+     * that voluntary motion took off is left alone. A finger handed over keeps at most the
+     * squeeze it had then: the squeeze the others need as they take its load over must not
+     * press it back onto the object */
+    for (int i = 0; i < 3; i++) {
+        double handed = state[HH_REFLEX_S_HANDED + i];
+        if (touching[i])
+            handed = !released[i] ? 0.0 : handed > 0.0 ? handed : hh_max(state[HH_REFLEX_S_SCALE], DBL_MIN);
+        next[HH_REFLEX_S_HANDED + i] = handed;
+    }
     return HH_REFLEX_OK;
 }

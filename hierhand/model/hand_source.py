@@ -28,6 +28,17 @@ EXPECTED = "expected a HandPlant or an FMU exported by 'hierhand fmu export'"
 EXPECTED_FROM_PYTHON = "expected a HandPlant, an FMU exported by 'hierhand fmu export', or a Hand"
 
 
+class ModelsTheHand:
+    """Mixin of the blocks that model the hand they act on: the block-reference parameter
+    ``hand``, and a documentation instance on the default hand (``hierhand blocks``)."""
+
+    block_params = ("hand",)
+
+    @classmethod
+    def example(cls):
+        return cls(hand=Hand.default())
+
+
 def hand_of(source: Any, param: str = "hand") -> Hand:
     """The ``Hand`` of a plant block (``HandPlant`` or exported FMU) or a ``Hand`` itself.
 

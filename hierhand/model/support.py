@@ -15,10 +15,10 @@ import numpy as np
 
 from blocks import Block
 
-from .hand_source import HAND_DOC, hand_of
+from .hand_source import HAND_DOC, ModelsTheHand, hand_of
 
 
-class ObjectSupport(Block):
+class ObjectSupport(ModelsTheHand, Block):
     """The force of a support carrying the object's weight, removed at ``until``.
 
     Output ``y`` in the plant's ``f_ext`` layout (fx, fy, torque about the object's
@@ -28,7 +28,6 @@ class ObjectSupport(Block):
     """
 
     type_name = "ObjectSupport"
-    block_params = ("hand",)
     time_varying = True
     param_docs = {
         "hand": HAND_DOC + "; the support carries the weight of its object",

@@ -218,3 +218,16 @@ def test_blocks_marks_a_reference_parameter(tmp_path):
     assert "source (required; the name of another block of the diagram)" in text
     assert "spare (default None; the name of another block of the diagram)" in text
     assert "ports: see 'hierhand validate' of a diagram using it (it needs the block named by source)" in text
+
+
+def test_blocks_lists_the_ports_of_a_reference_block_from_its_example():
+    from blocks.typeinfo import describe_type
+    from tests.blocks.blockdefs import Model, ScaleByModel
+
+    class Documented(ScaleByModel):
+        @classmethod
+        def example(cls):
+            return cls(source=Model(value=2.0))
+
+    text = describe_type(Documented)
+    assert "inputs: u[1]" in text and "outputs: y[1]" in text and "see 'hierhand validate'" not in text

@@ -46,7 +46,7 @@ static int reflex_arguments(held_buffers *h, PyObject *const *args, const double
     if ((*state = hh_py_hold(h, args[1], -1, 0, "state")) == NULL)
         return -1;
     if (hh_py_last_count(h) != HH_REFLEX_N_STATE) {
-        PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 4 entries [scale, released(3)]");
+        PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 4 entries [scale, handed(3)]");
         return -1;
     }
     if ((in->tip = reflex_input(h, args[2], 9, "tip")) == NULL ||
@@ -345,7 +345,7 @@ static const struct {
     LAYOUT_ENTRY(HH_REFLEX_P_DT), LAYOUT_ENTRY(HH_REFLEX_P_MIN_FORCE), LAYOUT_ENTRY(HH_REFLEX_P_RATIO),
     LAYOUT_ENTRY(HH_REFLEX_P_MAX_FORCE), LAYOUT_ENTRY(HH_REFLEX_P_INITIAL), LAYOUT_ENTRY(HH_REFLEX_P_COINCIDENT_RTOL),
     LAYOUT_ENTRY(HH_REFLEX_P_RELEASE_SHARE),
-    LAYOUT_ENTRY(HH_REFLEX_N_PARAMS), LAYOUT_ENTRY(HH_REFLEX_S_SCALE), LAYOUT_ENTRY(HH_REFLEX_S_RELEASED),
+    LAYOUT_ENTRY(HH_REFLEX_N_PARAMS), LAYOUT_ENTRY(HH_REFLEX_S_SCALE), LAYOUT_ENTRY(HH_REFLEX_S_HANDED),
     LAYOUT_ENTRY(HH_REFLEX_N_STATE), LAYOUT_ENTRY(HH_REFLEX_O_TAU), LAYOUT_ENTRY(HH_REFLEX_O_FORCE),
     LAYOUT_ENTRY(HH_REFLEX_O_ACTIVE), LAYOUT_ENTRY(HH_REFLEX_N_OUT), LAYOUT_ENTRY(HH_REFLEX_OK),
     LAYOUT_ENTRY(HH_REFLEX_COINCIDENT), LAYOUT_ENTRY(HH_REFLEX_NO_PERIOD),

@@ -89,8 +89,16 @@ def test_reflex_follows_the_contacts_and_lets_a_finger_go():
     assert grasp.tolist() == [True, True, False]
     # voluntary motion takes the forefinger over (its command keeps a third of its grasp torque) ...
     taken = dict(reflex_inputs(reflex.hand, fn=[1, 1, 1]), share=np.array([1.0, 0.3, 1.0]))
+    handed_at = state[0]
     state = reflex.update(0.0, state, taken)
-    assert state[1:].tolist() == [0.0, 1.0, 0.0]
+    assert state[1:].tolist() == [0.0, handed_at, 0.0]
+    # ... keeps at most the squeeze it had then while the others' squeeze rises ...
+    state[0] = 3 * handed_at
+    f, _ = reflex.forces(state, reflex_inputs(reflex.hand, fn=[1, 1, 1], normals=((1, 0), (-1, 0), (-1, 0))))
+    g, _, _ = reflex.directions(state, *(reflex_inputs(reflex.hand, fn=[1, 1, 1], normals=(
+        (1, 0), (-1, 0), (-1, 0)))[k] for k in ("tip", "normal", "fn")))
+    np.testing.assert_allclose(f[1], handed_at * g[1], rtol=1e-12)
+    np.testing.assert_allclose(f[0], 3 * handed_at * g[0], rtol=1e-12)
     # ... so once it has let go it is no longer pushed back
     _, grasp = reflex.forces(state, reflex_inputs(reflex.hand, fn=[1, 0, 1], normals=((1, 0), (0, 0), (-1, 0))))
     assert grasp.tolist() == [True, False, True]

@@ -55,7 +55,8 @@ def reference_directions(reflex, state, tip, normal, fn):
 def reference_forces(reflex, state, inputs):
     g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], inputs["fn"])
     length = np.linalg.norm(g, axis=1)
-    scale = np.where(touching, state[0], reflex.approach_force / np.maximum(length, 1e-300))
+    held_at = np.where(state[1:] > 0, np.minimum(state[0], state[1:]), state[0])  # handed over: at most then
+    scale = np.where(touching, held_at, reflex.approach_force / np.maximum(length, 1e-300))
     return g * scale[:, None], grasp
 
 
@@ -83,7 +84,8 @@ def reference_update(reflex, state, inputs):
                           np.abs(ft[held]) / reflex.ratio_target)
         shortfall = float(np.max((need - fn[held]) / np.maximum(gain, 1e-3)))
         scale = min(max(scale + reflex.ki * reflex.dt * shortfall, 0.0), reflex.max_force)
-    return np.concatenate(([scale], np.where(touching, released.astype(float), state[1:])))
+    first = np.where(state[1:] > 0, state[1:], max(state[0], np.finfo(float).tiny))
+    return np.concatenate(([scale], np.where(touching, np.where(released, first, 0.0), state[1:])))
 
 
 def make_reflex(grasp):
@@ -106,9 +108,9 @@ def random_case(rng, reflex, k, inward: bool):
         if initial[i] and rng.random() < 0.3:
             continue  # still approaching: listed in 'grasp', not handed over, not touching
         fn[i] = rng.uniform(0.1, 8.0)
-        state[1 + i] = float(rng.random() < 0.8)
+        state[1 + i] = rng.choice([0.0, rng.uniform(0.5, 12.0)])  # held, or handed over at some scale
     for i in set(range(3)) - set(chosen):
-        state[1 + i] = 1.0 if initial[i] else float(rng.random() < 0.5)  # out of the grasp
+        state[1 + i] = rng.uniform(0.5, 12.0) if initial[i] else rng.choice([0.0, 3.0])  # out of the grasp
     centre = tip[chosen, :2].mean(axis=0)
     normal = np.zeros((3, 2))
     for i in range(3):
@@ -250,7 +252,7 @@ def test_input_widths_are_checked_naming_the_port(port, width):
     inputs[port] = [0.0] * (width - 1)  # converted first, then refused for its width
     with pytest.raises(ValueError, match=f"^GraspReflex: input '{port}' must have {width} entries$"):
         call(0.0, state, inputs)
-    with pytest.raises(ValueError, match=r"state must have 4 entries \[scale, released\(3\)\]"):
+    with pytest.raises(ValueError, match=r"state must have 4 entries \[scale, handed\(3\)\]"):
         reflex.update(0.0, np.zeros(3), random_case(np.random.default_rng(9), reflex, 2, inward=True)[1])
 
 
