@@ -90,7 +90,7 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
                      const double *q, double *out);
 
 /* next (HH_REFLEX_N_STATE): with two or more fingers in the grasp, touching and held
- * (not handed over: in->share[i] below release_share, least share first, while two others
+ * (not handed over: in->share[i] below release_share, least share first, while two fingers
  * stay held; in->share NULL hands none over), the scale moves by
  * ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3) over them, need_i =
  * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; a touching finger

@@ -192,7 +192,7 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
 
 /* The fingers the suppresser has handed to voluntary motion: among those held (in the
  * grasp and touching), a finger whose command keeps less than release_share of its
- * grasping torque, least share first, as long as two others stay held. Its contact force
+ * grasping torque, least share first, as long as two fingers stay held. Its contact force
  * is no longer the reflex's to restore; counting it would wind the shared scale up while
  * the finger is pulled off. Two fingers always stay with the reflex: they are the grasp
  * (a pinch whose posture PD resists the squeeze keeps only about 0.9 of its torque). */
