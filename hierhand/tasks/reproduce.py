@@ -178,9 +178,8 @@ DEVIATIONS = """\
   `release_share` (0.8) of its grasp torque no longer drives the integrator (two fingers always
   stay with it) and keeps at most the squeeze it had then: the squeeze follows the thumb and the
   middle finger as they take the load over, and the forefinger's grasp torque falls as its
-  manipulation torque grows, as in the paper's Fig. 14. This is anti-windup
-  for a loop whose actuator is shared with a higher level; the paper's control law itself is
-  unchanged.
+  manipulation torque grows, as in the paper's Fig. 14. This is anti-windup for a loop whose
+  actuator is shared with a higher level; the paper's control law itself is unchanged.
 - **The middle finger's path** goes down past the forefinger's tip before moving in, and sits
   17 mm below it: the model has no finger-finger contact, and a straight path passed 6.7 mm
   through the forefinger's tip. Lower on the face (20 mm) the thumb-middle pinch axis tilts more
@@ -196,7 +195,10 @@ DEVIATIONS = """\
 - **Minimum squeeze of 3 N** in the task diagrams (the block's default is 1 N): at the
   hand-over at 0.1 s two fingers must carry m g = 2.94 N by friction at the safety ratio,
   m g / (2 x 0.6) = 2.45 N each. With 1 N the fingers still close cleanly, but the hand-over
-  takes f_t/f_n to the slip limit for about 20 ms while the integrator catches up.
+  takes f_t/f_n to the slip limit for about 20 ms while the integrator catches up. (3 N was
+  once needed for another reason: with 1 N the fingers bounced off at first contact and the
+  reflex, which pushed a finger towards the object only until it first touched, never closed
+  them again; it now pushes back a finger that bounces off.)
 - **Start**: the fingers start 0.1 mm off the object (the paper starts in contact) and close
   under the reflex's approach force while a support carries the object's weight. The PD's load
   feedforward carries only what the support does not; when it carried the whole weight as well,
