@@ -12,7 +12,6 @@ from __future__ import annotations
 from fractions import Fraction
 
 import gc
-import os
 import shutil
 import stat
 import subprocess
@@ -29,30 +28,16 @@ from blocks.fmu_archive import ArchiveError, extract_archive
 
 fmpy = pytest.importorskip("fmpy")
 
-SOURCES = Path(__file__).parent / "fmu_sources"
-HEADERS = Path(fmpy.__file__).parent / "c-code"
-
-
-def _compiler() -> str | None:
-    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
-        if name and shutil.which(name):
-            return shutil.which(name)
-    return None
-
-
-def _zip(path: Path, files: dict[str, bytes | str]) -> Path:
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
-        for name, data in files.items():
-            zf.writestr(name, data)
-    return path
+from .fmu_build import SOURCES, build_error, compile_library, marker_library, zip_files  # noqa: E402
 
 
 class Fmus:
     """Builds FMU files in a folder from the compiled binaries and (edited) model descriptions."""
 
-    def __init__(self, folder: Path, lib2: bytes, lib3: bytes):
+    def __init__(self, folder: Path, lib2: bytes, lib3: bytes, marker: bytes, markers: Path):
         self.folder = folder
         self.lib2, self.lib3 = lib2, lib3
+        self.marker, self.markers = marker, markers
         self.xml2 = (SOURCES / "first_order_fmi2.xml").read_text()
         self.xml3 = (SOURCES / "first_order_fmi3.xml").read_text()
         self.fmi2 = self.make("first_order.fmu")
@@ -68,31 +53,20 @@ class Fmus:
             files = {"modelDescription.xml": self.xml3 if xml is None else xml}
             if binary:
                 files[f"binaries/{fmpy.platform_tuple}/FirstOrder3{ext}"] = self.lib3
-        return _zip(self.folder / name, files)
+        return zip_files(self.folder / name, files)
 
 
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory) -> Fmus:
-    if sys.platform.startswith("win"):
-        pytest.skip("the test FMUs are built with a Unix C compiler")
-    cc = _compiler()
-    if cc is None:
-        pytest.skip("no C compiler (cc, gcc or clang) on PATH to build the test FMUs")
-    if not (HEADERS / "fmi2Functions.h").is_file() or not (HEADERS / "fmi3Functions.h").is_file():
-        pytest.skip(f"fmpy's FMI headers are missing (looked in {HEADERS})")
+    why = build_error()
+    if why:
+        pytest.skip(why)
     build = tmp_path_factory.mktemp("fmu_build")
-
-    def compile_(out: str, *sources: str) -> bytes:
-        target = build / out
-        cmd = [cc, "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *(str(SOURCES / s) for s in sources),
-               "-o", str(target)]
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        assert done.returncode == 0, f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}"
-        return target.read_bytes()
-
-    lib2 = compile_("fo2" + fmpy.sharedLibraryExtension, "first_order_fmi2.c")
-    lib3 = compile_("fo3" + fmpy.sharedLibraryExtension, "first_order_fmi3.c", "fmi3_unsupported.c")
-    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3)
+    markers = tmp_path_factory.mktemp("fmu_markers")
+    lib2 = compile_library(build / ("fo2" + fmpy.sharedLibraryExtension), "first_order_fmi2.c")
+    lib3 = compile_library(build / ("fo3" + fmpy.sharedLibraryExtension), "first_order_fmi3.c",
+                           "fmi3_unsupported.c")
+    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3, marker_library(build, markers), markers)
 
 
 def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
@@ -375,7 +349,7 @@ def test_not_a_zip(fmus, tmp_path):
 
 
 def test_no_model_description(fmus, tmp_path):
-    empty = _zip(tmp_path / "empty.fmu", {"resources/readme.txt": "hello"})
+    empty = zip_files(tmp_path / "empty.fmu", {"resources/readme.txt": "hello"})
     assert "the archive has no modelDescription.xml" in load_error(lambda: diagram(empty))
 
 
@@ -417,7 +391,7 @@ def test_vector_with_a_gap(fmus):
 
 
 def test_unsafe_archive_is_refused_by_the_block(fmus, tmp_path):
-    evil = _zip(tmp_path / "evil.fmu", {"modelDescription.xml": fmus.xml2, "../evil.txt": "x"})
+    evil = zip_files(tmp_path / "evil.fmu", {"modelDescription.xml": fmus.xml2, "../evil.txt": "x"})
     msg = load_error(lambda: diagram(evil))
     assert "unsafe FMU archive" in msg and "'../evil.txt'" in msg
     assert not (tmp_path.parent / "evil.txt").exists()
@@ -486,7 +460,7 @@ def test_extractor_limits_size_and_count(tmp_path):
         extract_archive(big, tmp_path / "o1", max_member_bytes=1000)
     with pytest.raises(ArchiveError, match="more than the limit of 3000 bytes"):
         extract_archive(big, tmp_path / "o1", max_total_bytes=3000)
-    many = _zip(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
+    many = zip_files(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
     with pytest.raises(ArchiveError, match="has 20 members, more than the limit of 10"):
         extract_archive(many, tmp_path / "o1", max_members=10)
     extract_archive(many, tmp_path / "o1")
