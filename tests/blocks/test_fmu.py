@@ -12,6 +12,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import gc
+import os
 import shutil
 import stat
 import subprocess
@@ -24,7 +25,7 @@ import pytest
 
 import blocks
 from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, simulate
-from blocks.fmu_archive import ArchiveError, extract_archive
+from blocks.fmu_archive import ArchiveError, Limits, extract_archive, read_member
 
 fmpy = pytest.importorskip("fmpy")
 
@@ -457,14 +458,52 @@ def test_extractor_limits_size_and_count(tmp_path):
     big = _zip_with(tmp_path / "big.zip", "big.bin", b"\0" * 5000)
     (tmp_path / "o1").mkdir()
     with pytest.raises(ArchiveError, match="'big.bin' is 5000 bytes uncompressed, more than the limit of 1000"):
-        extract_archive(big, tmp_path / "o1", max_member_bytes=1000)
+        extract_archive(big, tmp_path / "o1", Limits(member_bytes=1000))
     with pytest.raises(ArchiveError, match="more than the limit of 3000 bytes"):
-        extract_archive(big, tmp_path / "o1", max_total_bytes=3000)
+        extract_archive(big, tmp_path / "o1", Limits(total_bytes=3000))
     many = zip_files(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
     with pytest.raises(ArchiveError, match="has 20 members, more than the limit of 10"):
-        extract_archive(many, tmp_path / "o1", max_members=10)
+        extract_archive(many, tmp_path / "o1", Limits(members=10))
+    with pytest.raises(ArchiveError, match="its member list takes .* bytes, more than 1 members can need"):
+        read_member(many, "f1.txt", Limits(members=1))
     extract_archive(many, tmp_path / "o1")
     assert len(list((tmp_path / "o1").iterdir())) == 20
+
+
+def test_archive_limits_keep_a_zip_bomb_small():
+    """At most 256 MiB per member and in all (once 1 GiB and 4 GiB), at most 200-fold inflation."""
+    from blocks import fmu_archive
+
+    assert fmu_archive.MAX_MEMBER_BYTES == fmu_archive.MAX_TOTAL_BYTES == 256 * 2**20
+    assert fmu_archive.MAX_RATIO == 200 and fmu_archive.RATIO_FLOOR_BYTES == 2**20
+    assert fmu_archive.MAX_MEMBERS == 10_000
+
+
+def test_a_member_that_inflates_too_much_is_refused(tmp_path):
+    bomb = zip_files(tmp_path / "bomb.fmu", {"modelDescription.xml": "<x/>", "resources/zeros.bin": b"\0" * (4 << 20)})
+    (tmp_path / "out").mkdir()
+    with pytest.raises(ArchiveError, match=r"'resources/zeros.bin' inflates from \d+ to 4194304 bytes or more, "
+                                           "more than 200 times"):
+        extract_archive(bomb, tmp_path / "out")
+    with pytest.raises(ArchiveError, match="more than 200 times"):
+        read_member(bomb, "modelDescription.xml")     # every member is checked, even when reading one
+    small = zip_files(tmp_path / "small.fmu", {"notes.txt": b"\0" * 100_000})  # below the floor: fine
+    assert read_member(small, "notes.txt") == (b"\0" * 100_000, ["notes.txt"])
+
+
+def test_the_bytes_are_counted_as_they_are_decompressed(tmp_path):
+    """The running count does not rely on the headers: a member whose header says it is
+    huge (so zipfile does not cut it) is stopped once the bytes read pass a limit."""
+    from blocks.fmu_archive import _chunks
+
+    archive = zip_files(tmp_path / "a.zip", {"x.bin": os.urandom(5000)})
+    with zipfile.ZipFile(archive) as zf:
+        info = zf.getinfo("x.bin")
+        info.file_size = 10**9
+        with pytest.raises(ArchiveError, match="is 5000 bytes uncompressed, more than the limit of 1000"):
+            list(_chunks(zf, info, 0, "a.zip", Limits(member_bytes=1000)))
+        with pytest.raises(ArchiveError, match="add up to more than the limit of 6000"):
+            list(_chunks(zf, info, 2000, "a.zip", Limits(total_bytes=6000)))
 
 
 def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
@@ -479,7 +518,7 @@ def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
     archive.write_bytes(bytes(data))
     (tmp_path / "out").mkdir()
     with pytest.raises((ArchiveError, zipfile.BadZipFile)):
-        extract_archive(archive, tmp_path / "out", max_member_bytes=100)
+        extract_archive(archive, tmp_path / "out", Limits(member_bytes=100))
     assert not (tmp_path / "out" / "x.bin").exists()
 
 
