@@ -8,6 +8,7 @@ the tests that need a library skip with that reason.
 
 from __future__ import annotations
 
+import io
 import os
 import shutil
 import subprocess
@@ -55,10 +56,17 @@ def compile_library(target: Path, *sources: str, defines: dict[str, str] | None 
 
 def zip_files(path: Path, files: dict[str, bytes | str]) -> Path:
     """Write a zip archive of ``files`` (member name -> content)."""
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+    path.write_bytes(zip_bytes(files))
+    return path
+
+
+def zip_bytes(files: dict[str, bytes | str]) -> bytes:
+    """A zip archive of ``files`` (member name -> content), in memory."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as zf:
         for name, data in files.items():
             zf.writestr(name, data)
-    return path
+    return buffer.getvalue()
 
 
 def fmi2_files(library: bytes, xml: str | None = None, identifier: str = "FirstOrder") -> dict[str, bytes | str]:
@@ -76,3 +84,4 @@ def marker_library(build: Path, markers: Path) -> bytes:
     when fmi2Instantiate runs (see ``fmu_sources/marker.c``)."""
     return compile_library(build / f"marker{EXT}", "first_order_fmi2.c", "marker.c",
                            defines={"TRACE_RUNS": "1", "MARKER_DIR": f'"{markers}"'})
+

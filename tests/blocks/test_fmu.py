@@ -15,8 +15,6 @@ import gc
 import os
 import shutil
 import stat
-import subprocess
-import sys
 import zipfile
 from pathlib import Path
 
@@ -29,7 +27,14 @@ from blocks.fmu_archive import ArchiveError, Limits, extract_archive, read_membe
 
 fmpy = pytest.importorskip("fmpy")
 
-from .fmu_build import SOURCES, build_error, compile_library, marker_library, zip_files  # noqa: E402
+from .fmu_build import (  # noqa: E402
+    SOURCES,
+    build_error,
+    compile_library,
+    fmi2_files,
+    marker_library,
+    zip_files,
+)
 
 
 class Fmus:
@@ -186,10 +191,10 @@ def test_runs_reuse_one_instance_reset_between_runs(fmus):
     np.testing.assert_array_equal(first["f.y"][1], second["f.y"][1])
     # Two states alive at once get two instances, each with its own FMU state.
     s1, s2 = block.initial_state(), block.initial_state()
-    assert s1.instance is not s2.instance
     u = {"u": np.array([1.0])}
     block.output(0.0, s1, u)
     block.output(0.0, s2, u)
+    assert s1.instance is not s2.instance
     block.update(0.0, s1, u)
     assert block.output(0.1, s1, u)["y"][0] == 1.0 and block.output(0.0, s2, u)["y"][0] == 0.0
     s1.close()
@@ -198,7 +203,9 @@ def test_runs_reuse_one_instance_reset_between_runs(fmus):
 
 
 def test_close_frees_instances_and_extracted_files(fmus):
-    block = diagram(fmus.fmi2).blocks["f"].block
+    d = diagram(fmus.fmi2)
+    block = d.blocks["f"].block
+    simulate(d)
     folder = block._model.dir
     assert (folder / "modelDescription.xml").is_file()
     block.close()
@@ -253,6 +260,29 @@ connections: [src.y -> f.u, w.y -> f.w]
 log: [f.wsum]
 """)
     np.testing.assert_allclose(simulate(d)["f.wsum"][1][:, 0], [0.0, 0.75, 0.75])
+
+
+# -- what runs an FMU's code ---------------------------------------------------------------
+
+
+def _traces(fmus, identifier: str) -> set[str]:
+    """What the marker FMU of ``identifier`` left: 'loaded', 'instantiated' (see marker.c)."""
+    return {p.name.rsplit(".", 1)[1] for p in fmus.markers.glob(f"{identifier}{fmpy.sharedLibraryExtension}.*")}
+
+
+def test_loading_a_diagram_does_not_run_the_fmus_code(fmus, tmp_path):
+    """Only a run loads the binary: loading, describing and scheduling read modelDescription.xml."""
+    path = zip_files(tmp_path / "traced.fmu", fmi2_files(fmus.marker, identifier="TracedLoad"))
+    d = diagram(path)
+    block = d.blocks["f"].block
+    assert block.parameter_values()["a"] == 0.5 and block.describe().startswith("FMI 2.0")
+    blocks.build_schedule(d, None)
+    state = block.initial_state()
+    assert _traces(fmus, "TracedLoad") == set()
+    assert block._model.dir is None                     # nothing extracted either
+    state.close()
+    assert simulate(d).complete
+    assert _traces(fmus, "TracedLoad") == {"loaded", "instantiated"}
 
 
 # -- run-time failures --------------------------------------------------------------------
@@ -339,7 +369,8 @@ log: [f.y]
     (folder / "d.yaml").write_text(text)
     assert simulate(load_diagram(folder / "d.yaml")).complete
     msg = load_error(lambda: loads_diagram(text, filename="d.yaml", base_dir=tmp_path / "elsewhere"))
-    assert f"FMU file not found: {tmp_path / 'elsewhere' / 'fmus' / 'plant.fmu'}" in msg
+    assert f"FMU file not found: looked at {tmp_path / 'elsewhere' / 'fmus' / 'plant.fmu'}" in msg
+    assert "a relative path is resolved against the diagram's folder" in msg
 
 
 def test_not_a_zip(fmus, tmp_path):
@@ -378,11 +409,13 @@ def test_no_binary_for_this_platform(fmus):
     assert "it has no binaries" in msg
 
 
-def test_instantiation_failure_is_a_load_error_with_the_fmu_log(fmus):
+def test_instantiation_failure_fails_the_run_with_the_fmu_log(fmus):
+    """Only a run loads and instantiates the FMU, so only a run finds a binary that fails."""
     wrong = fmus.make("wrong_guid.fmu", fmus.xml2.replace("8c4e810f", "00000000"))
-    msg = load_error(lambda: diagram(wrong))
-    assert "instantiating the FMU failed" in msg
-    assert "FMU log: [error] logStatusError: wrong FMU type or GUID {00000000" in msg
+    status = simulate(diagram(wrong)).status
+    assert status.startswith("failed at t=0 s: block 'f' (FMU) output: "), status
+    assert "instantiating the FMU failed" in status
+    assert "FMU log: [error] logStatusError: wrong FMU type or GUID {00000000" in status
 
 
 def test_vector_with_a_gap(fmus):
