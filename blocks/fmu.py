@@ -44,7 +44,8 @@ instances are freed when the block goes away, at process exit, or by ``FMU.close
 instance that failed is freed, never reused. The state cannot be copied or checkpointed
 (FMU get/set state is not used).
 
-Errors. Problems with the file and its modelDescription are raised at load time (ValueError, which the diagram loader reports as
+Errors. Problems with the file, its modelDescription and a period the FMU cannot step
+are raised at load time (ValueError, which the diagram loader reports as
 ``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, and a
 failing ``doStep``, raise ``BlockError`` naming the FMU, the time and the status, with the
 FMU's recent log messages; the executor keeps the results up to that point.
@@ -84,6 +85,10 @@ LOG_LINES = 20
 
 ERROR_LOG_LINES = 8
 """How many of them an error message quotes."""
+
+STEP_TOLERANCE = Fraction(1, 10**6)
+"""How far (in internal steps) a period may miss a whole multiple of an FMU's fixed internal
+step; the exported hand plant accepts the same."""
 
 _STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 _INDEXED = re.compile(r"^(?P<base>.*[^\s])\[(?P<index>\s*\d+\s*(?:,\s*\d+\s*)*)\]$")
@@ -353,6 +358,7 @@ class _Model:
             raise ValueError(f"{shown} has no binary for this platform ({platform}/"
                              f"{library.rsplit('/', 1)[1]}); {detail}")
         self.library = library
+        self.fixed_step = description.fixed_step()
         self.guid = md.guid or ""
         de = md.defaultExperiment
         self.default_step = _fraction_or_none(de.stepSize if de else None)
@@ -915,12 +921,24 @@ class FMU(Block):
 
     def bind(self, period: Fraction | None) -> None:
         """The period is the communication step; without one, the FMU's default step
-        (DefaultExperiment stepSize) is used, and the diagram schedules the block at it."""
+        (DefaultExperiment stepSize) is used, and the diagram schedules the block at it.
+        An FMU with a fixed internal step needs a whole multiple of it."""
+        given = period is not None
         if period is None:
             period = self._model.default_step
             if period is None:
                 raise ValueError("an FMU block needs a period, its communication step size (the FMU "
                                  "declares no default step size: add e.g. 'period: 1 ms')")
+        fixed = self._model.fixed_step
+        if fixed is not None:
+            count = period / fixed
+            if count < 1 or abs(count - round(count)) > STEP_TOLERANCE:
+                which = "period" if given else "default step (DefaultExperiment stepSize)"
+                near = max(1, round(count)) * fixed
+                raise ValueError(f"the {which} {format_duration(period)} is not a whole multiple of the "
+                                 f"fixed internal step {format_duration(fixed)} of {self._model.shown}, "
+                                 f"so the FMU would refuse every step; use a multiple of it, e.g. "
+                                 f"'period: {format_duration(near)}'")
         super().bind(period)
         self._step = float(period)
 

@@ -13,8 +13,10 @@ from __future__ import annotations
 import io
 import zipfile
 from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
 from typing import Any
+from xml.etree import ElementTree
 
 from .fmu_archive import ArchiveError, read_member
 
@@ -37,6 +39,25 @@ class FMUDescription:
     def platforms(self) -> list[str]:
         """The platform folders under ``binaries/`` that hold files."""
         return sorted({f.split("/")[1] for f in self.files if f.startswith("binaries/") and f.count("/") >= 2})
+
+    def fixed_step(self) -> Fraction | None:
+        """The FMU's fixed internal step, if it declares one: FMI 3 ``fixedInternalStepSize``
+        of ``<CoSimulation>``; FMI 2 has no such attribute, so there the same attribute is
+        read from a ``<CoSimulation>`` element in any tool's ``<VendorAnnotations>``."""
+        cs = self.md.coSimulation
+        value = getattr(cs, "fixedInternalStepSize", None) if cs is not None else None
+        if value is None and self.md.fmiVersion == "2.0":
+            try:
+                root = ElementTree.fromstring(self.xml)
+            except ElementTree.ParseError:
+                return None
+            for element in root.iterfind("VendorAnnotations/Tool/CoSimulation"):
+                value = element.get("fixedInternalStepSize") or value
+        try:
+            step = Fraction(str(value).strip()) if value is not None else None
+        except (ValueError, ZeroDivisionError):
+            return None
+        return step if step is not None and step > 0 else None
 
 
 def read_description(path: str | Path, shown: str, validate: bool = True) -> FMUDescription:
@@ -85,6 +106,9 @@ def describe_fmu(path: str | Path) -> str:
     lines.append("  interfaces: " + (", ".join(f"{n} (model identifier {i.modelIdentifier})"
                                                for n, i in interfaces) or "none"))
     lines.append(f"  platforms: {', '.join(description.platforms()) or 'none (no binaries)'}")
+    step = description.fixed_step()
+    if step is not None:
+        lines.append(f"  fixed internal step: {float(step):g} s (communication steps must be multiples)")
     de = md.defaultExperiment
     if de is not None:
         parts = [f"{k} {getattr(de, a)}" for k, a in (("start", "startTime"), ("stop", "stopTime"),

@@ -353,6 +353,44 @@ log: [f.y]
     np.testing.assert_allclose(t, [0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
 
 
+def _fixed_step(fmus, version: int, step: str, name: str) -> Path:
+    """The first-order FMU declaring a fixed internal step: FMI 3's fixedInternalStepSize,
+    for FMI 2 the same attribute in a vendor annotation."""
+    if version == 3:
+        xml = fmus.xml3.replace("<CoSimulation ", f'<CoSimulation fixedInternalStepSize="{step}" ')
+    else:
+        annotation = (f'<VendorAnnotations><Tool name="some tool"><CoSimulation fixedInternalStepSize="{step}"/>'
+                      "</Tool></VendorAnnotations>\n  <ModelVariables>")
+        xml = fmus.xml2.replace("<ModelVariables>", annotation)
+    return fmus.make(name, xml, version=version)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_period_off_the_fixed_internal_step_is_a_load_error(fmus, version):
+    """Such an FMU refuses every step; that must show at load time, not once a run has started."""
+    path = _fixed_step(fmus, version, "0.04", f"fixed{version}.fmu")
+    msg = load_error(lambda: diagram(path, period="0.1 s"))
+    assert msg.startswith("fmu.yaml:5: block 'f' (FMU): the period 100 ms is not a whole multiple of the "
+                          "fixed internal step 40 ms"), msg
+    assert "use a multiple of it, e.g. 'period: 80 ms'" in msg
+    assert diagram(path, period="0.2 s").blocks["f"].period == Fraction(1, 5)
+    # the default step (DefaultExperiment stepSize 0.1) must be a multiple too
+    text = f"""
+time: {{t_end: 0.5 s}}
+blocks:
+  f: {{type: FMU, params: {{path: '{path}'}}}}
+"""
+    assert "the default step (DefaultExperiment stepSize) 100 ms is not a whole multiple" in load_error(
+        lambda: loads_diagram(text))
+
+
+def test_fmu_info_shows_the_fixed_internal_step(fmus):
+    from blocks.fmu_info import describe_fmu
+
+    assert "fixed internal step: 0.04 s" in describe_fmu(_fixed_step(fmus, 3, "0.04", "fixed_info.fmu"))
+    assert "fixed internal step" not in describe_fmu(fmus.fmi3)
+
+
 def test_a_relative_path_is_resolved_against_the_diagrams_folder(fmus, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     folder = tmp_path / "project"
