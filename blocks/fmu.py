@@ -48,7 +48,8 @@ Errors. Problems with the file, its modelDescription and a period the FMU cannot
 are raised at load time (ValueError, which the diagram loader reports as
 ``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, and a
 failing ``doStep``, raise ``BlockError`` naming the FMU, the time and the status, with the
-FMU's recent log messages; the executor keeps the results up to that point.
+FMU's recent log messages; the executor keeps the results up to that point. Ctrl-C inside
+an FMU call is a KeyboardInterrupt, never an FMU failure (see ``fmu_interrupt``).
 """
 
 from __future__ import annotations
@@ -73,6 +74,7 @@ from typing import Any
 
 import numpy as np
 
+from blocks import fmu_interrupt
 from blocks.block import Block, BlockError, Signal
 from blocks.fmu_archive import ArchiveError, extract_archive
 from blocks.fmu_info import MODEL_DESCRIPTION, read_description
@@ -496,6 +498,7 @@ class _Model:
                 inst.slave.terminate()
             except Exception:
                 inst.broken = True
+            fmu_interrupt.deliver()
         with self.lock:
             self.live -= 1
             keep = not inst.broken and not self.closed
@@ -566,6 +569,7 @@ def _record(buffer: collections.deque | None, status: int, category: bytes | Non
     log.log({0: logging.DEBUG, 1: logging.WARNING}.get(status, logging.INFO), "%s: %s", who, line)
 
 
+@fmu_interrupt.callback
 def _fmi2_log(env, instance_name, status, category, message) -> None:
     entry = _fmi2_buffers.get(env or 0)
     if entry is None:  # an FMU of other code using fmpy's default callbacks: do what fmpy does
@@ -595,7 +599,8 @@ def _fmi2_arm():
 
 
 def _arm(major: int) -> None:
-    """Before a call into an FMU that can log: for FMI 2, our logger in place."""
+    """Before a call into an FMU: the interrupt hook and, for FMI 2, our logger in place."""
+    fmu_interrupt.arm()
     if major == 2:
         _fmi2_arm()
 
@@ -634,6 +639,7 @@ class _Instance:
             if os.getcwd() != cwd:
                 os.chdir(cwd)
         self.slave = slave
+        fmu_interrupt.arm()
         try:
             if model.major == 2:
                 from fmpy.fmi2 import (
@@ -645,8 +651,9 @@ class _Instance:
 
                 callbacks = fmi2CallbackFunctions()
                 callbacks.logger = _fmi2_arm()
-                callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(fmpy.calloc)
-                callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(fmpy.free)
+                # the C library's own functions: no Python (which Ctrl-C could break) in between
+                callbacks.allocateMemory = ctypes.cast(fmpy.calloc, fmi2CallbackAllocateMemoryTYPE)
+                callbacks.freeMemory = ctypes.cast(fmpy.free, fmi2CallbackFreeMemoryTYPE)
                 callbacks.componentEnvironment = self.serial
                 addLoggerProxy(ctypes.byref(callbacks))
                 _fmi2_buffers[self.serial] = (self.messages, f"{model.shown} ({name})")
@@ -657,10 +664,11 @@ class _Instance:
                 def log3(env, status, category, message):
                     _record(messages, status, category, message, who)
 
-                slave.instantiate(logMessage=log3)
+                slave.instantiate(logMessage=fmu_interrupt.callback(log3))
         except Exception as exc:
             _fmi2_buffers.pop(self.serial, None)
             slave.freeLibrary()
+            fmu_interrupt.check()
             raise BlockError(f"{model.shown}: instantiating the FMU failed: {exc}{self.log_text()}") from None
         self._buffers(ctypes)
 
@@ -775,6 +783,7 @@ class _Instance:
             log.debug("%s: freeing the FMU instance failed: %s", self.model.shown, exc)
         finally:
             _fmi2_buffers.pop(self.serial, None)
+        fmu_interrupt.deliver()
 
 
 def _setters(slave: Any, major: int) -> dict[str, Any]:
@@ -957,8 +966,10 @@ class FMU(Block):
             state.outputs = inst.read()
         except Exception as exc:
             inst.broken = True
+            fmu_interrupt.check()  # a failure that comes with Ctrl-C is the interrupt
             raise BlockError(f"{self._model.shown}: initialising the FMU at t={t:.9g} s failed: "
                              f"{_reason(exc)}{inst.log_text()}") from None
+        fmu_interrupt.check()
 
     def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         if state.time is None:
@@ -979,6 +990,7 @@ class FMU(Block):
             _arm(inst.model.major)
             inst.write(inputs)
             terminate, early, last = inst.do_step(t, h)
+            fmu_interrupt.check()
             if terminate or early:
                 inst.broken = True
                 what = "requested to terminate the simulation" if terminate else f"returned early at t={last:.9g} s"
@@ -990,6 +1002,7 @@ class FMU(Block):
             raise
         except Exception as exc:
             inst.broken = True
+            fmu_interrupt.check()  # a failure that comes with Ctrl-C is the interrupt
             raise BlockError(f"{self._model.shown}: {_reason(exc, t, h)}{inst.log_text()}") from None
         return state
 

@@ -85,3 +85,10 @@ def marker_library(build: Path, markers: Path) -> bytes:
     return compile_library(build / f"marker{EXT}", "first_order_fmi2.c", "marker.c",
                            defines={"TRACE_RUNS": "1", "MARKER_DIR": f'"{markers}"'})
 
+
+def interrupting_library(build: Path, status: int, at: float = 0.2) -> bytes:
+    """The FMI 2 first-order FMU's library whose doStep, from time ``at`` on, sends the
+    process SIGINT (as Ctrl-C would), logs a message and returns ``status`` (0 ok, 3 error,
+    4 fatal: what an FMU does whose memory callback Ctrl-C broke)."""
+    return compile_library(build / f"interrupting{status}{EXT}", "first_order_fmi2.c",
+                           defines={"SIGINT_AT": repr(at), "SIGINT_STATUS": str(status)})

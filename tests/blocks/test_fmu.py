@@ -15,6 +15,7 @@ import gc
 import os
 import shutil
 import stat
+import sys
 import zipfile
 from pathlib import Path
 
@@ -32,6 +33,7 @@ from .fmu_build import (  # noqa: E402
     build_error,
     compile_library,
     fmi2_files,
+    interrupting_library,
     marker_library,
     zip_files,
 )
@@ -40,10 +42,12 @@ from .fmu_build import (  # noqa: E402
 class Fmus:
     """Builds FMU files in a folder from the compiled binaries and (edited) model descriptions."""
 
-    def __init__(self, folder: Path, lib2: bytes, lib3: bytes, marker: bytes, markers: Path):
+    def __init__(self, folder: Path, lib2: bytes, lib3: bytes, marker: bytes, markers: Path,
+                 interrupting: dict[int, bytes]):
         self.folder = folder
         self.lib2, self.lib3 = lib2, lib3
         self.marker, self.markers = marker, markers
+        self.interrupting = interrupting
         self.xml2 = (SOURCES / "first_order_fmi2.xml").read_text()
         self.xml3 = (SOURCES / "first_order_fmi3.xml").read_text()
         self.fmi2 = self.make("first_order.fmu")
@@ -72,7 +76,9 @@ def fmus(tmp_path_factory) -> Fmus:
     lib2 = compile_library(build / ("fo2" + fmpy.sharedLibraryExtension), "first_order_fmi2.c")
     lib3 = compile_library(build / ("fo3" + fmpy.sharedLibraryExtension), "first_order_fmi3.c",
                            "fmi3_unsupported.c")
-    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3, marker_library(build, markers), markers)
+    interrupting = {status: interrupting_library(build, status) for status in (0, 4)}
+    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3, marker_library(build, markers), markers,
+                interrupting)
 
 
 def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
@@ -313,6 +319,53 @@ def test_dostep_discard_is_a_failure(fmus):
     results = simulate(diagram(fmus.fmi2, start_values="{threshold: 2}", source=src))
     assert "fmi2DoStep at t=0.2 s (step 0.1 s) returned status 'discard'" in results.status
     assert "step discarded" in results.status
+
+
+@pytest.mark.parametrize("status", [0, 4], ids=["ok", "fatal"])
+def test_ctrl_c_during_a_step_is_an_interrupt_not_an_fmu_failure(fmus, tmp_path, status):
+    """SIGINT arrives inside doStep, which then logs (the KeyboardInterrupt is raised in the
+    log callback, where ctypes loses it) and returns ok, or 'fatal' as an FMU whose memory
+    callback was broken would. Either way the run stops as interrupted, results kept."""
+    path = zip_files(tmp_path / "interrupting.fmu", fmi2_files(fmus.interrupting[status]))
+    d = diagram(path, log="[f.y]")
+    try:
+        results = simulate(d)
+    except KeyboardInterrupt:  # pragma: no cover - would otherwise stop the whole test session
+        pytest.fail("the interrupt escaped the run")
+    assert results.status == "interrupted at t=0.2 s", results.status
+    assert results.interrupted and not results.complete
+    np.testing.assert_allclose(results["f.y"][0], [0.0, 0.1, 0.2])   # the results so far
+    assert "fmi2DoStep" not in results.status
+
+
+def test_an_interrupt_lost_in_a_callback_is_raised_after_the_call():
+    """The pieces on their own: a KeyboardInterrupt inside a wrapped callback, or one that
+    ctypes hands to sys.unraisablehook for it, is raised by the next check()."""
+    from types import SimpleNamespace
+
+    from blocks import fmu_interrupt
+
+    @fmu_interrupt.callback
+    def log(*args):
+        raise KeyboardInterrupt
+
+    log(1, 2)
+    with pytest.raises(KeyboardInterrupt):
+        fmu_interrupt.check()
+    fmu_interrupt.check()                                   # noted once, raised once
+    fmu_interrupt.arm()
+    sys.unraisablehook(SimpleNamespace(exc_type=KeyboardInterrupt, object=log))
+    with pytest.raises(KeyboardInterrupt):
+        fmu_interrupt.check()
+    seen = []
+    before = sys.unraisablehook
+    sys.unraisablehook = seen.append                        # others' hooks keep their messages
+    fmu_interrupt.arm()
+    other = SimpleNamespace(exc_type=KeyboardInterrupt, object=print)
+    sys.unraisablehook(other)
+    assert seen == [other]
+    fmu_interrupt.check()
+    sys.unraisablehook = before
 
 
 # -- load-time errors ---------------------------------------------------------------------

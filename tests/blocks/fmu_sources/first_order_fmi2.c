@@ -16,6 +16,9 @@
 #ifdef TRACE_RUNS
 void trace_run(const char *event); /* marker.c: leaves a file saying the code ran */
 #endif
+#ifdef SIGINT_AT
+#include <signal.h> /* Ctrl-C inside doStep at t >= SIGINT_AT, then a log message, then SIGINT_STATUS */
+#endif
 
 #define GUID "{8c4e810f-3df3-4a00-8276-176fa3c9f000}"
 #define NREAL 10
@@ -137,6 +140,13 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
     Model *m = c;
     (void)noSetPrior;
     fmi2Real u = m->r[6], threshold = m->r[3];
+#ifdef SIGINT_AT
+    if (t >= SIGINT_AT) {
+        raise(SIGINT);
+        m->cb.logger(m->cb.componentEnvironment, m->name, fmi2OK, "logEvents", "interrupted at t = %g", t);
+        if (SIGINT_STATUS != fmi2OK) return SIGINT_STATUS;
+    }
+#endif
     if (u > threshold) {
         m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError",
                      "input u = %g exceeds the threshold %g at t = %g", u, threshold, t);
