@@ -19,18 +19,18 @@ from typing import Any, Iterable, Mapping
 import numpy as np
 
 from .block import Block
+from .limits import MAX_PORT_WIDTH
 from .param_paths import PathError, set_path
 from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
 from .timebase import DurationError, parse_duration
-from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml
+from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml, read_yaml_file
 
 TOP_KEYS = ("version", "name", "description", "time", "blocks", "connections", "log")
 TIME_KEYS = ("t_end",)
 BLOCK_KEYS = ("type", "period", "offset", "params", "params_file", "description")
 CONNECTION_KEYS = ("from", "to", "delay", "initial")
 LOG_KEYS = ("signal", "decimate")
-MAX_PORT_WIDTH = 1_000_000
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
 
@@ -176,12 +176,12 @@ def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
     """Load and validate a diagram file; ``overrides`` maps ``block.param[.key]`` to a value."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_yaml_file(path)
     except FileNotFoundError:
         raise DiagramError([Issue(str(path), None, "diagram file not found",
                                   "check the path; diagrams are YAML files such as diagrams/toy.yaml")]) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DiagramError([Issue(str(path), None, f"cannot read diagram file: {exc}")]) from None
+    except YamlSourceError as exc:
+        raise DiagramError([Issue(str(path), exc.line, exc.message, exc.hint)]) from None
     return loads_diagram(text, filename=str(path), base_dir=path.parent, overrides=overrides, trust=trust)
 
 
@@ -258,8 +258,7 @@ class _Loader:
         try:
             data = load_yaml(text)
         except YamlSourceError as exc:
-            raise DiagramError([Issue(self.file, exc.line, exc.message,
-                                      "check indentation, colons and brackets near that line")]) from None
+            raise DiagramError([Issue(self.file, exc.line, exc.message, exc.hint)]) from None
         if not isinstance(data, LineDict):
             raise DiagramError([Issue(self.file, getattr(data, "line", 1) or 1,
                                       "a diagram must be a YAML mapping",
@@ -544,17 +543,18 @@ class _Loader:
             return None
         path = (self.base_dir / rel)
         try:
-            text = path.read_text(encoding="utf-8")
-        except OSError:
+            text = read_yaml_file(path)
+            self.hash.update(text.encode("utf-8"))
+            data = load_yaml(text)
+        except FileNotFoundError:
             self.error(line, f"block '{name}': params_file '{rel}' not found (looked at {path})",
                        "params_file is relative to the diagram's folder")
             return None
-        self.hash.update(text.encode("utf-8"))
-        try:
-            data = load_yaml(text)
         except YamlSourceError as exc:
-            self.error(exc.line, exc.message, "check indentation, colons and brackets near that line",
-                       file=str(path))
+            if exc.line is None:  # the file as a whole: reported where the diagram names it
+                self.error(line, f"block '{name}': params_file '{rel}': {exc.message}", exc.hint)
+            else:
+                self.error(exc.line, exc.message, exc.hint, file=str(path))
             return None
         if data is None:
             return {}
