@@ -14,7 +14,7 @@ import re
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, NamedTuple
 
 import numpy as np
 
@@ -23,6 +23,7 @@ from .limits import MAX_PORT_WIDTH
 from .param_paths import PathError, set_path
 from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
+from .safepath import inside
 from .timebase import DurationError, parse_duration
 from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml, read_yaml_file
 
@@ -77,6 +78,13 @@ class BlockSpec:
         return {p: self.params[p] for p in type(self.block).block_params if p in self.params}
 
 
+class _ParamsFile(NamedTuple):
+    """A block's params file: its path and its content (a LineDict, or {} when empty)."""
+
+    path: str
+    data: Mapping
+
+
 @dataclass
 class _Entry:
     """A block of the file checked up to its constructor call (built once its references are)."""
@@ -88,6 +96,7 @@ class _Entry:
     period: Fraction | None
     offset: Fraction | None
     params: dict
+    source: _ParamsFile | None = None
     references: dict[str, str] = field(default_factory=dict)
 
 
@@ -409,10 +418,15 @@ class _Loader:
                 self.error(spec.line_of("offset"), f"block '{name}': offset must be in [0, period)",
                            "an offset is a phase within one period")
                 return None
-        params = self.params(name, spec, cls, line)
+        source = None
+        if "params_file" in spec:
+            source = self.params_file(spec, name)
+            if source is None:
+                return None
+        params = self.params(name, spec, cls, line, source)
         if params is None:
             return None
-        return _Entry(name, spec, line, cls, period, offset, params)
+        return _Entry(name, spec, line, cls, period, offset, params, source)
 
     def references(self, entry: _Entry, names: Mapping) -> bool:
         """Check the block's block-reference parameters against the diagram's block names
@@ -480,29 +494,28 @@ class _Loader:
         return BlockSpec(name, cls.registered_name(), block, period, entry.offset or Fraction(0), entry.params,
                          line, params_file)
 
-    def params(self, name: str, spec: LineDict, cls: type[Block], line: int) -> dict | None:
-        params: dict = {}
-        if "params_file" in spec:
-            loaded = self.params_file(spec, name)
-            if loaded is None:
-                return None
-            params = loaded
+    def params(self, name: str, spec: LineDict, cls: type[Block], line: int,
+               source: _ParamsFile | None) -> dict | None:
         inline = spec.get("params", {})
         if inline is None:
             inline = {}
         if not isinstance(inline, Mapping):
             self.error(spec.line_of("params"), f"block '{name}': 'params' must be a mapping")
             return None
-        params = deep_merge(params, inline)
+        params = deep_merge(source.data if source else {}, inline)
         declared = cls.parameters()
         accepts_any = cls.accepts_any_parameter()
         ok = True
-        for key in list(inline):
-            if key not in declared and not accepts_any:
-                self.error(line_of(inline, key, spec.line_of("params")),
-                           f"block '{name}' ({cls.registered_name()}) has no parameter {key!r}",
-                           _suggest(key, declared) or f"parameters: {_known(declared)}")
-                ok = False
+        given = [(inline, None, spec.line_of("params"))]
+        if source is not None:
+            given.insert(0, (source.data, source.path, 1))
+        for mapping, file, default_line in given:
+            for key in mapping:
+                if key not in declared and not accepts_any:
+                    self.error(line_of(mapping, key, default_line),
+                               f"block '{name}' ({cls.registered_name()}) has no parameter {key!r}",
+                               _suggest(key, declared) or f"parameters: {_known(declared)}", file=file)
+                    ok = False
         for key, value in self.overrides.items():
             block_name, _, path = key.partition(".")
             if block_name != name:
@@ -535,13 +548,20 @@ class _Loader:
             ok = False
         return params if ok else None
 
-    def params_file(self, spec: LineDict, name: str) -> dict | None:
+    def params_file(self, spec: LineDict, name: str) -> _ParamsFile | None:
+        """Read the block's params file; without ``trust`` it must lie in the diagram's
+        folder tree (see ``blocks.safepath``)."""
         rel = spec["params_file"]
         line = spec.line_of("params_file")
         if not isinstance(rel, str):
             self.error(line, f"block '{name}': params_file must be a path")
             return None
         path = (self.base_dir / rel)
+        if not self.trust and not inside(path, self.base_dir):
+            self.error(line, f"block '{name}': params_file '{rel}' is outside the diagram's folder",
+                       "a diagram reads files only from its own folder and below; pass --trust "
+                       "(Python: trust=True) if you trust this diagram")
+            return None
         try:
             text = read_yaml_file(path)
             self.hash.update(text.encode("utf-8"))
@@ -557,12 +577,12 @@ class _Loader:
                 self.error(exc.line, exc.message, exc.hint, file=str(path))
             return None
         if data is None:
-            return {}
+            return _ParamsFile(str(path), {})
         if not isinstance(data, Mapping):
             self.error(1, "a params file must be a YAML mapping of parameter names to values",
                        file=str(path))
             return None
-        return deep_merge({}, data)
+        return _ParamsFile(str(path), data)
 
     def connections_section(self, data: LineDict, blocks: dict[str, BlockSpec]) -> list[Connection]:
         section = data.get("connections")

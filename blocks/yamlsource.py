@@ -100,6 +100,8 @@ def read_yaml_file(path: str | Path) -> str:
         raise
     except OSError as exc:
         raise YamlSourceError(f"cannot open: {exc.strerror or exc}", None) from None
+    except ValueError:
+        raise YamlSourceError("cannot open: the path contains a NUL character", None) from None
     info = os.fstat(fd)
     if not stat.S_ISREG(info.st_mode):
         os.close(fd)
