@@ -18,14 +18,14 @@ from typing import Any, Iterable, Mapping, NamedTuple
 
 import numpy as np
 
-from .block import Block
+from .block import Block, ParameterError
 from .limits import MAX_PORT_WIDTH
 from .param_paths import PathError, set_path
 from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
 from .safepath import inside
 from .timebase import DurationError, parse_duration
-from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml, read_yaml_file
+from .yamlsource import LineDict, LineList, YamlSourceError, line_at, line_of, load_yaml, read_yaml_file
 
 TOP_KEYS = ("version", "name", "description", "time", "blocks", "connections", "log")
 TIME_KEYS = ("t_end",)
@@ -368,7 +368,7 @@ class _Loader:
         cyclic = {r.block for cycle in cycles for r in cycle}
         for cycle in cycles:
             first = entries[cycle[0].block]
-            self.param_error(first, cycle[0].param, f"block references form a cycle: {chain_text(cycle)}",
+            self.param_error(first, (cycle[0].param,), f"block references form a cycle: {chain_text(cycle)}",
                              "a referenced block is built before the blocks that refer to it; "
                              "remove one of these references")
         built: dict[str, BlockSpec] = {}
@@ -437,13 +437,13 @@ class _Loader:
                 continue
             target = entry.params[key]
             if not isinstance(target, str):
-                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' must be the name of "
+                self.param_error(entry, (key,), f"block '{entry.name}': parameter '{key}' must be the name of "
                                  f"a block of this diagram, got {target!r}", f"e.g. {key}: <block name>")
             elif target == entry.name:
-                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' refers to the block "
+                self.param_error(entry, (key,), f"block '{entry.name}': parameter '{key}' refers to the block "
                                  "itself", f"name another block of this diagram; blocks are: {_known(names)}")
             elif target not in names:
-                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' names no block "
+                self.param_error(entry, (key,), f"block '{entry.name}': parameter '{key}' names no block "
                                  f"'{target}'", _suggest(target, names) or f"blocks are: {_known(names)}")
             else:
                 entry.references[key] = target
@@ -451,19 +451,29 @@ class _Loader:
             ok = False
         return ok
 
-    def param_error(self, entry: _Entry, key: str, message: str, hint: str = "") -> None:
-        """An issue about one parameter, reported where its value comes from: the --set
-        that gave it, or its line in the diagram."""
-        override = f"{entry.name}.{key}"
-        if override in self.overrides:
-            self.override_error(override, message, hint)
-            return
+    def param_error(self, entry: _Entry, path: tuple, message: str, hint: str = "") -> None:
+        """An issue about a parameter value (``path``: the parameter, then keys and indices
+        into it), reported where that value comes from: the --set that gave it (or a part
+        of it), else the deepest part of the path written in the block's ``params:`` or
+        its params file, else the block's parameters as a whole."""
+        parts = [str(p) for p in path]
+        for key in self.overrides:
+            block, _, rest = key.partition(".")
+            given = rest.split(".")
+            if parts and block == entry.name and (given[:len(parts)] == parts or parts[:len(given)] == given):
+                self.override_error(key, message, hint)
+                return
         inline = entry.spec.get("params")
-        if isinstance(inline, LineDict) and key in inline:
-            line = inline.line_of(key)
-        else:
-            line = entry.spec.line_of("params_file") if "params_file" in entry.spec else entry.line
-        self.error(line, message, hint)
+        line, found = line_at(inline, path) if isinstance(inline, LineDict) else (None, 0)
+        file = None
+        if entry.source is not None:
+            file_line, file_found = line_at(entry.source.data, path)
+            if file_found > found:
+                file, line, found = entry.source.path, file_line, file_found
+        if not found:
+            written = "params" if "params" in entry.spec else "params_file"
+            line = entry.spec.line_of(written) if written in entry.spec else entry.line
+        self.error(line, message, hint, file=file)
 
     def build(self, entry: _Entry, built: Mapping[str, BlockSpec]) -> BlockSpec | None:
         """Construct and bind the block, its references given as the blocks they name."""
@@ -477,9 +487,10 @@ class _Loader:
             if period is None and block.period is not None:
                 period = block.period  # a block with a natural rate (an FMU's default step)
         except Exception as exc:  # a block's own message says which parameter is wrong
-            where = spec.line_of("params") if "params" in spec else line
-            self.error(where, f"block '{name}' ({type_name}): {exc}",
-                       f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
+            problems = exc.problems if isinstance(exc, ParameterError) else [((), str(exc))]
+            for path, text in problems:
+                self.param_error(entry, path, f"block '{name}' ({type_name}): {text}",
+                                 f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
             return None
         block.name = name
         for kind in ("inputs", "outputs"):

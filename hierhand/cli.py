@@ -413,15 +413,16 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def cmd_fmu_export(args: argparse.Namespace) -> int:
+    from blocks import DiagramError
     from hierhand.fmu_export import FmuExportError, export_plant_fmu
     from hierhand.model import HandFileError
 
-    if args.hand is not None and not args.hand.is_file():
+    if args.hand is not None and not args.hand.exists():
         raise UsageError(f"--hand {args.hand}: hand file not found")
     try:
         path = export_plant_fmu(args.output, fmi=args.fmi, hand=args.hand)
     except HandFileError as exc:
-        raise UsageError("; ".join(f"{exc.source or '--hand'}: {e}" for e in exc.errors)) from None
+        raise DiagramError(exc.issues()) from None
     except (FmuExportError, OSError) as exc:
         raise UsageError(f"fmu export: {exc}") from None
     print(f"wrote {path}")

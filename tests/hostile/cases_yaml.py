@@ -93,12 +93,17 @@ CASES = [
          files={"d.yaml": "name: deep\nblocks: " + "[" * 50_000 + "\n"}, timeout=10, check=stderr_lines(1)),
     Case("yaml-deep-block-nesting", ("validate", "d.yaml"), 2, r"^d\.yaml:3: .*nested deeper than 100",
          files={"d.yaml": "name: deep\nblocks:\n  " + "- " * 50_000 + "x\n"}, timeout=10),
+    Case("yaml-deep-nesting-in-hand-file", ("fmu", "export", "--hand", "h.yaml", "-o", "out.fmu"), 2,
+         r"^h\.yaml:1: .*nested deeper than 100", files={"h.yaml": "gravity: " + "[" * 50_000}, timeout=10,
+         absent=("out.fmu",), check=stderr_lines(1)),
     # 3. size: checked before the file is read
     Case("yaml-diagram-too-big", ("validate", "d.yaml"), 2, rf"^d\.yaml: .*larger than {MAX_YAML_BYTES}",
          files={"d.yaml": GOOD + "#" * MAX_YAML_BYTES}, check=stderr_lines(1)),
     Case("yaml-params-file-too-big", ("validate", "d.yaml"), 2,
          r"^d\.yaml:5: block 'gain': params_file 'p\.yaml': file larger than",
          files={"d.yaml": params_gain("p.yaml"), "p.yaml": "k: 1\n" + "#" * MAX_YAML_BYTES}),
+    Case("yaml-hand-file-too-big", ("fmu", "export", "--hand", "h.yaml", "-o", "out.fmu"), 2,
+         r"^h\.yaml: .*larger than", files={"h.yaml": "#" * (MAX_YAML_BYTES + 1)}, absent=("out.fmu",)),
     # 4. params_file: devices, binary files, paths out of the diagram's folder, unknown keys
     Case("yaml-params-file-device", ("validate", "--trust", "d.yaml"), 2,
          r"^d\.yaml:5: block 'gain': params_file '/dev/zero': not a regular file",
@@ -131,4 +136,18 @@ CASES = [
          check=stderr_lines(1)),
     Case("yaml-control-character", ("validate", "d.yaml"), 2, r"^d\.yaml:2: .*U\+0007.*column 15",
          files={"d.yaml": GOOD.replace("ok\n", "ok\ndescription: \u00e9\x07\n")}, check=stderr_lines(1)),
+    # 8. hand files: one line per problem at the hand file's line; exit 2 for bad input
+    Case("yaml-hand-params-file-lines", ("validate", "d.yaml"), 2,
+         r"^hand\.yaml:5: block 'plant' \(HandPlant\): object\.bogus is not a known key",
+         files={"d.yaml": PLANT, "hand.yaml": BAD_HAND}, check=stderr_lines(2)),
+    Case("yaml-hand-params-file-value", ("validate", "d.yaml"), 2,
+         r"^hand\.yaml:3: block 'plant' \(HandPlant\): object\.mass must be > 0",
+         files={"d.yaml": PLANT, "hand.yaml": BAD_HAND.replace("  bogus: 3\n", "").replace("  bad_key: 2\n", "")
+                .replace("mass: 0.3", "mass: -1")}, check=stderr_lines(1)),
+    Case("yaml-fmu-export-bad-hand", ("fmu", "export", "--hand", "bad.yaml", "-o", "out.fmu"), 2,
+         r"^bad\.yaml:5: object\.bogus is not a known key.*\nbad\.yaml:8: contact\.bad_key",
+         files={"bad.yaml": BAD_HAND}, absent=("out.fmu",), check=stderr_lines(2)),
+    Case("yaml-fmu-export-broken-hand", ("fmu", "export", "--hand", "bad.yaml", "-o", "out.fmu"), 2,
+         r"^bad\.yaml:2: YAML syntax error", files={"bad.yaml": "gravity: [0.0, -9.81]\nobject: mass: 1\n"},
+         absent=("out.fmu",), check=stderr_lines(1)),
 ]
