@@ -44,6 +44,9 @@ class Issue:
     line: int | None
     message: str
     hint: str = ""
+    override: str | None = None
+    """The override (``block.param``) the issue is about; ``file`` then says how the user
+    gave it (``--set plant.k=2``, ``--grid plant.k=1,2``)."""
 
     def __str__(self) -> str:
         where = f"{self.file}:{self.line}" if self.line else self.file
@@ -181,8 +184,14 @@ class Diagram:
 
 
 def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
-                 trust: bool = False) -> Diagram:
-    """Load and validate a diagram file; ``overrides`` maps ``block.param[.key]`` to a value."""
+                 trust: bool = False, origins: Mapping[str, str] | None = None) -> Diagram:
+    """Load and validate a diagram file; ``overrides`` maps ``block.param[.key]`` to a value.
+
+    ``origins`` says how the user gave an override, for the messages about it: by key, the
+    text that stands where a file name would (``--grid plant.k=1,2``); by default
+    ``--set block.param=value``. ``trust`` allows ``python:`` block types and params files
+    outside the diagram's folder.
+    """
     path = Path(path)
     try:
         text = read_yaml_file(path)
@@ -191,14 +200,16 @@ def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
                                   "check the path; diagrams are YAML files such as diagrams/toy.yaml")]) from None
     except YamlSourceError as exc:
         raise DiagramError([Issue(str(path), exc.line, exc.message, exc.hint)]) from None
-    return loads_diagram(text, filename=str(path), base_dir=path.parent, overrides=overrides, trust=trust)
+    return loads_diagram(text, filename=str(path), base_dir=path.parent, overrides=overrides, trust=trust,
+                         origins=origins)
 
 
 def loads_diagram(text: str, filename: str = "<diagram>", base_dir: str | Path | None = None,
-                  overrides: Mapping[str, Any] | None = None, trust: bool = False) -> Diagram:
+                  overrides: Mapping[str, Any] | None = None, trust: bool = False,
+                  origins: Mapping[str, str] | None = None) -> Diagram:
     """Load and validate a diagram from YAML text (``base_dir`` resolves ``params_file``)."""
     loader = _Loader(filename, Path(base_dir) if base_dir is not None else Path.cwd(),
-                     dict(overrides or {}), trust)
+                     dict(overrides or {}), trust, dict(origins or {}))
     diagram = loader.load(text)
     from .schedule import build_schedule
 
@@ -246,11 +257,13 @@ def deep_merge(base: Mapping, top: Mapping) -> dict:
 class _Loader:
     """One pass over a diagram text, collecting every issue before raising."""
 
-    def __init__(self, filename: str, base_dir: Path, overrides: dict[str, Any], trust: bool):
+    def __init__(self, filename: str, base_dir: Path, overrides: dict[str, Any], trust: bool,
+                 origins: dict[str, str]):
         self.file = filename
         self.base_dir = base_dir
         self.overrides = overrides
         self.trust = trust
+        self.origins = origins
         self.issues: list[Issue] = []
         self.failed_blocks: set[str] = set()
         self.hash = hashlib.sha256()
@@ -259,7 +272,8 @@ class _Loader:
         self.issues.append(Issue(file or self.file, line, message, hint))
 
     def override_error(self, key: str, message: str, hint: str = "") -> None:
-        self.issues.append(Issue(f"--set {key}={self.overrides[key]!r}", None, message, hint))
+        origin = self.origins.get(key) or f"--set {key}={self.overrides[key]!r}"
+        self.issues.append(Issue(origin, None, message, hint, override=key))
 
     def load(self, text: str) -> Diagram:
         self.hash.update(text.encode("utf-8"))

@@ -446,7 +446,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from hierhand.sweep import SweepError
     from hierhand.sweep.metrics import parse_metrics
     from hierhand.sweep.plan import execute, prepare, stored_count
-    from hierhand.sweep.points import (combine, csv_points, grid_points, parse_grid, parse_random,
+    from hierhand.sweep.points import (combine, csv_points, grid_points, origins, parse_grid, parse_random,
                                        random_points)
 
     try:
@@ -470,7 +470,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 axes.update(samples=args.samples, seed=args.seed)
         if args.t_end is not None:
             end_time(args, load_diagram(args.diagram, trust=args.trust))
-        plan = prepare(args.diagram, points, metrics, t_end=args.t_end, trust=args.trust, axes=axes)
+        plan = prepare(args.diagram, points, metrics, t_end=args.t_end, trust=args.trust, axes=axes,
+                       origins=origins(args.grid, args.random, args.points, points))
         t0 = time.perf_counter()
         try:
             report, skipped, failed = execute(plan, args.output, workers=args.workers, scheduler=args.scheduler,

@@ -136,6 +136,18 @@ CASES = [
          check=stderr_lines(1)),
     Case("yaml-control-character", ("validate", "d.yaml"), 2, r"^d\.yaml:2: .*U\+0007.*column 15",
          files={"d.yaml": GOOD.replace("ok\n", "ok\ndescription: \u00e9\x07\n")}, check=stderr_lines(1)),
+    # 6. override errors name the option the user typed
+    Case("yaml-grid-override-named", ("sweep", "d.yaml", "-o", "out", "--serial", "--grid", "plant.nope=1,2"), 2,
+         r"^--grid plant\.nope=1,2: block 'plant' \(Gain\) has no parameter 'nope'",
+         files={"d.yaml": SWEEP}, absent=("out",), check=stderr_lines(1)),
+    Case("yaml-random-override-named", ("sweep", "d.yaml", "-o", "out", "--serial",
+                                        "--random", "nope.k=uniform(0, 1)"), 2,
+         r"^--random nope\.k=uniform\(0, 1\): no block named 'nope'", files={"d.yaml": SWEEP}, absent=("out",)),
+    Case("yaml-points-override-named", ("sweep", "d.yaml", "-o", "out", "--serial", "--points", "p.csv"), 2,
+         r"^--points p\.csv:1: column 'plant\.k\.x': 'plant\.k' is a float",
+         files={"d.yaml": SWEEP, "p.csv": "plant.k.x\n1\n2\n"}, absent=("out",)),
+    Case("yaml-set-override-named", ("validate", "d.yaml", "--set", "gain.kk=3"), 2,
+         r"^--set gain\.kk=3: block 'gain' \(Gain\) has no parameter 'kk'", files={"d.yaml": GOOD}),
     # 8. hand files: one line per problem at the hand file's line; exit 2 for bad input
     Case("yaml-hand-params-file-lines", ("validate", "d.yaml"), 2,
          r"^hand\.yaml:5: block 'plant' \(HandPlant\): object\.bogus is not a known key",
