@@ -32,5 +32,6 @@ MAX_PORT_WIDTH = 1_000_000
 this is a mistake in a block's parameters rather than a signal anyone logs."""
 
 MAX_FOLDER_NAME = 100
-"""Longest folder name made from a diagram's ``name:`` (the default ``runs/<name>``);
-file systems refuse names beyond 255 bytes."""
+"""Longest folder name made from a diagram's ``name:`` (the default ``runs/<name>``), in
+bytes of UTF-8: file systems refuse names beyond 255 bytes, and a results path must leave
+room for the folder it is in."""

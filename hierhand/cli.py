@@ -51,7 +51,8 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="simulate a diagram and write its results",
                          description="Simulate DIAGRAM and write signals.npz and run.json to the output folder.")
     _diagram_args(run)
-    run.add_argument("-o", "--output", type=Path, help="results folder (default: runs/<diagram name>)")
+    run.add_argument("-o", "--output", type=Path,
+                     help="results folder (default: runs/<diagram name>, the name made one safe folder name)")
     run.add_argument("--csv", action="store_true", help="also write signals.csv")
     run.add_argument("--plot", action="store_true", help="also plot the logged signals to <output>/plots/")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary line")
@@ -256,10 +257,11 @@ class ProgressBar:
 def cmd_run(args: argparse.Namespace) -> int:
     from blocks import simulate
     from blocks.plot import plot_signals
+    from blocks.safepath import folder_name
 
     diagram = load(args)
     t_end = end_time(args, diagram)
-    out = args.output or Path("runs") / diagram.name
+    out = args.output or Path("runs") / folder_name(diagram.name)
     bar = ProgressBar(float(t_end), enabled=not args.quiet)
     try:
         results = simulate(diagram, t_end=t_end, progress=bar)

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 import pytest
 
 from blocks import DiagramError, load_diagram
-from blocks.safepath import inside
+from blocks.limits import MAX_FOLDER_NAME
+from blocks.safepath import folder_name, inside
 
 DIAGRAM = """\
 name: p
@@ -70,3 +72,25 @@ def test_unknown_key_of_a_params_file_is_reported_at_its_line(tmp_path):
     [issue] = info.value.issues
     assert (issue.file, issue.line) == (str(tmp_path / "d" / "p.yaml"), 3)
     assert issue.message == "block 'g' (Gain) has no parameter 'kk'" and issue.hint == "did you mean 'k'?"
+
+
+@pytest.mark.parametrize("name, folder", [
+    ("toy-multirate", "toy-multirate"), ("grasp_v2.1", "grasp_v2.1"), ("Greifer-\u00fc", "Greifer-\u00fc"),
+    ("../../escaped", "_escaped"), ("/tmp/x", "_tmp_x"), ("a\\\\b", "a_b"), ("a\x00b", "a_b"),
+    ("..", "_"), (".", "diagram"), ("", "diagram"), (".hidden", "hidden"), ("--rm -rf", "rm_-rf"),
+    ("a..b", "a_b"), ("my run", "my_run"), ("C:\\\\x", "C_x"),
+])
+def test_folder_name(name, folder):
+    assert folder_name(name) == folder
+
+
+def test_folder_name_is_cut_to_the_limit_in_utf8_bytes():
+    assert folder_name("a" * 500) == "a" * MAX_FOLDER_NAME
+    cut = folder_name("\u00fc" * 500)
+    assert len(cut.encode("utf-8")) <= MAX_FOLDER_NAME and set(cut) == {"\u00fc"}
+
+
+@pytest.mark.parametrize("name", ["../../x", "/abs/x", "..", "a/../../b", "\\\\..\\\\x", "x\x00/..", "~/x"])
+def test_folder_name_is_one_component_that_stays_below(tmp_path, name):
+    folder = folder_name(name)
+    assert len(Path(folder).parts) == 1 and inside(tmp_path / folder, tmp_path) and tmp_path / folder != tmp_path

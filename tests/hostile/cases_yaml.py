@@ -148,6 +148,15 @@ CASES = [
          files={"d.yaml": SWEEP, "p.csv": "plant.k.x\n1\n2\n"}, absent=("out",)),
     Case("yaml-set-override-named", ("validate", "d.yaml", "--set", "gain.kk=3"), 2,
          r"^--set gain\.kk=3: block 'gain' \(Gain\) has no parameter 'kk'", files={"d.yaml": GOOD}),
+    # 7. the diagram's name becomes one safe folder under runs/, never a path
+    Case("yaml-name-climbs-out", ("run", "-q", "d.yaml"), 0, r"^$",
+         files={"d.yaml": GOOD.replace("name: ok", "name: ../../escaped")},
+         absent=("../escaped", "../../escaped"), check=only_inside),
+    Case("yaml-name-absolute", ("run", "-q", "d.yaml"), 0, r"^$",
+         files={"d.yaml": GOOD.replace("name: ok", "name: /tmp/hierhand-corpus-escaped")},
+         absent=("/tmp/hierhand-corpus-escaped",), check=only_inside),
+    Case("yaml-name-dots", ("run", "-q", "d.yaml"), 0, r"^$",
+         files={"d.yaml": GOOD.replace("name: ok", "name: '..'")}, check=only_inside),
     # 8. hand files: one line per problem at the hand file's line; exit 2 for bad input
     Case("yaml-hand-params-file-lines", ("validate", "d.yaml"), 2,
          r"^hand\.yaml:5: block 'plant' \(HandPlant\): object\.bogus is not a known key",
