@@ -397,10 +397,12 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, ReproduceError, reproduce
+    from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, MissingDiagram, ReproduceError, reproduce
 
     try:
         summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS, report=print)
+    except MissingDiagram as exc:
+        raise UsageError(str(exc)) from None
     except ReproduceError as exc:
         print(f"hierhand: {exc}", file=sys.stderr)
         return EXIT_FAILED

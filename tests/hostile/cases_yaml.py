@@ -171,4 +171,6 @@ CASES = [
     Case("yaml-fmu-export-broken-hand", ("fmu", "export", "--hand", "bad.yaml", "-o", "out.fmu"), 2,
          r"^bad\.yaml:2: YAML syntax error", files={"bad.yaml": "gravity: [0.0, -9.81]\nobject: mass: 1\n"},
          absent=("out.fmu",), check=stderr_lines(1)),
+    Case("yaml-reproduce-no-diagrams", ("reproduce", "--diagrams", "/nonexistent", "-o", "rep"), 2,
+         r"/nonexistent/grasp\.yaml: task diagram not found", absent=("rep",), check=stderr_lines(1)),
 ]
