@@ -221,8 +221,10 @@ class _Builder:
 
     def mapping(self, node: yaml.MappingNode, depth: int, site: int, fresh: bool) -> "LineDict":
         """A mapping; merge keys (``<<: *base`` or ``<<: [*a, *b]``) give the keys it does not
-        write itself, an earlier merged mapping winning over a later one. In a mapping met
-        for the first time a value is written at its key's line, in a repetition at ``site``."""
+        write itself, an earlier merged mapping winning over a later one. A merged mapping
+        counts as a level of nesting, as it is built inside this one (so a chain of merges
+        stays within the recursion limit). In a mapping met for the first time a value is
+        written at its key's line, in a repetition at ``site``."""
         merged: dict[Any, tuple[Any, int]] = {}
         out = LineDict()
         out.line = node.start_mark.line + 1
@@ -231,7 +233,7 @@ class _Builder:
             key_line = key_node.start_mark.line + 1
             if key_node.tag == _MERGE_TAG:
                 for source in self.merge_sources(value_node, key_line):
-                    built = self.build(source, depth, key_line if fresh else site)
+                    built = self.build(source, depth + 1, key_line if fresh else site)
                     for key, value in built.items():
                         merged.setdefault(key, (value, built.line_of(key)))
                 continue

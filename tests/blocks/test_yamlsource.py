@@ -182,6 +182,13 @@ def test_nesting_through_aliases_is_refused():
     assert "through aliases" in info.value.message and info.value.line == 2
 
 
+def test_a_chain_of_merge_keys_is_nesting():
+    text = "m0: &m0 {a: 1}\n" + "".join(f"m{i}: &m{i} {{<<: *m{i - 1}}}\n" for i in range(1, 1000))
+    with pytest.raises(YamlSourceError) as info:
+        load_yaml(text)
+    assert "through aliases" in info.value.message and info.value.line == MAX_YAML_DEPTH  # m99: 99 merges deep
+
+
 def test_control_character_has_line_and_column():
     with pytest.raises(YamlSourceError) as info:
         load_yaml("a: 1\nb: \u00e9\x07\n")
