@@ -504,7 +504,7 @@ def test_cli_reports_an_invalid_hand_file_in_one_line(tmp_path):
     done = subprocess.run([sys.executable, "-m", "hierhand", "fmu", "export", "--hand", str(bad), "-o",
                            str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2
-    assert done.stderr.strip() == f"hierhand: error: {bad}: object.mass must be > 0, got -1"
+    assert done.stderr.strip() == f"{bad}:1: object.mass must be > 0, got -1"
     assert not list(tmp_path.glob("*.fmu"))
 
 
