@@ -14,9 +14,16 @@ def block_label(diagram: Diagram, schedule: Schedule, name: str) -> str:
     return f"{name}\n{diagram.blocks[name].type_name}\n{schedule.rate_text(name)}"
 
 
+def dot_quoted(text: str) -> str:
+    """``text`` as a DOT double-quoted string: backslashes and quotes escaped, line breaks
+    as ``\\n``, so that a diagram's free-form name cannot break the DOT file."""
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\r", "").replace("\n", "\\n")
+    return f'"{escaped}"'
+
+
 def to_dot(diagram: Diagram, schedule: Schedule) -> str:
     """Graphviz DOT text: blocks as boxes with type and rate, wires labelled with ports."""
-    lines = [f'digraph "{diagram.name}" {{', "  rankdir=LR;", '  node [shape=box, fontname="Helvetica"];']
+    lines = [f"digraph {dot_quoted(diagram.name)} {{", "  rankdir=LR;", '  node [shape=box, fontname="Helvetica"];']
     for name in diagram.blocks:
         label = block_label(diagram, schedule, name).replace("\n", "\\n")
         lines.append(f'  "{name}" [label="{label}"];')

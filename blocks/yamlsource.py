@@ -85,8 +85,9 @@ def line_at(data: Any, path: Sequence[Any]) -> tuple[int | None, int]:
     return line, found
 
 
-def read_yaml_file(path: str | Path) -> str:
-    """The text of a diagram, params file or hand file: a regular file of at most
+def read_yaml_file(path: str | Path, kind: str = "YAML") -> str:
+    """The text of a diagram, params file or hand file (or another small text input, named
+    ``kind`` in the hints, such as a CSV points file): a regular file of at most
     MAX_YAML_BYTES bytes of UTF-8 text without NUL bytes.
 
     The size and kind are checked on the open file before anything is read (a device or
@@ -105,12 +106,12 @@ def read_yaml_file(path: str | Path) -> str:
     info = os.fstat(fd)
     if not stat.S_ISREG(info.st_mode):
         os.close(fd)
-        raise YamlSourceError("not a regular file (a folder, device or pipe)", None, "name a YAML file")
+        raise YamlSourceError("not a regular file (a folder, device or pipe)", None, f"name a {kind} file")
     with os.fdopen(fd, "rb") as fh:
         raw = fh.read(MAX_YAML_BYTES + 1) if info.st_size <= MAX_YAML_BYTES else b""
         if info.st_size > MAX_YAML_BYTES or len(raw) > MAX_YAML_BYTES:
             raise YamlSourceError(f"file larger than {MAX_YAML_BYTES} bytes", None,
-                                  "the limit guards against hostile files; keep large data out of YAML")
+                                  f"the limit guards against hostile files; keep large data out of {kind}")
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
@@ -118,10 +119,10 @@ def read_yaml_file(path: str | Path) -> str:
         column = len(raw[line_start:exc.start].decode("utf-8")) + 1
         raise YamlSourceError(f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at column {column}",
                               raw.count(b"\n", 0, exc.start) + 1,
-                              "save the file as UTF-8; a binary file is not YAML") from None
+                              f"save the file as UTF-8; a binary file is not {kind}") from None
     if "\x00" in text:
         line, column = _position(text, text.index("\x00"))
-        raise YamlSourceError(f"NUL byte at column {column}: a binary file, not YAML text", line,
+        raise YamlSourceError(f"NUL byte at column {column}: a binary file, not {kind} text", line,
                               "save the file as UTF-8 text")
     return text
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import hashlib
+import io
 import itertools
 import json
 import re
@@ -18,6 +19,8 @@ from typing import Any, Sequence
 
 import numpy as np
 import yaml
+
+from blocks.yamlsource import YamlSourceError, read_yaml_file
 
 from .errors import SweepError
 
@@ -137,10 +140,12 @@ def random_points(dists: dict[str, tuple[str, float, float]], samples: int, seed
 def csv_points(path: Path) -> list[Point]:
     """Points from a CSV file whose header names ``block.param`` columns; cells read as YAML."""
     try:
-        with open(path, newline="", encoding="utf-8") as f:
-            rows = list(csv.reader(f))
-    except OSError as exc:
-        raise SweepError(f"--points {path}: cannot read: {exc.strerror or exc}") from None
+        rows = list(csv.reader(io.StringIO(read_yaml_file(path, "CSV"), newline="")))
+    except FileNotFoundError:
+        raise SweepError(f"--points {path}: no such file") from None
+    except YamlSourceError as exc:
+        where = f"{path}:{exc.line}" if exc.line else str(path)
+        raise SweepError(f"--points {where}: {exc.message}" + (f" (hint: {exc.hint})" if exc.hint else "")) from None
     if not rows or not any(cell.strip() for cell in rows[0]):
         raise SweepError(f"--points {path}: empty file; the first line names the BLOCK.PARAM columns")
     keys = [check_key(k, f"--points {path}: column") for k in rows[0]]
