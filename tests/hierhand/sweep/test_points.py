@@ -77,7 +77,7 @@ def test_points_file(tmp_path):
     f.write_text("k\n1\n")
     with pytest.raises(SweepError, match="not BLOCK.PARAM"):
         csv_points(f)
-    with pytest.raises(SweepError, match="cannot read"):
+    with pytest.raises(SweepError, match="no such file"):
         csv_points(tmp_path / "missing.csv")
 
 
