@@ -497,15 +497,19 @@ class _Loader:
         arguments.update({key: built[target].block for key, target in entry.references.items()})
         try:
             block = cls(**arguments)
-            block.bind(period)
-            if period is None and block.period is not None:
-                period = block.period  # a block with a natural rate (an FMU's default step)
         except Exception as exc:  # a block's own message says which parameter is wrong
             problems = exc.problems if isinstance(exc, ParameterError) else [((), str(exc))]
             for path, text in problems:
                 self.param_error(entry, path, f"block '{name}' ({type_name}): {text}",
                                  f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
             return None
+        try:
+            block.bind(period)
+        except Exception as exc:  # the period does not suit the block: said at the period
+            self.error(spec.line_of("period") if "period" in spec else line, f"block '{name}' ({type_name}): {exc}")
+            return None
+        if period is None and block.period is not None:
+            period = block.period  # a block with a natural rate (an FMU's default step)
         block.name = name
         for kind in ("inputs", "outputs"):
             ports = getattr(block, kind)
