@@ -149,3 +149,19 @@ class Weights(Block):
 
     def output(self, t, state, inputs):
         return {"y": self.weights.copy(), "extra": self.extra.copy()}
+
+
+class InterruptedAccumulator(FastAccumulator):
+    """A FastAccumulator whose ``advance`` raises KeyboardInterrupt at its ``calls``-th call,
+    as Ctrl-C does when it lands inside a long span of advanced hits."""
+
+    def __init__(self, calls: int = 3):
+        super().__init__(1)
+        self.calls = calls
+        self.made = 0
+
+    def advance(self, t, state, inputs, n):
+        self.made += 1
+        if self.made == self.calls:
+            raise KeyboardInterrupt
+        return super().advance(t, state, inputs, n)
