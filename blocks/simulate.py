@@ -250,9 +250,9 @@ class _Run:
         return op
 
     def advance_op(self, name: str, last: bool):
-        """Steps ``name`` to the next event in chunks. An interrupt between chunks records
-        how far the last advanced block of the event got (the earlier ones are further,
-        the later ones still at the event): the run's data are complete up to there."""
+        """Steps ``name`` to the next event in chunks. An interrupt in the span records how
+        far the last advanced block of the event got (the earlier ones are further, the
+        later ones still at the event): every block was computed up to there."""
         blk = self.d.blocks[name].block
         advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
         period, dt = self.s.period_ticks[name], float(blk.period)
@@ -284,13 +284,20 @@ class _Run:
                         d[dp] = value
             except KeyboardInterrupt:
                 if last:
-                    self.reached = k + done * period
+                    self.reached = self.logged_tick(name, k + done * period)
                 raise
             except Exception as exc:
                 done += self.log_partial_rows(name, exc, ports, loggers)
                 raise _StepFailure(name, "advance", k + done * period, exc) from exc
 
         return op
+
+    def logged_tick(self, name: str, counted: int) -> int:
+        """The tick of the last hit of ``name`` that its logs hold, which is where its data
+        reach even when an interrupt fell between logging a chunk and counting it;
+        ``counted`` when nothing of it is logged."""
+        hits = max((lg.hits + sum(len(rows) for rows in lg.pending) for lg in self.loggers[name]), default=0)
+        return int(self.s.nth_hits(name, np.array([hits - 1]))[0]) if hits else counted
 
     def check_outputs(self, name: str, out: Any, ports: tuple[str, ...]) -> None:
         blk = self.d.blocks[name].block
