@@ -39,10 +39,10 @@ STAGING_PREFIX = ".staging-"
 
 
 class OutputFolderError(OSError):
-    """A results folder that cannot be created or written; ``reason`` says why, without the path."""
+    """A results folder that cannot be created or written: '``directory`` ``reason``'."""
 
     def __init__(self, directory: Path, reason: str):
-        super().__init__(f"{directory}: {reason}")
+        super().__init__(f"{directory} {reason}")
         self.reason = reason
 
 
