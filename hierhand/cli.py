@@ -2,8 +2,8 @@
 
 Exit codes: 0 ok, 2 bad input (a one-line message per problem, no traceback), 1 a failure
 during a simulation (the message names block, time and signal; partial results are kept)
-or results that could not be saved where asked, 130 Ctrl-C (a run saves what it computed,
-marked interrupted).
+or results that could not be saved where asked, 130 Ctrl-C and 143 SIGTERM (a run saves
+what it computed, marked interrupted).
 """
 
 from __future__ import annotations
@@ -38,9 +38,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (UsageError, ResultsError) as exc:
         print(f"hierhand: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        from hierhand.stop_signals import exit_code
+
         print("hierhand: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return exit_code(exc)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -256,12 +258,13 @@ class ProgressBar:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Simulate and save. The output folder is checked before the run; Ctrl-C stops the
-    run and its results so far are saved; after an interrupt the plots are skipped, to
-    stop soon."""
+    """Simulate and save. The output folder is checked before the run; Ctrl-C or SIGTERM
+    stops the run and its results so far are saved, and no signal cuts the saving short
+    (``stop_signals``); after an interrupt the plots are skipped, to stop soon."""
     from blocks import DiagramError, simulate
     from blocks.results_folder import OutputFolderError
     from hierhand.run_output import check_output, remove_if_empty, save_run
+    from hierhand.stop_signals import StopSignals, exit_code
 
     diagram = load(args)
     t_end = end_time(args, diagram)
@@ -271,15 +274,17 @@ def cmd_run(args: argparse.Namespace) -> int:
     except OutputFolderError as exc:
         raise UsageError(f"output folder {exc}") from None
     bar = ProgressBar(float(t_end), enabled=not args.quiet)
-    try:
-        results = simulate(diagram, t_end=t_end, progress=bar)
-    except DiagramError:
-        if created:
-            remove_if_empty(out)
-        raise
-    finally:
-        bar.close()
-    saved = save_run(results, out, csv=args.csv, plot=args.plot and not results.interrupted)
+    with StopSignals() as stops:
+        try:
+            results = simulate(diagram, t_end=t_end, progress=bar)
+        except DiagramError:
+            if created:
+                remove_if_empty(out)
+            raise
+        finally:
+            bar.close()
+        with stops.held():
+            saved = save_run(results, out, csv=args.csv, plot=args.plot and not results.interrupted)
     if not results.complete:
         print(f"hierhand: {diagram.file}: {results.status}", file=sys.stderr)
     if saved.problem:
@@ -289,7 +294,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         skipped = (f"; plots skipped after the interrupt ('hierhand plot {out}' draws them)"
                    if args.plot and results.interrupted else "")
         print(f"hierhand: partial results (marked incomplete) saved in {out}{skipped}", file=sys.stderr)
-        return EXIT_INTERRUPTED if results.interrupted else EXIT_FAILED
+        return exit_code(stops.received) if results.interrupted else EXIT_FAILED
     if not args.quiet:
         info = results.info
         rtf = info.get("real_time_factor")

@@ -165,3 +165,19 @@ class InterruptedAccumulator(FastAccumulator):
         if self.made == self.calls:
             raise KeyboardInterrupt
         return super().advance(t, state, inputs, n)
+
+
+class Touch(Block):
+    """A source that creates the file ``path`` when it first computes its output (at t = 0):
+    the sign a test waits for that a run has started."""
+
+    outputs = {"y": 1}
+    feedthrough = False
+
+    def __init__(self, path: str = ""):
+        self.path = path
+
+    def output(self, t, state, inputs):
+        with open(self.path, "a", encoding="utf-8"):
+            pass
+        return {"y": np.zeros(1)}
