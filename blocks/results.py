@@ -9,6 +9,7 @@ way with a status saying where it stopped.
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 from typing import Iterator
 
@@ -61,8 +62,19 @@ class Results:
 
     @property
     def interrupted(self) -> bool:
-        """True when the run was stopped by Ctrl-C rather than by its end time or a failure."""
+        """True when the run was stopped (Ctrl-C, SIGTERM) rather than by its end time or a failure."""
         return self.status.startswith("interrupted")
+
+    @property
+    def stop_time(self) -> float | None:
+        """Where a failed or interrupted run stopped: run.json's ``t_stop``, or the time in
+        the status of files written before it was recorded; None for a complete run."""
+        if self.complete:
+            return None
+        if self.info.get("t_stop") is not None:
+            return float(self.info["t_stop"])
+        found = re.match(r"\w+ at t=([-+0-9.eE]+) s", self.status)
+        return float(found.group(1)) if found else None
 
     def value_at(self, name: str, t: float) -> np.ndarray:
         """The held (zero-order hold) value of a signal at time ``t``."""
