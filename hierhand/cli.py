@@ -277,7 +277,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     with StopSignals() as stops:
         try:
             results = simulate(diagram, t_end=t_end, progress=bar)
-        except DiagramError:
+        except (DiagramError, KeyboardInterrupt):  # refused, or stopped, before it started
             if created:
                 remove_if_empty(out)
             raise

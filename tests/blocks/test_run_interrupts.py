@@ -77,12 +77,15 @@ def assert_saved_up_to_the_status_time(out: Path, interrupted_by: str) -> Result
     return r
 
 
-def test_ctrl_c_inside_an_advance_span_saves_the_run_up_to_where_it_got(tmp_path):
+@pytest.mark.parametrize("sig, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)], ids=["SIGINT", "SIGTERM"])
+def test_a_stop_inside_an_advance_span_saves_the_run_up_to_where_it_got(tmp_path, sig, code):
+    """Ctrl-C, and SIGTERM treated alike (exit 143, as a shell reports it)."""
     proc, out = start(tmp_path)
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(sig)
     err = finish(proc)
-    assert proc.returncode == 130, err
-    assert_saved_up_to_the_status_time(out, "SIGINT")
+    assert proc.returncode == code, err
+    assert_saved_up_to_the_status_time(out, sig.name)
+    assert "interrupted at t=" in err and f"by {sig.name}" in err
     assert "partial results (marked incomplete) saved" in err
 
 
@@ -109,11 +112,3 @@ def test_a_second_ctrl_c_cannot_lose_the_results(tmp_path, second):
     rows = (out / "signals.csv").read_text(encoding="utf-8").count("\n")
     assert rows == len(r["acc.y"][0]) + 1
 
-
-def test_sigterm_saves_the_run_like_ctrl_c_and_exits_143(tmp_path):
-    proc, out = start(tmp_path)
-    proc.send_signal(signal.SIGTERM)
-    err = finish(proc)
-    assert proc.returncode == 143, err
-    assert_saved_up_to_the_status_time(out, "SIGTERM")
-    assert "interrupted at t=" in err and "by SIGTERM" in err

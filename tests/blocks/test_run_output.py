@@ -15,16 +15,10 @@ import pytest
 from blocks import Results
 from hierhand.run_output import save_run
 
+from .test_cli import LONG_DIAGRAM
 from .test_results_folder import read_only_folder
 
 REPO = Path(__file__).resolve().parents[2]
-LONG = """\
-name: long
-time: {t_end: 1000000 s}
-blocks:
-  ramp: {type: Ramp, period: 0.1 ms, params: {slope: 1.0}}
-log: [{signal: ramp.y, decimate: 1000000}]
-"""
 
 
 def hierhand(tmp_path: Path, *args: str, timeout: float = 60) -> subprocess.CompletedProcess:
@@ -37,14 +31,15 @@ def hierhand(tmp_path: Path, *args: str, timeout: float = 60) -> subprocess.Comp
 
 def test_a_read_only_output_folder_is_refused_before_the_run(tmp_path):
     folder = read_only_folder(tmp_path)
-    (tmp_path / "d.yaml").write_text(LONG, encoding="utf-8")
+    (tmp_path / "d.yaml").write_text(LONG_DIAGRAM, encoding="utf-8")
     proc = hierhand(tmp_path, "run", "d.yaml", "-o", str(folder), timeout=30)
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr == f"hierhand: error: output folder {folder} is not writable: Permission denied\n"
 
 
 def test_results_that_cannot_be_saved_go_to_a_temporary_folder(tmp_path):
-    (tmp_path / "d.yaml").write_text(LONG.replace("1000000 s", "10 ms").replace("1000000}", "10}"), encoding="utf-8")
+    short = LONG_DIAGRAM.replace("100000 s", "10 ms").replace("decimate: 10000", "decimate: 10")
+    (tmp_path / "d.yaml").write_text(short, encoding="utf-8")
     (tmp_path / "out" / "signals.npz").mkdir(parents=True)  # passes the check, fails the save
     proc = hierhand(tmp_path, "run", "d.yaml", "-o", "out")
     assert proc.returncode == 1, proc.stderr

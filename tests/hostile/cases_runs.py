@@ -1,7 +1,7 @@
 """Corpus cases for ``hierhand run`` and its output folder: a bad -o is refused before the
 run, a run's files replace the previous run's as one set, incomplete runs keep their data.
 
-The long diagram would run for days: a case that expects an answer within its timeout
+The long diagram runs for many minutes: a case that expects an answer within its timeout
 proves that the output folder was checked before the simulation started.
 """
 
@@ -15,15 +15,8 @@ from pathlib import Path
 
 from blocks import Results
 
+from ..blocks.test_cli import LONG_DIAGRAM as LONG
 from .corpus import Case
-
-LONG = """\
-name: long
-time: {t_end: 1000000 s}
-blocks:
-  ramp: {type: Ramp, period: 0.1 ms, params: {slope: 1.0}}
-log: [{signal: ramp.y, decimate: 1000000}]
-"""
 
 SHORT = """\
 name: short
