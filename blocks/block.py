@@ -35,6 +35,22 @@ class BlockError(Exception):
         self.rows = rows
 
 
+class ParameterError(ValueError):
+    """Invalid parameters found by a block's constructor, one entry per problem.
+
+    ``problems`` pairs where the offending value is (the parameter, then the keys and list
+    indices into it: ``("object", "mass")``, ``("fingers", 1, "links")``; ``()`` when no
+    one value is to blame) with a message naming it. The diagram loader reports each
+    problem on a line of its own, at the line of the diagram, params file or ``--set``
+    that gave that value; any other exception of a constructor is one problem at the
+    block's parameters.
+    """
+
+    def __init__(self, problems, message: str | None = None):
+        self.problems = [(tuple(path), str(text)) for path, text in problems]
+        super().__init__(message if message is not None else "; ".join(t for _, t in self.problems))
+
+
 class Block:
     """Base class of every block.
 

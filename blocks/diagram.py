@@ -14,23 +14,24 @@ import re
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
-from typing import Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, NamedTuple
 
 import numpy as np
 
-from .block import Block
+from .block import Block, ParameterError
+from .limits import MAX_PORT_WIDTH
 from .param_paths import PathError, set_path
 from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
+from .safepath import inside
 from .timebase import DurationError, parse_duration
-from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml
+from .yamlsource import LineDict, LineList, YamlSourceError, line_at, line_of, load_yaml, read_yaml_file
 
 TOP_KEYS = ("version", "name", "description", "time", "blocks", "connections", "log")
 TIME_KEYS = ("t_end",)
 BLOCK_KEYS = ("type", "period", "offset", "params", "params_file", "description")
 CONNECTION_KEYS = ("from", "to", "delay", "initial")
 LOG_KEYS = ("signal", "decimate")
-MAX_PORT_WIDTH = 1_000_000
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
 
@@ -43,6 +44,9 @@ class Issue:
     line: int | None
     message: str
     hint: str = ""
+    override: str | None = None
+    """The override (``block.param``) the issue is about; ``file`` then says how the user
+    gave it (``--set plant.k=2``, ``--grid plant.k=1,2``)."""
 
     def __str__(self) -> str:
         where = f"{self.file}:{self.line}" if self.line else self.file
@@ -77,6 +81,13 @@ class BlockSpec:
         return {p: self.params[p] for p in type(self.block).block_params if p in self.params}
 
 
+class _ParamsFile(NamedTuple):
+    """A block's params file: its path and its content (a LineDict, or {} when empty)."""
+
+    path: str
+    data: Mapping
+
+
 @dataclass
 class _Entry:
     """A block of the file checked up to its constructor call (built once its references are)."""
@@ -88,6 +99,7 @@ class _Entry:
     period: Fraction | None
     offset: Fraction | None
     params: dict
+    source: _ParamsFile | None = None
     references: dict[str, str] = field(default_factory=dict)
 
 
@@ -172,24 +184,32 @@ class Diagram:
 
 
 def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
-                 trust: bool = False) -> Diagram:
-    """Load and validate a diagram file; ``overrides`` maps ``block.param[.key]`` to a value."""
+                 trust: bool = False, origins: Mapping[str, str] | None = None) -> Diagram:
+    """Load and validate a diagram file; ``overrides`` maps ``block.param[.key]`` to a value.
+
+    ``origins`` says how the user gave an override, for the messages about it: by key, the
+    text that stands where a file name would (``--grid plant.k=1,2``); by default
+    ``--set block.param=value``. ``trust`` allows ``python:`` block types and params files
+    outside the diagram's folder.
+    """
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_yaml_file(path)
     except FileNotFoundError:
         raise DiagramError([Issue(str(path), None, "diagram file not found",
                                   "check the path; diagrams are YAML files such as diagrams/toy.yaml")]) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise DiagramError([Issue(str(path), None, f"cannot read diagram file: {exc}")]) from None
-    return loads_diagram(text, filename=str(path), base_dir=path.parent, overrides=overrides, trust=trust)
+    except YamlSourceError as exc:
+        raise DiagramError([Issue(str(path), exc.line, exc.message, exc.hint)]) from None
+    return loads_diagram(text, filename=str(path), base_dir=path.parent, overrides=overrides, trust=trust,
+                         origins=origins)
 
 
 def loads_diagram(text: str, filename: str = "<diagram>", base_dir: str | Path | None = None,
-                  overrides: Mapping[str, Any] | None = None, trust: bool = False) -> Diagram:
+                  overrides: Mapping[str, Any] | None = None, trust: bool = False,
+                  origins: Mapping[str, str] | None = None) -> Diagram:
     """Load and validate a diagram from YAML text (``base_dir`` resolves ``params_file``)."""
     loader = _Loader(filename, Path(base_dir) if base_dir is not None else Path.cwd(),
-                     dict(overrides or {}), trust)
+                     dict(overrides or {}), trust, dict(origins or {}))
     diagram = loader.load(text)
     from .schedule import build_schedule
 
@@ -237,11 +257,13 @@ def deep_merge(base: Mapping, top: Mapping) -> dict:
 class _Loader:
     """One pass over a diagram text, collecting every issue before raising."""
 
-    def __init__(self, filename: str, base_dir: Path, overrides: dict[str, Any], trust: bool):
+    def __init__(self, filename: str, base_dir: Path, overrides: dict[str, Any], trust: bool,
+                 origins: dict[str, str]):
         self.file = filename
         self.base_dir = base_dir
         self.overrides = overrides
         self.trust = trust
+        self.origins = origins
         self.issues: list[Issue] = []
         self.failed_blocks: set[str] = set()
         self.hash = hashlib.sha256()
@@ -250,7 +272,8 @@ class _Loader:
         self.issues.append(Issue(file or self.file, line, message, hint))
 
     def override_error(self, key: str, message: str, hint: str = "") -> None:
-        self.issues.append(Issue(f"--set {key}={self.overrides[key]!r}", None, message, hint))
+        origin = self.origins.get(key) or f"--set {key}={self.overrides[key]!r}"
+        self.issues.append(Issue(origin, None, message, hint, override=key))
 
     def load(self, text: str) -> Diagram:
         self.hash.update(text.encode("utf-8"))
@@ -258,8 +281,7 @@ class _Loader:
         try:
             data = load_yaml(text)
         except YamlSourceError as exc:
-            raise DiagramError([Issue(self.file, exc.line, exc.message,
-                                      "check indentation, colons and brackets near that line")]) from None
+            raise DiagramError([Issue(self.file, exc.line, exc.message, exc.hint)]) from None
         if not isinstance(data, LineDict):
             raise DiagramError([Issue(self.file, getattr(data, "line", 1) or 1,
                                       "a diagram must be a YAML mapping",
@@ -360,7 +382,7 @@ class _Loader:
         cyclic = {r.block for cycle in cycles for r in cycle}
         for cycle in cycles:
             first = entries[cycle[0].block]
-            self.param_error(first, cycle[0].param, f"block references form a cycle: {chain_text(cycle)}",
+            self.param_error(first, (cycle[0].param,), f"block references form a cycle: {chain_text(cycle)}",
                              "a referenced block is built before the blocks that refer to it; "
                              "remove one of these references")
         built: dict[str, BlockSpec] = {}
@@ -410,10 +432,15 @@ class _Loader:
                 self.error(spec.line_of("offset"), f"block '{name}': offset must be in [0, period)",
                            "an offset is a phase within one period")
                 return None
-        params = self.params(name, spec, cls, line)
+        source = None
+        if "params_file" in spec:
+            source = self.params_file(spec, name)
+            if source is None:
+                return None
+        params = self.params(name, spec, cls, line, source)
         if params is None:
             return None
-        return _Entry(name, spec, line, cls, period, offset, params)
+        return _Entry(name, spec, line, cls, period, offset, params, source)
 
     def references(self, entry: _Entry, names: Mapping) -> bool:
         """Check the block's block-reference parameters against the diagram's block names
@@ -424,13 +451,13 @@ class _Loader:
                 continue
             target = entry.params[key]
             if not isinstance(target, str):
-                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' must be the name of "
+                self.param_error(entry, (key,), f"block '{entry.name}': parameter '{key}' must be the name of "
                                  f"a block of this diagram, got {target!r}", f"e.g. {key}: <block name>")
             elif target == entry.name:
-                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' refers to the block "
+                self.param_error(entry, (key,), f"block '{entry.name}': parameter '{key}' refers to the block "
                                  "itself", f"name another block of this diagram; blocks are: {_known(names)}")
             elif target not in names:
-                self.param_error(entry, key, f"block '{entry.name}': parameter '{key}' names no block "
+                self.param_error(entry, (key,), f"block '{entry.name}': parameter '{key}' names no block "
                                  f"'{target}'", _suggest(target, names) or f"blocks are: {_known(names)}")
             else:
                 entry.references[key] = target
@@ -438,19 +465,29 @@ class _Loader:
             ok = False
         return ok
 
-    def param_error(self, entry: _Entry, key: str, message: str, hint: str = "") -> None:
-        """An issue about one parameter, reported where its value comes from: the --set
-        that gave it, or its line in the diagram."""
-        override = f"{entry.name}.{key}"
-        if override in self.overrides:
-            self.override_error(override, message, hint)
-            return
+    def param_error(self, entry: _Entry, path: tuple, message: str, hint: str = "") -> None:
+        """An issue about a parameter value (``path``: the parameter, then keys and indices
+        into it), reported where that value comes from: the --set that gave it (or a part
+        of it), else the deepest part of the path written in the block's ``params:`` or
+        its params file, else the block's parameters as a whole."""
+        parts = [str(p) for p in path]
+        for key in self.overrides:
+            block, _, rest = key.partition(".")
+            given = rest.split(".")
+            if parts and block == entry.name and (given[:len(parts)] == parts or parts[:len(given)] == given):
+                self.override_error(key, message, hint)
+                return
         inline = entry.spec.get("params")
-        if isinstance(inline, LineDict) and key in inline:
-            line = inline.line_of(key)
-        else:
-            line = entry.spec.line_of("params_file") if "params_file" in entry.spec else entry.line
-        self.error(line, message, hint)
+        line, found = line_at(inline, path) if isinstance(inline, LineDict) else (None, 0)
+        file = None
+        if entry.source is not None:
+            file_line, file_found = line_at(entry.source.data, path)
+            if file_found > found:
+                file, line, found = entry.source.path, file_line, file_found
+        if not found:
+            written = "params" if "params" in entry.spec else "params_file"
+            line = entry.spec.line_of(written) if written in entry.spec else entry.line
+        self.error(line, message, hint, file=file)
 
     def build(self, entry: _Entry, built: Mapping[str, BlockSpec]) -> BlockSpec | None:
         """Construct and bind the block, its references given as the blocks they name."""
@@ -464,9 +501,10 @@ class _Loader:
             if period is None and block.period is not None:
                 period = block.period  # a block with a natural rate (an FMU's default step)
         except Exception as exc:  # a block's own message says which parameter is wrong
-            where = spec.line_of("params") if "params" in spec else line
-            self.error(where, f"block '{name}' ({type_name}): {exc}",
-                       f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
+            problems = exc.problems if isinstance(exc, ParameterError) else [((), str(exc))]
+            for path, text in problems:
+                self.param_error(entry, path, f"block '{name}' ({type_name}): {text}",
+                                 f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
             return None
         block.name = name
         for kind in ("inputs", "outputs"):
@@ -481,29 +519,28 @@ class _Loader:
         return BlockSpec(name, cls.registered_name(), block, period, entry.offset or Fraction(0), entry.params,
                          line, params_file)
 
-    def params(self, name: str, spec: LineDict, cls: type[Block], line: int) -> dict | None:
-        params: dict = {}
-        if "params_file" in spec:
-            loaded = self.params_file(spec, name)
-            if loaded is None:
-                return None
-            params = loaded
+    def params(self, name: str, spec: LineDict, cls: type[Block], line: int,
+               source: _ParamsFile | None) -> dict | None:
         inline = spec.get("params", {})
         if inline is None:
             inline = {}
         if not isinstance(inline, Mapping):
             self.error(spec.line_of("params"), f"block '{name}': 'params' must be a mapping")
             return None
-        params = deep_merge(params, inline)
+        params = deep_merge(source.data if source else {}, inline)
         declared = cls.parameters()
         accepts_any = cls.accepts_any_parameter()
         ok = True
-        for key in list(inline):
-            if key not in declared and not accepts_any:
-                self.error(line_of(inline, key, spec.line_of("params")),
-                           f"block '{name}' ({cls.registered_name()}) has no parameter {key!r}",
-                           _suggest(key, declared) or f"parameters: {_known(declared)}")
-                ok = False
+        given = [(inline, None, spec.line_of("params"))]
+        if source is not None:
+            given.insert(0, (source.data, source.path, 1))
+        for mapping, file, default_line in given:
+            for key in mapping:
+                if key not in declared and not accepts_any:
+                    self.error(line_of(mapping, key, default_line),
+                               f"block '{name}' ({cls.registered_name()}) has no parameter {key!r}",
+                               _suggest(key, declared) or f"parameters: {_known(declared)}", file=file)
+                    ok = False
         for key, value in self.overrides.items():
             block_name, _, path = key.partition(".")
             if block_name != name:
@@ -536,33 +573,41 @@ class _Loader:
             ok = False
         return params if ok else None
 
-    def params_file(self, spec: LineDict, name: str) -> dict | None:
+    def params_file(self, spec: LineDict, name: str) -> _ParamsFile | None:
+        """Read the block's params file; without ``trust`` it must lie in the diagram's
+        folder tree (see ``blocks.safepath``)."""
         rel = spec["params_file"]
         line = spec.line_of("params_file")
         if not isinstance(rel, str):
             self.error(line, f"block '{name}': params_file must be a path")
             return None
         path = (self.base_dir / rel)
+        if not self.trust and not inside(path, self.base_dir):
+            self.error(line, f"block '{name}': params_file '{rel}' is outside the diagram's folder",
+                       "a diagram reads files only from its own folder and below; pass --trust "
+                       "(Python: trust=True) if you trust this diagram")
+            return None
         try:
-            text = path.read_text(encoding="utf-8")
-        except OSError:
+            text = read_yaml_file(path)
+            self.hash.update(text.encode("utf-8"))
+            data = load_yaml(text)
+        except FileNotFoundError:
             self.error(line, f"block '{name}': params_file '{rel}' not found (looked at {path})",
                        "params_file is relative to the diagram's folder")
             return None
-        self.hash.update(text.encode("utf-8"))
-        try:
-            data = load_yaml(text)
         except YamlSourceError as exc:
-            self.error(exc.line, exc.message, "check indentation, colons and brackets near that line",
-                       file=str(path))
+            if exc.line is None:  # the file as a whole: reported where the diagram names it
+                self.error(line, f"block '{name}': params_file '{rel}': {exc.message}", exc.hint)
+            else:
+                self.error(exc.line, exc.message, exc.hint, file=str(path))
             return None
         if data is None:
-            return {}
+            return _ParamsFile(str(path), {})
         if not isinstance(data, Mapping):
             self.error(1, "a params file must be a YAML mapping of parameter names to values",
                        file=str(path))
             return None
-        return deep_merge({}, data)
+        return _ParamsFile(str(path), data)
 
     def connections_section(self, data: LineDict, blocks: dict[str, BlockSpec]) -> list[Connection]:
         section = data.get("connections")

@@ -31,17 +31,25 @@ result independent of the evaluation order (the usual Jacobi co-simulation schem
 first output, at the block's first hit ``t0`` (its offset), is the FMU's initial output
 after initialisation with start time ``t0``.
 
-State. The FMU instance is external mutable state: ``initial_state()`` hands each run its
-own instance (``FMUState``), taken from the block's pool and reset, or instantiated if
-every pooled one is in use. When the run's state is garbage collected (or ``close()``d)
-the instance is terminated and returned to the pool; instances are freed when the block
-goes away, at process exit, or by ``FMU.close()``. An instance that failed is freed, never
-reused. The state cannot be copied or checkpointed (FMU get/set state is not used).
+Loading and running. Loading a diagram reads only the archive's member list and its
+modelDescription.xml (``fmu_info.read_description``): ``hierhand validate`` and ``graph``
+never run an FMU's code. The archive is extracted and the binary loaded when a run first
+needs an instance, at the block's first ``output`` or ``update``.
 
-Errors. Problems with the file are raised at load time (ValueError, which the diagram
-loader reports as ``file:line: block 'x' (FMU): ...``). A failing ``doStep`` raises
-``BlockError`` naming the FMU, the time and the status, with the FMU's recent log
-messages; the executor keeps the results up to that point.
+State. The FMU instance is external mutable state: ``initial_state()`` hands each run its
+own ``FMUState``, which takes an instance from the block's pool (reset), or instantiates
+one if every pooled one is in use, at the run's first call. When the run's state is
+garbage collected (or ``close()``d) the instance is terminated and returned to the pool;
+instances are freed when the block goes away, at process exit, or by ``FMU.close()``. An
+instance that failed is freed, never reused. The state cannot be copied or checkpointed
+(FMU get/set state is not used).
+
+Errors. Problems with the file, its modelDescription and a period the FMU cannot step
+are raised at load time (ValueError, which the diagram loader reports as
+``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, and a
+failing ``doStep``, raise ``BlockError`` naming the FMU, the time and the status, with the
+FMU's recent log messages; the executor keeps the results up to that point. Ctrl-C inside
+an FMU call is a KeyboardInterrupt, never an FMU failure (see ``fmu_interrupt``).
 """
 
 from __future__ import annotations
@@ -66,8 +74,10 @@ from typing import Any
 
 import numpy as np
 
+from blocks import fmu_interrupt
 from blocks.block import Block, BlockError, Signal
 from blocks.fmu_archive import ArchiveError, extract_archive
+from blocks.fmu_info import MODEL_DESCRIPTION, read_description
 from blocks.timebase import format_duration
 
 log = logging.getLogger("blocks.fmu")
@@ -77,6 +87,10 @@ LOG_LINES = 20
 
 ERROR_LOG_LINES = 8
 """How many of them an error message quotes."""
+
+STEP_TOLERANCE = Fraction(1, 10**6)
+"""How far (in internal steps) a period may miss a whole multiple of an FMU's fixed internal
+step; the exported hand plant accepts the same."""
 
 _STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 _INDEXED = re.compile(r"^(?P<base>.*[^\s])\[(?P<index>\s*\d+\s*(?:,\s*\d+\s*)*)\]$")
@@ -292,40 +306,32 @@ class _Binary:
 
 
 class _Model:
-    """An extracted FMU and what its modelDescription says; owns the pool of instances."""
+    """What an FMU's modelDescription says, and the pool of its instances.
+
+    Reading the model touches only the archive's member list and modelDescription.xml;
+    the archive is extracted (and the binary loaded, by ``_Instance``) when the first
+    instance is acquired, that is when a run starts.
+    """
 
     def __init__(self, path: Path, shown: str):
+        self.path = path
         self.shown = shown
         self.lock = threading.Lock()
+        self.extract_lock = threading.Lock()
         self.idle: list[_Instance] = []
         self.live = 0
         self.closed = False
-        self.dir = Path(tempfile.mkdtemp(prefix="blocks-fmu-"))
-        self._cleanup = weakref.finalize(self, _remove_model, self.idle, str(self.dir))
-        try:
-            self._read(path, shown)
-        except BaseException:
-            self._cleanup()
-            raise
+        self.dir: Path | None = None
+        self.binary: _Binary | None = None
+        self._dirs: list[str] = []
+        self._cleanup = weakref.finalize(self, _remove_model, self.idle, self._dirs)
+        self._read(path, shown)
 
     def _read(self, path: Path, shown: str) -> None:
         fmpy = _fmpy()
-        try:
-            extract_archive(path, self.dir)
-        except ArchiveError as exc:
-            raise ValueError(f"unsafe FMU archive, not extracted: {exc}") from None
-        except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, NotImplementedError) as exc:
-            raise ValueError(f"{shown} is not an FMU: not a readable zip archive ({exc})") from None
-        if not (self.dir / "modelDescription.xml").is_file():
-            raise ValueError(f"{shown} is not an FMU: the archive has no modelDescription.xml")
-        try:
-            md = fmpy.model_description.read_model_description(str(self.dir), validate=True)
-        except Exception as exc:
-            problems = getattr(exc, "problems", None)
-            text = "; ".join(str(p) for p in problems[:3]) + ("; ..." if len(problems) > 3 else "") \
-                if problems else (str(exc).strip().splitlines() or [type(exc).__name__])[0]
-            raise ValueError(f"{shown} has a broken modelDescription.xml: {text}") from None
-        self.md = md
+        description = read_description(path, shown)
+        self.description = description
+        md = self.md = description.md
         major = md.fmiMajorVersion if md.fmiVersion else 0
         if major not in (2, 3):
             raise ValueError(f"{shown} is an FMI {md.fmiVersion} FMU; the FMU block supports FMI 2.0 "
@@ -344,17 +350,17 @@ class _Model:
             raise ValueError(f"{shown} needs its execution tool (a tool-coupling FMU), which cannot "
                              "run here")
         platform = fmpy.platform if major == 2 else fmpy.platform_tuple
-        library = self.dir / "binaries" / platform / (self.identifier + fmpy.sharedLibraryExtension)
-        if not library.is_file():
-            folder = self.dir / "binaries"
-            found = sorted(p.name for p in folder.iterdir()) if folder.is_dir() else []
-            has_sources = (self.dir / "sources").is_dir()
+        library = f"binaries/{platform}/{self.identifier}{fmpy.sharedLibraryExtension}"
+        if library not in description.files:
+            found = description.platforms()
+            has_sources = any(f.startswith("sources/") for f in description.files)
             detail = f"it has binaries for {', '.join(found)}" if found else "it has no binaries"
             if has_sources:
                 detail += " and C sources (compile them first, e.g. with fmpy's compile_platform_binary)"
             raise ValueError(f"{shown} has no binary for this platform ({platform}/"
-                             f"{library.name}); {detail}")
+                             f"{library.rsplit('/', 1)[1]}); {detail}")
         self.library = library
+        self.fixed_step = description.fixed_step()
         self.guid = md.guid or ""
         de = md.defaultExperiment
         self.default_step = _fraction_or_none(de.stepSize if de else None)
@@ -376,8 +382,6 @@ class _Model:
                 indexed.setdefault(m.group("base"), []).append((index, v))
         self.vectors = {b: [v for _, v in sorted(items, key=lambda i: i[0])]
                         for b, items in indexed.items()}
-        self.binary = _Binary(shown, major, self.identifier, self.guid, self.dir, library,
-                              self.in_groups, self.out_groups)
 
     # -- start values -------------------------------------------------------------------
 
@@ -458,23 +462,43 @@ class _Model:
             self.live += 1
         if inst is None:
             try:
-                inst = _Instance(self.binary)
+                inst = _Instance(self._extracted())
             except BaseException:
                 with self.lock:
                     self.live -= 1
                 raise
         return inst
 
+    def _extracted(self) -> _Binary:
+        """What an instance needs, extracting the archive the first time (a run starts)."""
+        with self.extract_lock:
+            if self.binary is None:
+                folder = Path(tempfile.mkdtemp(prefix="blocks-fmu-"))
+                self._dirs.append(str(folder))
+                try:
+                    extract_archive(self.path, folder)
+                    xml = (folder / MODEL_DESCRIPTION).read_bytes()
+                except (ArchiveError, OSError, zipfile.BadZipFile, EOFError) as exc:
+                    shutil.rmtree(folder, ignore_errors=True)
+                    raise BlockError(f"{self.shown}: extracting the FMU failed: {exc}") from None
+                if xml != self.description.xml:
+                    shutil.rmtree(folder, ignore_errors=True)
+                    raise BlockError(f"{self.shown} has changed since the diagram was loaded; load it again")
+                self.dir = folder
+                self.binary = _Binary(self.shown, self.major, self.identifier, self.guid, folder,
+                                      folder / self.library, self.in_groups, self.out_groups)
+        return self.binary
+
     def release(self, inst: _Instance) -> None:
         """Take an instance back from a run: terminate and pool it, or free it if it failed."""
         if inst.started and not inst.broken:
             inst.started = False
             try:
-                if inst.model.major == 2:
-                    _fmi2_arm()
+                _arm(inst.model.major)
                 inst.slave.terminate()
             except Exception:
                 inst.broken = True
+            fmu_interrupt.deliver()
         with self.lock:
             self.live -= 1
             keep = not inst.broken and not self.closed
@@ -494,11 +518,12 @@ class _Model:
             self._cleanup()
 
 
-def _remove_model(idle: list, directory: str) -> None:
+def _remove_model(idle: list, directories: list[str]) -> None:
     for inst in list(idle):
         inst.free()
     idle.clear()
-    shutil.rmtree(directory, ignore_errors=True)
+    for directory in directories:
+        shutil.rmtree(directory, ignore_errors=True)
 
 
 def _fraction_or_none(text: Any) -> Fraction | None:
@@ -544,6 +569,7 @@ def _record(buffer: collections.deque | None, status: int, category: bytes | Non
     log.log({0: logging.DEBUG, 1: logging.WARNING}.get(status, logging.INFO), "%s: %s", who, line)
 
 
+@fmu_interrupt.callback
 def _fmi2_log(env, instance_name, status, category, message) -> None:
     entry = _fmi2_buffers.get(env or 0)
     if entry is None:  # an FMU of other code using fmpy's default callbacks: do what fmpy does
@@ -570,6 +596,13 @@ def _fmi2_arm():
     scratch.logger = callback
     add(ref)
     return callback
+
+
+def _arm(major: int) -> None:
+    """Before a call into an FMU: the interrupt hook and, for FMI 2, our logger in place."""
+    fmu_interrupt.arm()
+    if major == 2:
+        _fmi2_arm()
 
 
 # -- one FMU instance --------------------------------------------------------------------
@@ -606,6 +639,7 @@ class _Instance:
             if os.getcwd() != cwd:
                 os.chdir(cwd)
         self.slave = slave
+        fmu_interrupt.arm()
         try:
             if model.major == 2:
                 from fmpy.fmi2 import (
@@ -617,8 +651,9 @@ class _Instance:
 
                 callbacks = fmi2CallbackFunctions()
                 callbacks.logger = _fmi2_arm()
-                callbacks.allocateMemory = fmi2CallbackAllocateMemoryTYPE(fmpy.calloc)
-                callbacks.freeMemory = fmi2CallbackFreeMemoryTYPE(fmpy.free)
+                # the C library's own functions: no Python (which Ctrl-C could break) in between
+                callbacks.allocateMemory = ctypes.cast(fmpy.calloc, fmi2CallbackAllocateMemoryTYPE)
+                callbacks.freeMemory = ctypes.cast(fmpy.free, fmi2CallbackFreeMemoryTYPE)
                 callbacks.componentEnvironment = self.serial
                 addLoggerProxy(ctypes.byref(callbacks))
                 _fmi2_buffers[self.serial] = (self.messages, f"{model.shown} ({name})")
@@ -629,10 +664,11 @@ class _Instance:
                 def log3(env, status, category, message):
                     _record(messages, status, category, message, who)
 
-                slave.instantiate(logMessage=log3)
+                slave.instantiate(logMessage=fmu_interrupt.callback(log3))
         except Exception as exc:
             _fmi2_buffers.pop(self.serial, None)
             slave.freeLibrary()
+            fmu_interrupt.check()
             raise BlockError(f"{model.shown}: instantiating the FMU failed: {exc}{self.log_text()}") from None
         self._buffers(ctypes)
 
@@ -684,8 +720,7 @@ class _Instance:
             s.reset()
         self.used = True
         self.messages.clear()
-        if self.model.major == 2:
-            _fmi2_arm()
+        _arm(self.model.major)
         setters = _setters(s, self.model.major)
         for a in assignments:
             setters[a.kind]([a.vr], a.values)
@@ -742,13 +777,13 @@ class _Instance:
             return
         self.freed = True
         try:
-            if self.model.major == 2:
-                _fmi2_arm()
+            _arm(self.model.major)
             self.slave.freeInstance()
         except Exception as exc:  # freeing must not raise from a finalizer
             log.debug("%s: freeing the FMU instance failed: %s", self.model.shown, exc)
         finally:
             _fmi2_buffers.pop(self.serial, None)
+        fmu_interrupt.deliver()
 
 
 def _setters(slave: Any, major: int) -> dict[str, Any]:
@@ -768,6 +803,8 @@ def _setters(slave: Any, major: int) -> dict[str, Any]:
 class FMUState:
     """The run state of an FMU block: a handle to one FMU instance (external and mutable).
 
+    ``instance`` is taken from the block's pool when the run first needs it (its first
+    ``output`` or ``update``), so creating the state runs none of the FMU's code.
     ``time`` is the FMU's current communication point (None before initialisation) and
     ``outputs`` the FMU outputs there. ``close()`` gives the instance back to the block
     early; otherwise that happens when the state is garbage collected.
@@ -776,20 +813,30 @@ class FMUState:
     __slots__ = ("instance", "model", "time", "outputs", "_release", "__weakref__")
 
     def __init__(self, model: _Model):
-        self.instance = model.acquire()
+        if model.closed:
+            raise BlockError(f"{model.shown}: the FMU block was closed")
+        self.instance: _Instance | None = None
         self.model = model
         self.time: float | None = None
         self.outputs: dict[str, Signal] | None = None
-        self._release = weakref.finalize(self, model.release, self.instance)
+        self._release: weakref.finalize | None = None
+
+    def acquire(self) -> _Instance:
+        """The run's instance, taken from the pool (loading the FMU) on first use."""
+        if self.instance is None:
+            self.instance = self.model.acquire()
+            self._release = weakref.finalize(self, self.model.release, self.instance)
+        return self.instance
 
     def close(self) -> None:
-        self._release()
+        if self._release is not None:
+            self._release()
 
     def __deepcopy__(self, memo):
         raise TypeError("the state of an FMU block is a live FMU instance and cannot be copied")
 
     def __repr__(self) -> str:
-        return f"FMUState({self.instance.model.shown}, t={self.time})"
+        return f"FMUState({self.model.shown}, t={self.time})"
 
 
 class FMU(Block):
@@ -812,12 +859,12 @@ class FMU(Block):
         if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
             raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
         file = Path(path).expanduser()
-        resolved = file if file.is_absolute() else Path.cwd() / file
+        resolved = (file if file.is_absolute() else Path.cwd() / file).absolute()
         shown = f"FMU '{path}'"
         if not resolved.exists():
-            where = "" if file.is_absolute() else \
-                f" (relative paths are resolved against the current directory, {Path.cwd()})"
-            raise ValueError(f"FMU file not found: {resolved}{where}")
+            raise ValueError(f"FMU file not found: looked at {resolved} (in a diagram, a relative path "
+                             "is resolved against the diagram's folder; from Python, against the "
+                             "current directory)")
         if resolved.is_dir():
             raise ValueError(f"{shown} is a folder; give the path of the .fmu file")
         if not zipfile.is_zipfile(resolved):
@@ -841,12 +888,6 @@ class FMU(Block):
         self.input_defaults = model.input_starts(self._assignments)
         self.feedthrough = False
         self._step = 0.0
-        # Load the binary and instantiate once now, so that a broken binary is a load-time
-        # error; the instance waits in the pool for the first run.
-        try:
-            model.release(model.acquire())
-        except BlockError as exc:
-            raise ValueError(str(exc)) from None
 
     @property
     def fmi_version(self) -> str:
@@ -889,12 +930,24 @@ class FMU(Block):
 
     def bind(self, period: Fraction | None) -> None:
         """The period is the communication step; without one, the FMU's default step
-        (DefaultExperiment stepSize) is used, and the diagram schedules the block at it."""
+        (DefaultExperiment stepSize) is used, and the diagram schedules the block at it.
+        An FMU with a fixed internal step needs a whole multiple of it."""
+        given = period is not None
         if period is None:
             period = self._model.default_step
             if period is None:
                 raise ValueError("an FMU block needs a period, its communication step size (the FMU "
                                  "declares no default step size: add e.g. 'period: 1 ms')")
+        fixed = self._model.fixed_step
+        if fixed is not None:
+            count = period / fixed
+            if count < 1 or abs(count - round(count)) > STEP_TOLERANCE:
+                which = "period" if given else "default step (DefaultExperiment stepSize)"
+                near = max(1, round(count)) * fixed
+                raise ValueError(f"the {which} {format_duration(period)} is not a whole multiple of the "
+                                 f"fixed internal step {format_duration(fixed)} of {self._model.shown}, "
+                                 f"so the FMU would refuse every step; use a multiple of it, e.g. "
+                                 f"'period: {format_duration(near)}'")
         super().bind(period)
         self._step = float(period)
 
@@ -905,15 +958,18 @@ class FMU(Block):
         return FMUState(self._model)
 
     def _start(self, t: float, state: FMUState) -> None:
-        inst = state.instance
+        """The run's first call: take an instance (loading the FMU) and initialise it at ``t``."""
+        inst = state.acquire()
         try:
             inst.start(t, self._assignments, self.tolerance)
             state.time = t
             state.outputs = inst.read()
         except Exception as exc:
             inst.broken = True
+            fmu_interrupt.check()  # a failure that comes with Ctrl-C is the interrupt
             raise BlockError(f"{self._model.shown}: initialising the FMU at t={t:.9g} s failed: "
                              f"{_reason(exc)}{inst.log_text()}") from None
+        fmu_interrupt.check()
 
     def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         if state.time is None:
@@ -931,10 +987,10 @@ class FMU(Block):
             raise BlockError(f"{self._model.shown}: asked to step from t={t:.9g} s, but the FMU is at "
                              f"t={state.time:.9g} s (the block must fire every period)")
         try:
-            if inst.model.major == 2:
-                _fmi2_arm()
+            _arm(inst.model.major)
             inst.write(inputs)
             terminate, early, last = inst.do_step(t, h)
+            fmu_interrupt.check()
             if terminate or early:
                 inst.broken = True
                 what = "requested to terminate the simulation" if terminate else f"returned early at t={last:.9g} s"
@@ -946,6 +1002,7 @@ class FMU(Block):
             raise
         except Exception as exc:
             inst.broken = True
+            fmu_interrupt.check()  # a failure that comes with Ctrl-C is the interrupt
             raise BlockError(f"{self._model.shown}: {_reason(exc, t, h)}{inst.log_text()}") from None
         return state
 

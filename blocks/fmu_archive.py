@@ -1,20 +1,25 @@
-"""Safe extraction of FMU archives (zip files from other tools, so treated as untrusted).
+"""Safe reading and extraction of FMU archives (zip files from other tools, so untrusted).
 
-``zipfile.ZipFile.extractall`` trusts the member names; this extractor does not. Before
-writing anything it checks the whole member list and refuses the archive, naming the
-member, when it finds:
+``zipfile.ZipFile.extractall`` trusts the member names; this module does not. Before
+reading or writing anything it checks the whole member list and refuses the archive,
+naming the member, when it finds:
 
 - an absolute name (``/etc/x``, ``\\\\server\\x``, ``C:x``) or a ``..`` component;
 - a symbolic link or another special file (device, fifo, socket), or an encrypted member;
 - a name that is empty, holds a NUL or control character, or occurs twice (one member
   could otherwise overwrite another, or a file collide with a folder);
-- more members than ``max_members``, a member larger than ``max_member_bytes``, or more
-  than ``max_total_bytes`` in all (decompression bombs).
+- decompression bombs: a member list (central directory) larger than 1 KiB per allowed
+  member (checked before zipfile reads it), more than ``MAX_MEMBERS`` members, a member
+  larger than ``MAX_MEMBER_BYTES``, more than ``MAX_TOTAL_BYTES`` in all, or a member of
+  more than ``RATIO_FLOOR_BYTES`` that inflates more than ``MAX_RATIO`` times.
 
-Sizes are checked against the headers first and again while decompressing (a member
-that inflates beyond its declared size is cut off). Files are created exclusively
-(``O_EXCL``), without the archive's permission bits, inside a fresh destination folder,
-and every resolved path is checked to lie inside it.
+The sizes are checked against the headers first and again on the bytes actually
+decompressed, with a running count per member and in total (a member that inflates
+beyond its declared size is cut off), so forged headers do not get more through.
+Files are created exclusively (``O_EXCL``), without the archive's permission bits,
+inside a fresh destination folder, and every resolved path is checked to lie inside it.
+``read_member`` reads one member (an FMU's modelDescription.xml) into memory without
+writing anything to disk.
 """
 
 from __future__ import annotations
@@ -23,18 +28,42 @@ import os
 import shutil
 import stat
 import zipfile
+from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 MAX_MEMBERS = 10_000
-"""Default limit on the number of members (files and folders) of an archive."""
+"""Limit on the number of members (files and folders) of an archive."""
 
-MAX_MEMBER_BYTES = 1 << 30
-"""Default limit on the uncompressed size of one member (1 GiB)."""
+MAX_MEMBER_BYTES = 256 << 20
+"""Limit on the uncompressed size of one member (256 MiB): far above any FMU's binary."""
 
-MAX_TOTAL_BYTES = 4 << 30
-"""Default limit on the uncompressed size of all members together (4 GiB)."""
+MAX_TOTAL_BYTES = 256 << 20
+"""Limit on the uncompressed size of all members together (256 MiB)."""
 
+MAX_RATIO = 200
+"""Limit on how many times a large member may inflate (uncompressed / compressed size):
+binaries and XML compress 3 to 20 times, a decompression bomb about 1000 times."""
+
+RATIO_FLOOR_BYTES = 1 << 20
+"""Members up to this size (1 MiB) may inflate more than ``MAX_RATIO`` (a small file of
+repeated text), since they cannot do harm."""
+
+_CD_BYTES_PER_MEMBER = 1024
 _CHUNK = 1 << 20
+
+
+@dataclass(frozen=True)
+class Limits:
+    """The limits an archive must keep (the module's constants unless a caller tightens them)."""
+
+    members: int = MAX_MEMBERS
+    member_bytes: int = MAX_MEMBER_BYTES
+    total_bytes: int = MAX_TOTAL_BYTES
+    ratio: float = MAX_RATIO
+    ratio_floor: int = RATIO_FLOOR_BYTES
+
+
+LIMITS = Limits()
 
 
 class ArchiveError(ValueError):
@@ -69,14 +98,45 @@ def _file_type(info: zipfile.ZipInfo) -> int:
     return stat.S_IFMT(info.external_attr >> 16)
 
 
-def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>", *,
-                  max_members: int = MAX_MEMBERS, max_member_bytes: int = MAX_MEMBER_BYTES,
-                  max_total_bytes: int = MAX_TOTAL_BYTES) -> list[tuple[zipfile.ZipInfo, list[str]]]:
+def _central_directory_size(fp) -> int | None:
+    """The size the end record declares for the member list (zip64 too), or None if there
+    is no readable end record (zipfile then says what is wrong)."""
+    fp.seek(0, os.SEEK_END)
+    size = fp.tell()
+    fp.seek(max(0, size - (22 + 0xFFFF)))
+    tail = fp.read()
+    at = tail.rfind(b"PK\x05\x06")
+    if at < 0 or len(tail) - at < 22:
+        return None
+    cd_size = int.from_bytes(tail[at + 12:at + 16], "little")
+    locator = tail[at - 20:at] if at >= 20 else b""
+    if cd_size != 0xFFFFFFFF or not locator.startswith(b"PK\x06\x07"):
+        return cd_size
+    fp.seek(int.from_bytes(locator[8:16], "little"))
+    record = fp.read(48)
+    if not record.startswith(b"PK\x06\x06") or len(record) < 48:
+        return None
+    return int.from_bytes(record[40:48], "little")
+
+
+def open_archive(archive: str | os.PathLike, limits: Limits = LIMITS) -> zipfile.ZipFile:
+    """``zipfile.ZipFile(archive)``, after checking that its member list is not too large
+    to read (zipfile reads all of it into memory first)."""
+    with open(archive, "rb") as fp:
+        cd_size = _central_directory_size(fp)
+    if cd_size is not None and cd_size > limits.members * _CD_BYTES_PER_MEMBER:
+        raise ArchiveError(f"{_describe(archive)}: its member list takes {cd_size} bytes, more than "
+                           f"{limits.members} members can need (the limit is {limits.members} members)")
+    return zipfile.ZipFile(archive)
+
+
+def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",
+                  limits: Limits = LIMITS) -> list[tuple[zipfile.ZipInfo, list[str]]]:
     """Validate every member of ``zf``; return ``(info, path parts)`` pairs, or raise ArchiveError."""
     where = _describe(archive)
     infos = zf.infolist()
-    if len(infos) > max_members:
-        raise ArchiveError(f"{where} has {len(infos)} members, more than the limit of {max_members}")
+    if len(infos) > limits.members:
+        raise ArchiveError(f"{where} has {len(infos)} members, more than the limit of {limits.members}")
     total = 0
     seen: dict[str, str] = {}
     prefixes: set[str] = set()
@@ -96,21 +156,15 @@ def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",
                                "not a regular file or folder")
         if info.flag_bits & 0x1:
             raise ArchiveError(f"{where}: member {name!r} is encrypted")
-        if info.file_size > max_member_bytes:
-            raise ArchiveError(f"{where}: member {name!r} is {info.file_size} bytes uncompressed, more "
-                               f"than the limit of {max_member_bytes} bytes per member")
+        _check_size(info, info.file_size, total + info.file_size, where, limits)
         total += info.file_size
-        if total > max_total_bytes:
-            raise ArchiveError(f"{where}: the members add up to more than the limit of "
-                               f"{max_total_bytes} bytes uncompressed (at member {name!r})")
         key = "/".join(parts)
         if key in seen:
             raise ArchiveError(f"{where}: member {name!r} occurs twice (also as {seen[key]!r})")
         seen[key] = name
-        is_dir = info.is_dir() or kind == stat.S_IFDIR
         for i in range(1, len(parts)):
             prefixes.add("/".join(parts[:i]))
-        if not is_dir:
+        if not _is_dir(info):
             files.add(key)
         checked.append((info, parts))
     clash = files & prefixes
@@ -120,9 +174,54 @@ def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",
     return checked
 
 
-def extract_archive(archive: str | os.PathLike, dest: str | os.PathLike, *,
-                    max_members: int = MAX_MEMBERS, max_member_bytes: int = MAX_MEMBER_BYTES,
-                    max_total_bytes: int = MAX_TOTAL_BYTES) -> Path:
+def _is_dir(info: zipfile.ZipInfo) -> bool:
+    return info.is_dir() or _file_type(info) == stat.S_IFDIR
+
+
+def _check_size(info: zipfile.ZipInfo, size: int, total: int, where: str, limits: Limits) -> None:
+    """Raise ArchiveError if a member of ``size`` bytes (``total`` with the members before it)
+    breaks a limit: both for the sizes the headers declare and for the bytes read so far."""
+    name = info.filename
+    if size > limits.member_bytes:
+        raise ArchiveError(f"{where}: member {name!r} is {size} bytes uncompressed, more than the limit "
+                           f"of {limits.member_bytes} bytes per member")
+    if total > limits.total_bytes:
+        raise ArchiveError(f"{where}: the members add up to more than the limit of {limits.total_bytes} "
+                           f"bytes uncompressed (at member {name!r})")
+    if size > limits.ratio_floor and size > limits.ratio * max(info.compress_size, 1):
+        raise ArchiveError(f"{where}: member {name!r} inflates from {info.compress_size} to {size} bytes "
+                           f"or more, more than {limits.ratio:g} times (a decompression bomb?)")
+
+
+def _chunks(zf: zipfile.ZipFile, info: zipfile.ZipInfo, before: int, where: str, limits: Limits):
+    """The decompressed data of a member in chunks, counted as it comes: ArchiveError as
+    soon as it outgrows its declared size or a limit (``before``: bytes of earlier members)."""
+    done = 0
+    with zf.open(info) as src:
+        while chunk := src.read(_CHUNK):
+            done += len(chunk)
+            if done > info.file_size:
+                raise ArchiveError(f"{where}: member {info.filename!r} inflates beyond its declared "
+                                   f"size of {info.file_size} bytes")
+            _check_size(info, done, before + done, where, limits)
+            yield chunk
+
+
+def read_member(archive: str | os.PathLike, member: str,
+                limits: Limits = LIMITS) -> tuple[bytes | None, list[str]]:
+    """The data of the file ``member`` of ``archive`` (None if it has none) and the names of
+    all its files (``/``-separated), read without writing anything. Every member is checked
+    as for extraction first; raises ``ArchiveError`` or ``zipfile.BadZipFile``."""
+    with open_archive(archive, limits) as zf:
+        checked = check_members(zf, archive, limits)
+        names = ["/".join(parts) for info, parts in checked if not _is_dir(info)]
+        for info, parts in checked:
+            if "/".join(parts) == member and not _is_dir(info):
+                return b"".join(_chunks(zf, info, 0, _describe(archive), limits)), names
+    return None, names
+
+
+def extract_archive(archive: str | os.PathLike, dest: str | os.PathLike, limits: Limits = LIMITS) -> Path:
     """Extract the zip file ``archive`` into the existing, empty folder ``dest``.
 
     Raises ``ArchiveError`` (a ValueError) before writing anything when a member is
@@ -132,20 +231,20 @@ def extract_archive(archive: str | os.PathLike, dest: str | os.PathLike, *,
     dest = Path(dest)
     root = dest.resolve()
     where = _describe(archive)
-    with zipfile.ZipFile(archive) as zf:
-        checked = check_members(zf, archive, max_members=max_members,
-                                max_member_bytes=max_member_bytes, max_total_bytes=max_total_bytes)
+    with open_archive(archive, limits) as zf:
+        checked = check_members(zf, archive, limits)
+        total = 0
         try:
             for info, parts in checked:
                 target = root.joinpath(*parts)
                 if not target.resolve().is_relative_to(root):  # defence in depth
                     raise ArchiveError(f"{where}: member {info.filename!r} would be written outside "
                                        "the extraction folder")
-                if info.is_dir() or _file_type(info) == stat.S_IFDIR:
+                if _is_dir(info):
                     target.mkdir(parents=True, exist_ok=True)
                     continue
                 target.parent.mkdir(parents=True, exist_ok=True)
-                _copy_member(zf, info, target, min(info.file_size, max_member_bytes), where)
+                total += _copy_member(zf, info, target, total, where, limits)
         except BaseException:
             for child in root.iterdir():
                 if child.is_dir() and not child.is_symlink():
@@ -156,20 +255,17 @@ def extract_archive(archive: str | os.PathLike, dest: str | os.PathLike, *,
     return dest
 
 
-def _copy_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, target: Path, limit: int, where: str) -> None:
+def _copy_member(zf: zipfile.ZipFile, info: zipfile.ZipInfo, target: Path, before: int, where: str,
+                 limits: Limits) -> int:
+    """Write one member to ``target``; returns its size."""
     flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0) | getattr(os, "O_NOFOLLOW", 0)
     try:
         fd = os.open(target, flags, 0o644)
     except FileExistsError:  # e.g. names differing only in case on a case-insensitive file system
         raise ArchiveError(f"{where}: member {info.filename!r} collides with another member") from None
     written = 0
-    with os.fdopen(fd, "wb") as out, zf.open(info) as src:
-        while True:
-            chunk = src.read(_CHUNK)
-            if not chunk:
-                break
-            written += len(chunk)
-            if written > limit:
-                raise ArchiveError(f"{where}: member {info.filename!r} inflates beyond its declared "
-                                   f"size of {info.file_size} bytes")
+    with os.fdopen(fd, "wb") as out:
+        for chunk in _chunks(zf, info, before, where, limits):
             out.write(chunk)
+            written += len(chunk)
+    return written

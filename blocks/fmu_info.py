@@ -1,39 +1,101 @@
-"""``hierhand fmu info``: what an FMU declares, read safely without loading its binary."""
+"""What an FMU declares, read safely and without running any of its code.
+
+``read_description`` reads only the archive's member list and its ``modelDescription.xml``
+(into memory, through ``fmu_archive.read_member``, with the archive limits): nothing is
+extracted to disk and no binary is loaded. The FMU block reads its FMU this way when a
+diagram is loaded (``hierhand validate`` and ``graph`` never run an FMU's code) and
+extracts and loads the binary only when a run starts; ``hierhand fmu info`` prints
+``describe_fmu``.
+"""
 
 from __future__ import annotations
 
-import tempfile
+import io
 import zipfile
+from dataclasses import dataclass
+from fractions import Fraction
 from pathlib import Path
+from typing import Any
+from xml.etree import ElementTree
 
-from .fmu_archive import ArchiveError, extract_archive
+from .fmu_archive import ArchiveError, read_member
+
+MODEL_DESCRIPTION = "modelDescription.xml"
 
 
-class FMUInfoError(Exception):
-    """An FMU that cannot be read."""
+class FMUInfoError(ValueError):
+    """An FMU that cannot be read; the message names it."""
+
+
+@dataclass
+class FMUDescription:
+    """An FMU's modelDescription (fmpy's ``ModelDescription``), its XML text and the
+    names of the files in its archive (``/``-separated)."""
+
+    md: Any
+    xml: bytes
+    files: list[str]
+
+    def platforms(self) -> list[str]:
+        """The platform folders under ``binaries/`` that hold files."""
+        return sorted({f.split("/")[1] for f in self.files if f.startswith("binaries/") and f.count("/") >= 2})
+
+    def fixed_step(self) -> Fraction | None:
+        """The FMU's fixed internal step, if it declares one: FMI 3 ``fixedInternalStepSize``
+        of ``<CoSimulation>``; FMI 2 has no such attribute, so there the same attribute is
+        read from a ``<CoSimulation>`` element in any tool's ``<VendorAnnotations>``."""
+        cs = self.md.coSimulation
+        value = getattr(cs, "fixedInternalStepSize", None) if cs is not None else None
+        if value is None and self.md.fmiVersion == "2.0":
+            try:
+                root = ElementTree.fromstring(self.xml)
+            except ElementTree.ParseError:
+                return None
+            for element in root.iterfind("VendorAnnotations/Tool/CoSimulation"):
+                value = element.get("fixedInternalStepSize") or value
+        try:
+            step = Fraction(str(value).strip()) if value is not None else None
+        except (ValueError, ZeroDivisionError):
+            return None
+        return step if step is not None and step > 0 else None
+
+
+def read_description(path: str | Path, shown: str, validate: bool = True) -> FMUDescription:
+    """The modelDescription of the FMU archive ``path`` (``shown`` names it in messages),
+    checked against the FMI schema if ``validate``; FMUInfoError if it cannot be read."""
+    from fmpy.model_description import read_model_description
+
+    try:
+        xml, files = read_member(path, MODEL_DESCRIPTION)
+    except ArchiveError as exc:
+        raise FMUInfoError(f"unsafe FMU archive, not extracted: {exc}") from None
+    except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, NotImplementedError) as exc:
+        raise FMUInfoError(f"{shown} is not an FMU: not a readable zip archive ({exc})") from None
+    except OSError as exc:
+        raise FMUInfoError(f"{shown} cannot be read: {exc.strerror or exc}") from None
+    if xml is None:
+        raise FMUInfoError(f"{shown} is not an FMU: the archive has no {MODEL_DESCRIPTION}")
+    alone = io.BytesIO()
+    with zipfile.ZipFile(alone, "w") as zf:  # fmpy reads the description from a zip file
+        zf.writestr(MODEL_DESCRIPTION, xml)
+    alone.seek(0)
+    try:
+        md = read_model_description(alone, validate=validate)
+    except Exception as exc:
+        problems = getattr(exc, "problems", None)
+        text = "; ".join(str(p) for p in problems[:3]) + ("; ..." if len(problems) > 3 else "") \
+            if problems else (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+        raise FMUInfoError(f"{shown} has a broken {MODEL_DESCRIPTION}: {text}") from None
+    return FMUDescription(md, xml, files)
 
 
 def describe_fmu(path: str | Path) -> str:
     """Text listing an FMU's FMI version, interfaces, default experiment and variables."""
-    from fmpy.model_description import read_model_description
-
     path = Path(path)
     if not path.is_file():
         raise FMUInfoError(f"{path}: FMU file not found")
-    with tempfile.TemporaryDirectory(prefix="blocks-fmu-info-") as tmp:
-        try:
-            extract_archive(path, Path(tmp))
-        except ArchiveError as exc:
-            raise FMUInfoError(f"{path}: unsafe FMU archive, not extracted: {exc}") from None
-        except (zipfile.BadZipFile, EOFError, NotImplementedError) as exc:
-            raise FMUInfoError(f"{path}: not an FMU (not a readable zip archive: {exc})") from None
-        try:
-            md = read_model_description(tmp, validate=False)
-        except Exception as exc:
-            first = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
-            raise FMUInfoError(f"{path}: broken modelDescription.xml: {first}") from None
-        binaries = sorted(p.name for p in (Path(tmp) / "binaries").iterdir()) \
-            if (Path(tmp) / "binaries").is_dir() else []
+    description = read_description(path, f"FMU '{path}'", validate=False)
+    md = description.md
     lines = [f"{path}", f"  model: {md.modelName}  (FMI {md.fmiVersion}, generated by "
                         f"{md.generationTool or 'unknown tool'})"]
     if md.description:
@@ -43,7 +105,10 @@ def describe_fmu(path: str | Path) -> str:
                    ("scheduled execution", "scheduledExecution")) if getattr(md, attr, None) is not None]
     lines.append("  interfaces: " + (", ".join(f"{n} (model identifier {i.modelIdentifier})"
                                                for n, i in interfaces) or "none"))
-    lines.append(f"  platforms: {', '.join(binaries) or 'none (no binaries)'}")
+    lines.append(f"  platforms: {', '.join(description.platforms()) or 'none (no binaries)'}")
+    step = description.fixed_step()
+    if step is not None:
+        lines.append(f"  fixed internal step: {float(step):g} s (communication steps must be multiples)")
     de = md.defaultExperiment
     if de is not None:
         parts = [f"{k} {getattr(de, a)}" for k, a in (("start", "startTime"), ("stop", "stopTime"),

@@ -4,13 +4,23 @@ Diagram errors must say ``file:line``; PyYAML forgets positions once it builds P
 objects, so this module builds them itself from the node tree and keeps the line of
 each key and item beside the value. It also rejects duplicate keys, which PyYAML
 silently collapses.
+
+The text may be hostile, so reading and loading stop at the limits of ``blocks.limits``:
+a file's size and kind (``read_yaml_file``), the nesting depth (measured before libyaml
+composes, whose recursion would overflow the C stack) and the values aliases may repeat
+(the 'billion laughs'). Every refusal is a ``YamlSourceError`` with the line to look at.
 """
 
 from __future__ import annotations
 
-from typing import Any
+import os
+import stat
+from pathlib import Path
+from typing import Any, Sequence
 
 import yaml
+
+from .limits import MAX_ALIAS_VALUES, MAX_YAML_BYTES, MAX_YAML_DEPTH
 
 
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -19,15 +29,17 @@ _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
 _SEQ_TAG = "tag:yaml.org,2002:seq"
 _MAP_TAG = "tag:yaml.org,2002:map"
+_MERGE_TAG = "tag:yaml.org,2002:merge"
 
 
 class YamlSourceError(Exception):
     """A YAML text that cannot be read; ``line`` is 1-based, or None when unknown."""
 
-    def __init__(self, message: str, line: int | None):
+    def __init__(self, message: str, line: int | None, hint: str = ""):
         super().__init__(message)
         self.message = message
         self.line = line
+        self.hint = hint
 
 
 class LineDict(dict):
@@ -57,60 +69,199 @@ def line_of(container: Any, key: Any, default: int = 0) -> int:
     return getattr(container, "line", default) or default
 
 
-def load_yaml(text: str) -> Any:
-    """Parse one YAML document into LineDict/LineList/scalars; None for an empty text."""
-    loader = _Loader(text)
+def line_at(data: Any, path: Sequence[Any]) -> tuple[int | None, int]:
+    """Where a value inside ``data`` is written: the line of the deepest part of ``path``
+    (mapping keys and list indices, ``("fingers", 1, "links")``) that ``data`` holds, and
+    how many parts it holds (0: none, the line is that of ``data`` itself, if known)."""
+    line, found = getattr(data, "line", None) or None, 0
+    for part in path:
+        if isinstance(data, LineDict) and part in data:
+            line, data = data.line_of(part), data[part]
+        elif isinstance(data, LineList) and isinstance(part, int) and 0 <= part < len(data):
+            line, data = data.line_of(part), data[part]
+        else:
+            break
+        found += 1
+    return line, found
+
+
+def read_yaml_file(path: str | Path) -> str:
+    """The text of a diagram, params file or hand file: a regular file of at most
+    MAX_YAML_BYTES bytes of UTF-8 text without NUL bytes.
+
+    The size and kind are checked on the open file before anything is read (a device or
+    FIFO is refused unread; opening does not wait for a FIFO's writer). Raises
+    FileNotFoundError for a missing file, YamlSourceError for anything else, with the
+    line and column of the first bad byte where there is one.
+    """
     try:
-        node = loader.get_single_node()
-        if node is None:
-            return None
-        return _build(loader, node, set())
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except FileNotFoundError:
+        raise
+    except OSError as exc:
+        raise YamlSourceError(f"cannot open: {exc.strerror or exc}", None) from None
+    except ValueError:
+        raise YamlSourceError("cannot open: the path contains a NUL character", None) from None
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):
+        os.close(fd)
+        raise YamlSourceError("not a regular file (a folder, device or pipe)", None, "name a YAML file")
+    with os.fdopen(fd, "rb") as fh:
+        raw = fh.read(MAX_YAML_BYTES + 1) if info.st_size <= MAX_YAML_BYTES else b""
+        if info.st_size > MAX_YAML_BYTES or len(raw) > MAX_YAML_BYTES:
+            raise YamlSourceError(f"file larger than {MAX_YAML_BYTES} bytes", None,
+                                  "the limit guards against hostile files; keep large data out of YAML")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line_start = raw.rfind(b"\n", 0, exc.start) + 1
+        column = len(raw[line_start:exc.start].decode("utf-8")) + 1
+        raise YamlSourceError(f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at column {column}",
+                              raw.count(b"\n", 0, exc.start) + 1,
+                              "save the file as UTF-8; a binary file is not YAML") from None
+    if "\x00" in text:
+        line, column = _position(text, text.index("\x00"))
+        raise YamlSourceError(f"NUL byte at column {column}: a binary file, not YAML text", line,
+                              "save the file as UTF-8 text")
+    return text
+
+
+def load_yaml(text: str) -> Any:
+    """Parse one YAML document into LineDict/LineList/scalars; None for an empty text.
+
+    Refuses (YamlSourceError) nesting deeper than MAX_YAML_DEPTH and aliases or merge keys
+    that repeat more than MAX_ALIAS_VALUES values.
+    """
+    try:
+        _check_depth(text)
+        loader = _Loader(text)
+        try:
+            node = loader.get_single_node()
+            return None if node is None else _Builder(loader).build(node, 1, node.start_mark.line + 1)
+        finally:
+            loader.dispose()
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         problem = exc.problem or exc.context or "invalid YAML"
-        raise YamlSourceError(f"YAML syntax error: {problem}", mark.line + 1 if mark else None) from None
+        raise YamlSourceError(f"YAML syntax error: {problem}", mark.line + 1 if mark else None,
+                              "check indentation, colons and brackets near that line") from None
+    except yaml.reader.ReaderError as exc:
+        line, column = _position(text, text.find(chr(exc.character)))
+        raise YamlSourceError(f"character U+{exc.character:04X} at column {column} is not allowed in YAML",
+                              line, "remove it; YAML text has no control characters") from None
     except yaml.YAMLError as exc:
-        raise YamlSourceError(f"YAML error: {exc}", None) from None
-    except RecursionError:
-        raise YamlSourceError("YAML nesting too deep", None) from None
-    finally:
-        loader.dispose()
+        raise YamlSourceError(f"YAML error: {' '.join(str(exc).split())}", None) from None
 
 
-def _build(loader: yaml.SafeLoader, node: yaml.Node, active: set[int]) -> Any:
-    line = node.start_mark.line + 1
-    if isinstance(node, yaml.ScalarNode):
-        return loader.construct_object(node, deep=True)
-    if id(node) in active:
-        raise YamlSourceError("recursive YAML alias", line)
-    active.add(id(node))
-    try:
+def _position(text: str, index: int) -> tuple[int, int]:
+    """1-based (line, column) of ``text[index]``."""
+    return text.count("\n", 0, index) + 1, index - (text.rfind("\n", 0, index) + 1) + 1
+
+
+def _check_depth(text: str) -> None:
+    """Refuse nesting deeper than MAX_YAML_DEPTH, from the parser's events (no recursion),
+    stopping at the first level too deep."""
+    depth = 0
+    for event in yaml.parse(text, Loader=_Loader):
+        if isinstance(event, yaml.CollectionStartEvent):
+            depth += 1
+            if depth > MAX_YAML_DEPTH:
+                raise YamlSourceError(f"YAML lists and mappings nested deeper than {MAX_YAML_DEPTH} levels",
+                                      event.start_mark.line + 1, "a diagram needs about 8 levels")
+        elif isinstance(event, yaml.CollectionEndEvent):
+            depth -= 1
+
+
+class _Builder:
+    """Builds LineDict/LineList/scalars from a composed node tree.
+
+    An alias is the very node of its anchor, so a node met a second time is a repetition:
+    those are counted against MAX_ALIAS_VALUES, and the nesting they add against
+    MAX_YAML_DEPTH. ``site`` is the line where the value being built is written (for a
+    repetition, where the alias that repeats it is).
+    """
+
+    def __init__(self, loader: yaml.SafeLoader):
+        self.loader = loader
+        self.active: set[int] = set()
+        self.seen: set[int] = set()
+        self.repeated = 0
+
+    def build(self, node: yaml.Node, depth: int, site: int) -> Any:
+        line = node.start_mark.line + 1
+        fresh = id(node) not in self.seen
+        if not fresh:
+            self.repeated += 1
+            if self.repeated > MAX_ALIAS_VALUES:
+                raise YamlSourceError(f"YAML aliases repeat more than {MAX_ALIAS_VALUES} values", site,
+                                      "an alias (*name) copies its anchor's whole value; nested aliases "
+                                      "multiply: write the values out or use fewer levels of aliases")
+        else:
+            self.seen.add(id(node))
+            site = line
+        if isinstance(node, yaml.ScalarNode):
+            return self.loader.construct_object(node, deep=True)
+        if depth > MAX_YAML_DEPTH:
+            raise YamlSourceError(f"YAML lists and mappings nested deeper than {MAX_YAML_DEPTH} levels "
+                                  "through aliases", site, "a diagram needs about 8 levels")
+        if id(node) in self.active:
+            raise YamlSourceError("recursive YAML alias", line)
         if node.tag not in (_SEQ_TAG, _MAP_TAG):
             raise YamlSourceError(f"unsupported YAML tag {node.tag!r}", line)
-        if isinstance(node, yaml.SequenceNode):
-            out = LineList(_build(loader, item, active) for item in node.value)
-            out.line = line
-            out.item_lines = [item.start_mark.line + 1 for item in node.value]
+        self.active.add(id(node))
+        try:
+            if isinstance(node, yaml.SequenceNode):
+                out = LineList(self.build(item, depth + 1, site) for item in node.value)
+                out.line = line
+                out.item_lines = [item.start_mark.line + 1 for item in node.value]
+                return out
+            return self.mapping(node, depth, site, fresh)
+        finally:
+            self.active.discard(id(node))
+
+    def mapping(self, node: yaml.MappingNode, depth: int, site: int, fresh: bool) -> "LineDict":
+        """A mapping; merge keys (``<<: *base`` or ``<<: [*a, *b]``) give the keys it does not
+        write itself, an earlier merged mapping winning over a later one. A merged mapping
+        counts as a level of nesting, as it is built inside this one (so a chain of merges
+        stays within the recursion limit). In a mapping met for the first time a value is
+        written at its key's line, in a repetition at ``site``."""
+        merged: dict[Any, tuple[Any, int]] = {}
+        out = LineDict()
+        out.line = node.start_mark.line + 1
+        out.key_lines = {}
+        for key_node, value_node in node.value:
+            key_line = key_node.start_mark.line + 1
+            if key_node.tag == _MERGE_TAG:
+                for source in self.merge_sources(value_node, key_line):
+                    built = self.build(source, depth + 1, key_line if fresh else site)
+                    for key, value in built.items():
+                        merged.setdefault(key, (value, built.line_of(key)))
+                continue
+            key = self.build(key_node, depth + 1, site)
+            try:
+                hash(key)
+            except TypeError:
+                raise YamlSourceError("a mapping key must be a plain value, not a list or mapping",
+                                      key_line) from None
+            if key in out:
+                raise YamlSourceError(f"duplicate key {key!r} (first at line {out.key_lines[key]})", key_line)
+            out[key] = self.build(value_node, depth + 1, key_line if fresh else site)
+            out.key_lines[key] = key_line
+        if not merged:
             return out
-        if isinstance(node, yaml.MappingNode):
-            loader.flatten_mapping(node)
-            out = LineDict()
-            out.line = line
-            out.key_lines = {}
-            for key_node, value_node in node.value:
-                key_line = key_node.start_mark.line + 1
-                key = _build(loader, key_node, active)
-                try:
-                    hash(key)
-                except TypeError:
-                    raise YamlSourceError("a mapping key must be a plain value, not a list or mapping",
-                                          key_line) from None
-                if key in out:
-                    raise YamlSourceError(
-                        f"duplicate key {key!r} (first at line {out.key_lines[key]})", key_line)
-                out[key] = _build(loader, value_node, active)
-                out.key_lines[key] = key_line
-            return out
-    finally:
-        active.discard(id(node))
-    raise YamlSourceError(f"unsupported YAML node {node.tag}", line)
+        full = LineDict()
+        full.line = out.line
+        full.key_lines = {}
+        for key, (value, line) in merged.items():
+            if key not in out:
+                full[key], full.key_lines[key] = value, line
+        full.update(out)
+        full.key_lines.update(out.key_lines)
+        return full
+
+    @staticmethod
+    def merge_sources(node: yaml.Node, line: int) -> list[yaml.MappingNode]:
+        sources = node.value if isinstance(node, yaml.SequenceNode) else [node]
+        if not all(isinstance(s, yaml.MappingNode) for s in sources):
+            raise YamlSourceError("a merge key '<<' takes a mapping or a list of mappings", line)
+        return sources

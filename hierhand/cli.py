@@ -55,7 +55,8 @@ def build_parser() -> argparse.ArgumentParser:
     run = sub.add_parser("run", help="simulate a diagram and write its results",
                          description="Simulate DIAGRAM and write signals.npz and run.json to the output folder.")
     _diagram_args(run)
-    run.add_argument("-o", "--output", type=Path, help="results folder (default: runs/<diagram name>)")
+    run.add_argument("-o", "--output", type=Path,
+                     help="results folder (default: runs/<diagram name>, the name made one safe folder name)")
     run.add_argument("--csv", action="store_true", help="also write signals.csv")
     run.add_argument("--plot", action="store_true", help="also plot the logged signals to <output>/plots/")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary line")
@@ -263,12 +264,13 @@ def cmd_run(args: argparse.Namespace) -> int:
     (``stop_signals``); after an interrupt the plots are skipped, to stop soon."""
     from blocks import DiagramError, simulate
     from blocks.results_folder import OutputFolderError
+    from blocks.safepath import folder_name
     from hierhand.run_output import check_output, remove_if_empty, save_run
     from hierhand.stop_signals import StopSignals, exit_code
 
     diagram = load(args)
     t_end = end_time(args, diagram)
-    out = args.output or Path("runs") / diagram.name
+    out = args.output or Path("runs") / folder_name(diagram.name)
     try:
         created = check_output(out)
     except OutputFolderError as exc:
@@ -417,10 +419,12 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
-    from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, ReproduceError, reproduce
+    from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, MissingDiagram, ReproduceError, reproduce
 
     try:
         summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS, report=print)
+    except MissingDiagram as exc:
+        raise UsageError(str(exc)) from None
     except ReproduceError as exc:
         print(f"hierhand: {exc}", file=sys.stderr)
         return EXIT_FAILED
@@ -435,15 +439,16 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 
 def cmd_fmu_export(args: argparse.Namespace) -> int:
+    from blocks import DiagramError
     from hierhand.fmu_export import FmuExportError, export_plant_fmu
     from hierhand.model import HandFileError
 
-    if args.hand is not None and not args.hand.is_file():
+    if args.hand is not None and not args.hand.exists():
         raise UsageError(f"--hand {args.hand}: hand file not found")
     try:
         path = export_plant_fmu(args.output, fmi=args.fmi, hand=args.hand)
     except HandFileError as exc:
-        raise UsageError("; ".join(f"{exc.source or '--hand'}: {e}" for e in exc.errors)) from None
+        raise DiagramError(exc.issues()) from None
     except (FmuExportError, OSError) as exc:
         raise UsageError(f"fmu export: {exc}") from None
     print(f"wrote {path}")
@@ -467,7 +472,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from hierhand.sweep import SweepError
     from hierhand.sweep.metrics import parse_metrics
     from hierhand.sweep.plan import execute, prepare, stored_count
-    from hierhand.sweep.points import (combine, csv_points, grid_points, parse_grid, parse_random,
+    from hierhand.sweep.points import (combine, csv_points, grid_points, origins, parse_grid, parse_random,
                                        random_points)
 
     try:
@@ -491,7 +496,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                 axes.update(samples=args.samples, seed=args.seed)
         if args.t_end is not None:
             end_time(args, load_diagram(args.diagram, trust=args.trust))
-        plan = prepare(args.diagram, points, metrics, t_end=args.t_end, trust=args.trust, axes=axes)
+        plan = prepare(args.diagram, points, metrics, t_end=args.t_end, trust=args.trust, axes=axes,
+                       origins=origins(args.grid, args.random, args.points, points))
         t0 = time.perf_counter()
         try:
             report, skipped, failed = execute(plan, args.output, workers=args.workers, scheduler=args.scheduler,

@@ -15,7 +15,9 @@ build it for another platform.
   from ``hand``; the FMU reads them from ``resources/hand_parameters.txt`` when
   instantiated, so one compiled library serves every exported hand.
 - The plant steps at ``INTERNAL_STEP`` inside; a communication step that is not a whole
-  multiple of it is refused with an error status and a logged message.
+  multiple of it is refused with an error status and a logged message. The step is declared
+  as ``fixedInternalStepSize`` (FMI 3: of ``<CoSimulation>``; FMI 2, which lacks it: in a
+  ``<VendorAnnotations>`` tool entry), so the FMU block refuses such a period at load time.
 
 The model identifier is ``HandPlant_<hash>`` over the hand, the FMI version, the binary
 and the sources, so FMUs of different hands load side by side in one process.
@@ -244,11 +246,14 @@ def model_description(fmi: int, identifier: str, token: str, hand) -> bytes:
         ET.SubElement(root, "CoSimulation", modelIdentifier=identifier,
                       canHandleVariableCommunicationStepSize="true", canGetAndSetFMUState="true",
                       canSerializeFMUState="true", hasEventMode="false", providesIntermediateUpdate="false",
-                      fixedInternalStep=repr(float(INTERNAL_STEP)))
+                      fixedInternalStepSize=repr(float(INTERNAL_STEP)))
     categories = ET.SubElement(root, "LogCategories")
     for name, text in LOG_CATEGORIES.items():
         ET.SubElement(categories, "Category", name=name, description=text)
     ET.SubElement(root, "DefaultExperiment", startTime="0", stopTime="1", stepSize=repr(DEFAULT_COMMUNICATION_STEP))
+    if fmi == 2:  # FMI 2 has no fixedInternalStepSize: FMI 3's attribute as a vendor annotation
+        tool = ET.SubElement(ET.SubElement(root, "VendorAnnotations"), "Tool", name="hierhand")
+        ET.SubElement(tool, "CoSimulation", fixedInternalStepSize=repr(float(INTERNAL_STEP)))
     variables = ET.SubElement(root, "ModelVariables")
     if fmi == 3:
         ET.SubElement(variables, "Float64", name="time", valueReference=str(VR_TIME), causality="independent",

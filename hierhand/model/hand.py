@@ -17,7 +17,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from .. import _native
-from .handfile import HandParams, merge_with_default, parse_hand, read_hand_file
+from .handfile import HandFileError, HandParams, merge_with_default, parse_hand, read_hand_file
 from .layout import (
     E_COUNT,
     E_DX,
@@ -36,6 +36,7 @@ from .layout import (
 
 def load_hand(path_or_dict: str | Path | Mapping[str, Any]) -> "Hand":
     """A hand from a hand file (path) or its content (dict); missing sections default.
+    HandFileError for an invalid hand, with the line of each problem when read from a file.
 
     Hands built from equal contents are one shared object (the plant and both
     controllers of a diagram read the same hand); treat a Hand as read-only.
@@ -47,7 +48,11 @@ def load_hand(path_or_dict: str | Path | Mapping[str, Any]) -> "Hand":
             return Hand(parse_hand(merge_with_default(path_or_dict)))
         return _hand_from_json(key)
     source = str(path_or_dict)
-    return Hand(parse_hand(merge_with_default(read_hand_file(source)), source))
+    data = read_hand_file(source)
+    try:
+        return Hand(parse_hand(merge_with_default(data), source))
+    except HandFileError as exc:
+        raise exc.located(data) from None
 
 
 @functools.lru_cache(maxsize=64)

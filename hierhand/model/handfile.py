@@ -9,20 +9,27 @@ optional and default to the shipped hand (``default_hand.yaml`` beside this modu
 This module checks the file's shape (sections, keys, lists, numbers); what values a
 hand's numbers may take (positive masses, mu_d <= mu_s, ...) is judged by the C core
 (``hand_params.c``), the same check an exported FMU applies to its parameters.
+
+A hand file is read like a diagram (``blocks.yamlsource``: the same limits, and the line
+of every key), so each problem is reported at the line of the field it names; the
+diagram loader does the same for a plant's params file through ``ParameterError``.
 """
 
 from __future__ import annotations
 
 import copy
 import functools
-
 import math
+import re
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 import yaml
+
+from blocks import Issue, ParameterError
+from blocks.yamlsource import YamlSourceError, line_at, load_yaml, read_yaml_file
 
 from .. import _native
 from .hand_vector import hand_file_path, hand_vector, parameter_names
@@ -40,15 +47,43 @@ OBJECT_OPTIONAL = ("inertia",)
 CONTACT_KEYS = ("k_n", "c_n", "k_t", "c_t", "mu_s", "mu_d")
 
 
-class HandFileError(ValueError):
-    """A hand file (or the plant's parameters) is invalid; ``errors`` lists every problem."""
+class HandFileError(ParameterError):
+    """A hand file (or the plant's parameters) is invalid; ``errors`` lists every problem.
 
-    def __init__(self, errors: list[str], source: str | None = None):
+    ``fields`` names the hand-file field of each problem (``fingers[1].links[2].mass``,
+    "" for the hand as a whole), which the diagram loader turns into a line of the
+    diagram or params file (``problems``); ``lines`` holds those lines for a hand file
+    read from disk (``load_hand``), None where unknown.
+    """
+
+    def __init__(self, errors: list[str], source: str | None = None, fields: list[str] | None = None,
+                 lines: list[int | None] | None = None):
         self.errors = list(errors)
         self.source = source
+        self.fields = list(fields) if fields is not None else [""] * len(self.errors)
+        self.lines = list(lines) if lines is not None else [None] * len(self.errors)
         where = f" {source}" if source else ""
-        lines = "\n".join(f"  - {e}" for e in self.errors)
-        super().__init__(f"invalid hand file{where}:\n{lines}")
+        text = "\n".join(f"  - {e}" for e in self.errors)
+        super().__init__([(field_path(f), e) for f, e in zip(self.fields, self.errors)],
+                         f"invalid hand file{where}:\n{text}")
+
+    def located(self, data: Any) -> "HandFileError":
+        """This error with the line of each problem's field in ``data`` (a hand file as
+        ``read_hand_file`` returns it)."""
+        return HandFileError(self.errors, self.source, self.fields,
+                             [line_at(data, path)[0] for path, _ in self.problems])
+
+    def issues(self) -> list[Issue]:
+        """One ``file:line: problem`` per problem."""
+        return [Issue(self.source or "hand file", line, error) for error, line in zip(self.errors, self.lines)]
+
+
+_FIELD_PART = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
+
+
+def field_path(field: str) -> tuple:
+    """A hand-file field as keys and indices: ``fingers[1].links[2].mass`` -> ("fingers", 1, "links", 2, "mass")."""
+    return tuple(int(index) if index else key for key, index in _FIELD_PART.findall(field))
 
 
 @dataclass(frozen=True)
@@ -145,13 +180,18 @@ def default_hand_dict() -> dict[str, Any]:
 
 
 def read_hand_file(path: str | Path) -> dict[str, Any]:
-    """A hand file's raw content (YAML safe loading); it must be a mapping."""
-    with open(path, encoding="utf-8") as fh:
-        data = yaml.load(fh, Loader=_SafeLoader)
+    """A hand file's raw content, a mapping with the line of every key (see
+    ``blocks.yamlsource``); HandFileError at the line where it cannot be read as one."""
+    try:
+        data = load_yaml(read_yaml_file(path))
+    except YamlSourceError as exc:
+        hint = f" (hint: {exc.hint})" if exc.hint else ""
+        raise HandFileError([exc.message + hint], str(path), lines=[exc.line]) from None
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise HandFileError(["the file must be a mapping of sections " + ", ".join(SECTIONS)], str(path))
+        raise HandFileError(["the file must be a mapping of sections " + ", ".join(SECTIONS)], str(path),
+                            lines=[getattr(data, "line", 1)])
     return data
 
 
@@ -185,36 +225,34 @@ def parse_hand(data: Mapping[str, Any], source: str | None = None) -> HandParams
     check.unknown_keys(data, SECTIONS, "")
     for key in SECTIONS:
         if key not in data:
-            check.error(f"{key} is missing")
-    if check.errors:
-        raise HandFileError(check.errors, source)
+            check.error(key, "is missing")
+    check.raise_errors(source)
 
     gravity = check.vector(data["gravity"], "gravity", 2)
     fingers = _parse_fingers(check, data["fingers"])
     obj = _parse_object(check, data["object"])
     contact = _parse_contact(check, data["contact"])
-    if check.errors:
-        raise HandFileError(check.errors, source)
+    check.raise_errors(source)
     params = HandParams(gravity=gravity, fingers=fingers, object=obj, contact=contact)
     derived = set() if "inertia" in data["object"] else {"object.inertia"}  # follows mass and size
     names = parameter_names()
-    problems = [f"{hand_file_path(names[i])} {text}" for i, text in _native.check_hand(params.vector)
-                if names[i] not in derived]
-    if problems:
-        raise HandFileError(problems, source)
+    for i, text in _native.check_hand(params.vector):
+        if names[i] not in derived:
+            check.error(hand_file_path(names[i]), text)
+    check.raise_errors(source)
     return params
 
 
 def _parse_fingers(check: "_Checker", raw: Any) -> tuple[FingerParams, ...] | None:
     if not isinstance(raw, list) or len(raw) != N_FINGERS:
-        check.error(f"fingers must be a list of exactly {N_FINGERS} fingers (thumb, fore, middle)")
+        check.error("fingers", f"must be a list of exactly {N_FINGERS} fingers (thumb, fore, middle)")
         return None
     fingers = []
     names: set[str] = set()
     for i, f in enumerate(raw):
         path = f"fingers[{i}]"
         if not isinstance(f, Mapping):
-            check.error(f"{path} must be a mapping with keys " + ", ".join(FINGER_KEYS))
+            check.error(path, "must be a mapping with keys " + ", ".join(FINGER_KEYS))
             fingers.append(None)
             continue
         if not check.keys(f, FINGER_KEYS, path):
@@ -222,9 +260,9 @@ def _parse_fingers(check: "_Checker", raw: Any) -> tuple[FingerParams, ...] | No
             continue
         name = f["name"]
         if not isinstance(name, str) or not name.strip():
-            check.error(f"{path}.name must be a non-empty string")
+            check.error(f"{path}.name", "must be a non-empty string")
         elif name in names:
-            check.error(f"{path}.name '{name}' is used by another finger")
+            check.error(f"{path}.name", f"'{name}' is used by another finger")
         names.add(str(name))
         links = _parse_links(check, f["links"], f"{path}.links")
         fingers.append(
@@ -244,13 +282,13 @@ def _parse_fingers(check: "_Checker", raw: Any) -> tuple[FingerParams, ...] | No
 
 def _parse_links(check: "_Checker", raw: Any, path: str) -> tuple[LinkParams, ...] | None:
     if not isinstance(raw, list) or len(raw) != N_LINKS:
-        check.error(f"{path} must be a list of exactly {N_LINKS} links (proximal to distal)")
+        check.error(path, f"must be a list of exactly {N_LINKS} links (proximal to distal)")
         return None
     links = []
     for j, link in enumerate(raw):
         lpath = f"{path}[{j}]"
         if not isinstance(link, Mapping):
-            check.error(f"{lpath} must be a mapping with keys " + ", ".join(LINK_KEYS))
+            check.error(lpath, "must be a mapping with keys " + ", ".join(LINK_KEYS))
             continue
         if not check.keys(link, LINK_KEYS, lpath):
             continue
@@ -274,7 +312,7 @@ def _parse_links(check: "_Checker", raw: Any, path: str) -> tuple[LinkParams, ..
 
 def _parse_object(check: "_Checker", raw: Any) -> ObjectParams | None:
     if not isinstance(raw, Mapping):
-        check.error("object must be a mapping with keys " + ", ".join(OBJECT_KEYS))
+        check.error("object", "must be a mapping with keys " + ", ".join(OBJECT_KEYS))
         return None
     if not check.keys(raw, OBJECT_KEYS, "object", optional=OBJECT_OPTIONAL):
         return None
@@ -297,7 +335,7 @@ def _parse_object(check: "_Checker", raw: Any) -> ObjectParams | None:
 
 def _parse_contact(check: "_Checker", raw: Any) -> ContactParams | None:
     if not isinstance(raw, Mapping):
-        check.error("contact must be a mapping with keys " + ", ".join(CONTACT_KEYS))
+        check.error("contact", "must be a mapping with keys " + ", ".join(CONTACT_KEYS))
         return None
     if not check.keys(raw, CONTACT_KEYS, "contact"):
         return None
@@ -309,42 +347,49 @@ class _Checker:
 
     def __init__(self) -> None:
         self.errors: list[str] = []
+        self.fields: list[str] = []
 
-    def error(self, message: str) -> None:
-        self.errors.append(message)
+    def error(self, field: str, text: str) -> None:
+        """A problem of ``field`` (``object.mass``), reported as "object.mass <text>"."""
+        self.errors.append(f"{field} {text}")
+        self.fields.append(field)
+
+    def raise_errors(self, source: str | None) -> None:
+        if self.errors:
+            raise HandFileError(self.errors, source, self.fields)
 
     def unknown_keys(self, d: Mapping[str, Any], allowed: tuple[str, ...], path: str) -> None:
         for key in d:
             if key not in allowed:
                 where = f"{path}.{key}" if path else str(key)
-                self.error(f"{where} is not a known key (allowed: {', '.join(allowed)})")
+                self.error(where, f"is not a known key (allowed: {', '.join(allowed)})")
 
     def keys(self, d: Mapping[str, Any], allowed: tuple[str, ...], path: str, optional: tuple[str, ...] = ()) -> bool:
         """Check for unknown and missing keys; ``False`` if a required key is missing."""
         self.unknown_keys(d, allowed, path)
         missing = [k for k in allowed if k not in d and k not in optional]
         for k in missing:
-            self.error(f"{path}.{k} is missing")
+            self.error(f"{path}.{k}", "is missing")
         return not missing
 
     def number(self, value: Any, path: str) -> float:
         """A finite number (its allowed range is the C core's check)."""
         # PyYAML reads 1e-4 (no dot) as a string, so numeric strings are accepted too.
         if isinstance(value, bool) or not isinstance(value, (int, float, str)):
-            self.error(f"{path} must be a number, got {value!r}")
+            self.error(path, f"must be a number, got {value!r}")
             return 0.0
         try:
             x = float(value)
         except ValueError:
-            self.error(f"{path} must be a number, got {value!r}")
+            self.error(path, f"must be a number, got {value!r}")
             return 0.0
         if not math.isfinite(x):
-            self.error(f"{path} must be finite, got {value!r}")
+            self.error(path, f"must be finite, got {value!r}")
             return 0.0
         return x
 
     def vector(self, value: Any, path: str, n: int) -> tuple[float, ...]:
         if not isinstance(value, (list, tuple)) or len(value) != n:
-            self.error(f"{path} must be a list of {n} numbers, got {value!r}")
+            self.error(path, f"must be a list of {n} numbers, got {value!r}")
             return (0.0,) * n
         return tuple(self.number(v, f"{path}[{i}]") for i, v in enumerate(value))

@@ -47,11 +47,13 @@ class SweepPlan:
 
 
 def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_end: str | None = None,
-            trust: bool = False, axes: dict[str, Any] | None = None) -> SweepPlan:
+            trust: bool = False, axes: dict[str, Any] | None = None,
+            origins: dict[str, str] | None = None) -> SweepPlan:
     """Check the points' parameter names and the metrics against the diagram; hash the points.
 
     Raises the loader's DiagramError for an unknown block or parameter, SweepError for
-    anything else that cannot work.
+    anything else that cannot work. ``origins`` says how the user gave each parameter
+    (``points.origins``), for the loader's messages about it.
     """
     from blocks import DiagramError, load_diagram
 
@@ -65,13 +67,14 @@ def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_e
     base = load_diagram(diagram, trust=trust)
     checked = base
     try:
-        checked = load_diagram(diagram, overrides=points[0], trust=trust)
+        checked = load_diagram(diagram, overrides=points[0], trust=trust, origins=origins)
     except DiagramError as exc:
-        if any(str(i.file).startswith("--set ") for i in exc.issues):
+        if any(i.override for i in exc.issues):
             raise
     for metric in metrics:
         metric.check(checked)
-    job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust)
+    job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust,
+                   origins=tuple((origins or {}).items()))
     return SweepPlan(job=job, points=unique_points(points, base.source_hash, t_end), parameters=keys,
                      diagram_hash=base.source_hash, axes=axes or {})
 

@@ -158,6 +158,17 @@ def csv_points(path: Path) -> list[Point]:
     return points
 
 
+def origins(grid: Sequence[str], random: Sequence[str], points_file: Path | None,
+            points: Sequence[Point]) -> dict[str, str]:
+    """How the user gave each swept parameter, for the loader's messages about it (instead
+    of '--set'): the ``--grid`` or ``--random`` item as typed, or the points file's header
+    line and column that name it."""
+    if points_file is not None:
+        return {key: f"--points {points_file}:1: column '{key}'" for key in (points[0] if points else ())}
+    return {item.partition("=")[0].strip(): f"{option} {item}"
+            for option, items in (("--grid", grid), ("--random", random)) for item in items}
+
+
 def combine(grid: list[Point], sampled: list[Point]) -> list[Point]:
     """Every grid point with every random sample (either list may be empty)."""
     if not grid:

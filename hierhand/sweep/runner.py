@@ -27,12 +27,15 @@ WARM_UP_TIME = Fraction(1, 100)
 
 @dataclass(frozen=True)
 class SweepJob:
-    """What every point runs: the diagram file, the metrics, the end time, trust."""
+    """What every point runs: the diagram file, the metrics, the end time, trust, and how
+    the user gave each parameter (``points.origins``, as pairs) for the messages of a point
+    that fails to load."""
 
     diagram: str
     metrics: tuple[Metric, ...] = ()
     t_end: str | None = None
     trust: bool = False
+    origins: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass
@@ -68,7 +71,7 @@ def run_point(job: SweepJob, point: Point) -> Outcome:
 
     t0 = time.perf_counter()
     try:
-        diagram = load_diagram(job.diagram, overrides=point, trust=job.trust)
+        diagram = load_diagram(job.diagram, overrides=point, trust=job.trust, origins=dict(job.origins))
         results = simulate(diagram, t_end=job.t_end)
         if results.interrupted:
             raise KeyboardInterrupt  # the user's Ctrl-C stops the sweep; this point stays to be run

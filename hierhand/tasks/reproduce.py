@@ -28,13 +28,24 @@ class ReproduceError(Exception):
     """A task that could not be run or measured."""
 
 
-def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda s: None) -> dict[str, Results]:
-    runs = {}
+class MissingDiagram(ReproduceError):
+    """A task diagram is not in the diagrams folder: bad input, found before anything runs."""
+
+
+def check_diagrams(diagrams: Path) -> None:
+    """MissingDiagram unless ``diagrams`` holds every task's diagram."""
     for task in TASKS:
         path = diagrams / f"{task}.yaml"
         if not path.is_file():
-            raise ReproduceError(f"{path}: task diagram not found (pass --diagrams DIR, the folder "
-                                 "holding grasp.yaml, manipulate.yaml, regrasp.yaml, regrasp_unsuppressed.yaml)")
+            raise MissingDiagram(f"{path}: task diagram not found (hint: pass --diagrams DIR, the folder "
+                                 f"holding {', '.join(f'{t}.yaml' for t in TASKS)})")
+
+
+def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda s: None) -> dict[str, Results]:
+    check_diagrams(diagrams)
+    runs = {}
+    for task in TASKS:
+        path = diagrams / f"{task}.yaml"
         diagram = blocks.load_diagram(path)
         results = blocks.simulate(diagram)
         results.save(out / "runs" / task)
@@ -87,6 +98,7 @@ def run_hand(parameters: dict, b: TaskBlocks = TaskBlocks()):
 
 def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[str], None] = lambda s: None) -> dict:
     """Run the tasks, write summary.json, the figures and report.md; return the summary."""
+    check_diagrams(diagrams)
     out.mkdir(parents=True, exist_ok=True)
     runs = run_tasks(diagrams, out, report)
     summary = summarize(runs)

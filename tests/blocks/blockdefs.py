@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from blocks import Block, BlockError
+from blocks import Block, BlockError, ParameterError
 
 
 class Accumulator(Block):
@@ -181,3 +181,21 @@ class Touch(Block):
         with open(self.path, "a", encoding="utf-8"):
             pass
         return {"y": np.zeros(1)}
+
+
+class Limits(Block):
+    """y = sum of ``gains``; every gain must be positive: each negative one is a
+    ``ParameterError`` problem at ``("gains", name)``, a non-mapping ``gains`` a ValueError."""
+
+    def __init__(self, gains=None, scale: float = 1.0):
+        gains = {} if gains is None else gains
+        if not isinstance(gains, dict):
+            raise ValueError("gains must be a mapping")
+        bad = [(("gains", k), f"gains.{k} must be positive, got {v}") for k, v in gains.items() if v <= 0]
+        if bad:
+            raise ParameterError(bad)
+        self.total = scale * sum(gains.values())
+        self.outputs = {"y": 1}
+
+    def output(self, t, state, inputs):
+        return {"y": np.array([self.total])}

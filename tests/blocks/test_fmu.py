@@ -15,7 +15,6 @@ import gc
 import os
 import shutil
 import stat
-import subprocess
 import sys
 import zipfile
 from pathlib import Path
@@ -25,34 +24,30 @@ import pytest
 
 import blocks
 from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, simulate
-from blocks.fmu_archive import ArchiveError, extract_archive
+from blocks.fmu_archive import ArchiveError, Limits, extract_archive, read_member
 
 fmpy = pytest.importorskip("fmpy")
 
-SOURCES = Path(__file__).parent / "fmu_sources"
-HEADERS = Path(fmpy.__file__).parent / "c-code"
-
-
-def _compiler() -> str | None:
-    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
-        if name and shutil.which(name):
-            return shutil.which(name)
-    return None
-
-
-def _zip(path: Path, files: dict[str, bytes | str]) -> Path:
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
-        for name, data in files.items():
-            zf.writestr(name, data)
-    return path
+from .fmu_build import (  # noqa: E402
+    SOURCES,
+    build_error,
+    compile_library,
+    fmi2_files,
+    interrupting_library,
+    marker_library,
+    zip_files,
+)
 
 
 class Fmus:
     """Builds FMU files in a folder from the compiled binaries and (edited) model descriptions."""
 
-    def __init__(self, folder: Path, lib2: bytes, lib3: bytes):
+    def __init__(self, folder: Path, lib2: bytes, lib3: bytes, marker: bytes, markers: Path,
+                 interrupting: dict[int, bytes]):
         self.folder = folder
         self.lib2, self.lib3 = lib2, lib3
+        self.marker, self.markers = marker, markers
+        self.interrupting = interrupting
         self.xml2 = (SOURCES / "first_order_fmi2.xml").read_text()
         self.xml3 = (SOURCES / "first_order_fmi3.xml").read_text()
         self.fmi2 = self.make("first_order.fmu")
@@ -68,31 +63,22 @@ class Fmus:
             files = {"modelDescription.xml": self.xml3 if xml is None else xml}
             if binary:
                 files[f"binaries/{fmpy.platform_tuple}/FirstOrder3{ext}"] = self.lib3
-        return _zip(self.folder / name, files)
+        return zip_files(self.folder / name, files)
 
 
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory) -> Fmus:
-    if sys.platform.startswith("win"):
-        pytest.skip("the test FMUs are built with a Unix C compiler")
-    cc = _compiler()
-    if cc is None:
-        pytest.skip("no C compiler (cc, gcc or clang) on PATH to build the test FMUs")
-    if not (HEADERS / "fmi2Functions.h").is_file() or not (HEADERS / "fmi3Functions.h").is_file():
-        pytest.skip(f"fmpy's FMI headers are missing (looked in {HEADERS})")
+    why = build_error()
+    if why:
+        pytest.skip(why)
     build = tmp_path_factory.mktemp("fmu_build")
-
-    def compile_(out: str, *sources: str) -> bytes:
-        target = build / out
-        cmd = [cc, "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *(str(SOURCES / s) for s in sources),
-               "-o", str(target)]
-        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-        assert done.returncode == 0, f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}"
-        return target.read_bytes()
-
-    lib2 = compile_("fo2" + fmpy.sharedLibraryExtension, "first_order_fmi2.c")
-    lib3 = compile_("fo3" + fmpy.sharedLibraryExtension, "first_order_fmi3.c", "fmi3_unsupported.c")
-    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3)
+    markers = tmp_path_factory.mktemp("fmu_markers")
+    lib2 = compile_library(build / ("fo2" + fmpy.sharedLibraryExtension), "first_order_fmi2.c")
+    lib3 = compile_library(build / ("fo3" + fmpy.sharedLibraryExtension), "first_order_fmi3.c",
+                           "fmi3_unsupported.c")
+    interrupting = {status: interrupting_library(build, status) for status in (0, 4)}
+    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3, marker_library(build, markers), markers,
+                interrupting)
 
 
 def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
@@ -211,10 +197,10 @@ def test_runs_reuse_one_instance_reset_between_runs(fmus):
     np.testing.assert_array_equal(first["f.y"][1], second["f.y"][1])
     # Two states alive at once get two instances, each with its own FMU state.
     s1, s2 = block.initial_state(), block.initial_state()
-    assert s1.instance is not s2.instance
     u = {"u": np.array([1.0])}
     block.output(0.0, s1, u)
     block.output(0.0, s2, u)
+    assert s1.instance is not s2.instance
     block.update(0.0, s1, u)
     assert block.output(0.1, s1, u)["y"][0] == 1.0 and block.output(0.0, s2, u)["y"][0] == 0.0
     s1.close()
@@ -223,7 +209,9 @@ def test_runs_reuse_one_instance_reset_between_runs(fmus):
 
 
 def test_close_frees_instances_and_extracted_files(fmus):
-    block = diagram(fmus.fmi2).blocks["f"].block
+    d = diagram(fmus.fmi2)
+    block = d.blocks["f"].block
+    simulate(d)
     folder = block._model.dir
     assert (folder / "modelDescription.xml").is_file()
     block.close()
@@ -280,6 +268,29 @@ log: [f.wsum]
     np.testing.assert_allclose(simulate(d)["f.wsum"][1][:, 0], [0.0, 0.75, 0.75])
 
 
+# -- what runs an FMU's code ---------------------------------------------------------------
+
+
+def _traces(fmus, identifier: str) -> set[str]:
+    """What the marker FMU of ``identifier`` left: 'loaded', 'instantiated' (see marker.c)."""
+    return {p.name.rsplit(".", 1)[1] for p in fmus.markers.glob(f"{identifier}{fmpy.sharedLibraryExtension}.*")}
+
+
+def test_loading_a_diagram_does_not_run_the_fmus_code(fmus, tmp_path):
+    """Only a run loads the binary: loading, describing and scheduling read modelDescription.xml."""
+    path = zip_files(tmp_path / "traced.fmu", fmi2_files(fmus.marker, identifier="TracedLoad"))
+    d = diagram(path)
+    block = d.blocks["f"].block
+    assert block.parameter_values()["a"] == 0.5 and block.describe().startswith("FMI 2.0")
+    blocks.build_schedule(d, None)
+    state = block.initial_state()
+    assert _traces(fmus, "TracedLoad") == set()
+    assert block._model.dir is None                     # nothing extracted either
+    state.close()
+    assert simulate(d).complete
+    assert _traces(fmus, "TracedLoad") == {"loaded", "instantiated"}
+
+
 # -- run-time failures --------------------------------------------------------------------
 
 
@@ -308,6 +319,53 @@ def test_dostep_discard_is_a_failure(fmus):
     results = simulate(diagram(fmus.fmi2, start_values="{threshold: 2}", source=src))
     assert "fmi2DoStep at t=0.2 s (step 0.1 s) returned status 'discard'" in results.status
     assert "step discarded" in results.status
+
+
+@pytest.mark.parametrize("status", [0, 4], ids=["ok", "fatal"])
+def test_ctrl_c_during_a_step_is_an_interrupt_not_an_fmu_failure(fmus, tmp_path, status):
+    """SIGINT arrives inside doStep, which then logs (the KeyboardInterrupt is raised in the
+    log callback, where ctypes loses it) and returns ok, or 'fatal' as an FMU whose memory
+    callback was broken would. Either way the run stops as interrupted, results kept."""
+    path = zip_files(tmp_path / "interrupting.fmu", fmi2_files(fmus.interrupting[status]))
+    d = diagram(path, log="[f.y]")
+    try:
+        results = simulate(d)
+    except KeyboardInterrupt:  # pragma: no cover - would otherwise stop the whole test session
+        pytest.fail("the interrupt escaped the run")
+    assert results.status == "interrupted at t=0.2 s", results.status
+    assert results.interrupted and not results.complete
+    np.testing.assert_allclose(results["f.y"][0], [0.0, 0.1, 0.2])   # the results so far
+    assert "fmi2DoStep" not in results.status
+
+
+def test_an_interrupt_lost_in_a_callback_is_raised_after_the_call():
+    """The pieces on their own: a KeyboardInterrupt inside a wrapped callback, or one that
+    ctypes hands to sys.unraisablehook for it, is raised by the next check()."""
+    from types import SimpleNamespace
+
+    from blocks import fmu_interrupt
+
+    @fmu_interrupt.callback
+    def log(*args):
+        raise KeyboardInterrupt
+
+    log(1, 2)
+    with pytest.raises(KeyboardInterrupt):
+        fmu_interrupt.check()
+    fmu_interrupt.check()                                   # noted once, raised once
+    fmu_interrupt.arm()
+    sys.unraisablehook(SimpleNamespace(exc_type=KeyboardInterrupt, object=log))
+    with pytest.raises(KeyboardInterrupt):
+        fmu_interrupt.check()
+    seen = []
+    before = sys.unraisablehook
+    sys.unraisablehook = seen.append                        # others' hooks keep their messages
+    fmu_interrupt.arm()
+    other = SimpleNamespace(exc_type=KeyboardInterrupt, object=print)
+    sys.unraisablehook(other)
+    assert seen == [other]
+    fmu_interrupt.check()
+    sys.unraisablehook = before
 
 
 # -- load-time errors ---------------------------------------------------------------------
@@ -348,6 +406,44 @@ log: [f.y]
     np.testing.assert_allclose(t, [0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
 
 
+def _fixed_step(fmus, version: int, step: str, name: str) -> Path:
+    """The first-order FMU declaring a fixed internal step: FMI 3's fixedInternalStepSize,
+    for FMI 2 the same attribute in a vendor annotation."""
+    if version == 3:
+        xml = fmus.xml3.replace("<CoSimulation ", f'<CoSimulation fixedInternalStepSize="{step}" ')
+    else:
+        annotation = (f'<VendorAnnotations><Tool name="some tool"><CoSimulation fixedInternalStepSize="{step}"/>'
+                      "</Tool></VendorAnnotations>\n  <ModelVariables>")
+        xml = fmus.xml2.replace("<ModelVariables>", annotation)
+    return fmus.make(name, xml, version=version)
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_a_period_off_the_fixed_internal_step_is_a_load_error(fmus, version):
+    """Such an FMU refuses every step; that must show at load time, not once a run has started."""
+    path = _fixed_step(fmus, version, "0.04", f"fixed{version}.fmu")
+    msg = load_error(lambda: diagram(path, period="0.1 s"))
+    assert msg.startswith("fmu.yaml:5: block 'f' (FMU): the period 100 ms is not a whole multiple of the "
+                          "fixed internal step 40 ms"), msg
+    assert "use a multiple of it, e.g. 'period: 80 ms'" in msg
+    assert diagram(path, period="0.2 s").blocks["f"].period == Fraction(1, 5)
+    # the default step (DefaultExperiment stepSize 0.1) must be a multiple too
+    text = f"""
+time: {{t_end: 0.5 s}}
+blocks:
+  f: {{type: FMU, params: {{path: '{path}'}}}}
+"""
+    assert "the default step (DefaultExperiment stepSize) 100 ms is not a whole multiple" in load_error(
+        lambda: loads_diagram(text))
+
+
+def test_fmu_info_shows_the_fixed_internal_step(fmus):
+    from blocks.fmu_info import describe_fmu
+
+    assert "fixed internal step: 0.04 s" in describe_fmu(_fixed_step(fmus, 3, "0.04", "fixed_info.fmu"))
+    assert "fixed internal step" not in describe_fmu(fmus.fmi3)
+
+
 def test_a_relative_path_is_resolved_against_the_diagrams_folder(fmus, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     folder = tmp_path / "project"
@@ -364,7 +460,8 @@ log: [f.y]
     (folder / "d.yaml").write_text(text)
     assert simulate(load_diagram(folder / "d.yaml")).complete
     msg = load_error(lambda: loads_diagram(text, filename="d.yaml", base_dir=tmp_path / "elsewhere"))
-    assert f"FMU file not found: {tmp_path / 'elsewhere' / 'fmus' / 'plant.fmu'}" in msg
+    assert f"FMU file not found: looked at {tmp_path / 'elsewhere' / 'fmus' / 'plant.fmu'}" in msg
+    assert "a relative path is resolved against the diagram's folder" in msg
 
 
 def test_not_a_zip(fmus, tmp_path):
@@ -375,7 +472,7 @@ def test_not_a_zip(fmus, tmp_path):
 
 
 def test_no_model_description(fmus, tmp_path):
-    empty = _zip(tmp_path / "empty.fmu", {"resources/readme.txt": "hello"})
+    empty = zip_files(tmp_path / "empty.fmu", {"resources/readme.txt": "hello"})
     assert "the archive has no modelDescription.xml" in load_error(lambda: diagram(empty))
 
 
@@ -403,11 +500,13 @@ def test_no_binary_for_this_platform(fmus):
     assert "it has no binaries" in msg
 
 
-def test_instantiation_failure_is_a_load_error_with_the_fmu_log(fmus):
+def test_instantiation_failure_fails_the_run_with_the_fmu_log(fmus):
+    """Only a run loads and instantiates the FMU, so only a run finds a binary that fails."""
     wrong = fmus.make("wrong_guid.fmu", fmus.xml2.replace("8c4e810f", "00000000"))
-    msg = load_error(lambda: diagram(wrong))
-    assert "instantiating the FMU failed" in msg
-    assert "FMU log: [error] logStatusError: wrong FMU type or GUID {00000000" in msg
+    status = simulate(diagram(wrong)).status
+    assert status.startswith("failed at t=0 s: block 'f' (FMU) output: "), status
+    assert "instantiating the FMU failed" in status
+    assert "FMU log: [error] logStatusError: wrong FMU type or GUID {00000000" in status
 
 
 def test_vector_with_a_gap(fmus):
@@ -417,7 +516,7 @@ def test_vector_with_a_gap(fmus):
 
 
 def test_unsafe_archive_is_refused_by_the_block(fmus, tmp_path):
-    evil = _zip(tmp_path / "evil.fmu", {"modelDescription.xml": fmus.xml2, "../evil.txt": "x"})
+    evil = zip_files(tmp_path / "evil.fmu", {"modelDescription.xml": fmus.xml2, "../evil.txt": "x"})
     msg = load_error(lambda: diagram(evil))
     assert "unsafe FMU archive" in msg and "'../evil.txt'" in msg
     assert not (tmp_path.parent / "evil.txt").exists()
@@ -483,14 +582,52 @@ def test_extractor_limits_size_and_count(tmp_path):
     big = _zip_with(tmp_path / "big.zip", "big.bin", b"\0" * 5000)
     (tmp_path / "o1").mkdir()
     with pytest.raises(ArchiveError, match="'big.bin' is 5000 bytes uncompressed, more than the limit of 1000"):
-        extract_archive(big, tmp_path / "o1", max_member_bytes=1000)
+        extract_archive(big, tmp_path / "o1", Limits(member_bytes=1000))
     with pytest.raises(ArchiveError, match="more than the limit of 3000 bytes"):
-        extract_archive(big, tmp_path / "o1", max_total_bytes=3000)
-    many = _zip(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
+        extract_archive(big, tmp_path / "o1", Limits(total_bytes=3000))
+    many = zip_files(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
     with pytest.raises(ArchiveError, match="has 20 members, more than the limit of 10"):
-        extract_archive(many, tmp_path / "o1", max_members=10)
+        extract_archive(many, tmp_path / "o1", Limits(members=10))
+    with pytest.raises(ArchiveError, match="its member list takes .* bytes, more than 1 members can need"):
+        read_member(many, "f1.txt", Limits(members=1))
     extract_archive(many, tmp_path / "o1")
     assert len(list((tmp_path / "o1").iterdir())) == 20
+
+
+def test_archive_limits_keep_a_zip_bomb_small():
+    """At most 256 MiB per member and in all (once 1 GiB and 4 GiB), at most 200-fold inflation."""
+    from blocks import fmu_archive
+
+    assert fmu_archive.MAX_MEMBER_BYTES == fmu_archive.MAX_TOTAL_BYTES == 256 * 2**20
+    assert fmu_archive.MAX_RATIO == 200 and fmu_archive.RATIO_FLOOR_BYTES == 2**20
+    assert fmu_archive.MAX_MEMBERS == 10_000
+
+
+def test_a_member_that_inflates_too_much_is_refused(tmp_path):
+    bomb = zip_files(tmp_path / "bomb.fmu", {"modelDescription.xml": "<x/>", "resources/zeros.bin": b"\0" * (4 << 20)})
+    (tmp_path / "out").mkdir()
+    with pytest.raises(ArchiveError, match=r"'resources/zeros.bin' inflates from \d+ to 4194304 bytes or more, "
+                                           "more than 200 times"):
+        extract_archive(bomb, tmp_path / "out")
+    with pytest.raises(ArchiveError, match="more than 200 times"):
+        read_member(bomb, "modelDescription.xml")     # every member is checked, even when reading one
+    small = zip_files(tmp_path / "small.fmu", {"notes.txt": b"\0" * 100_000})  # below the floor: fine
+    assert read_member(small, "notes.txt") == (b"\0" * 100_000, ["notes.txt"])
+
+
+def test_the_bytes_are_counted_as_they_are_decompressed(tmp_path):
+    """The running count does not rely on the headers: a member whose header says it is
+    huge (so zipfile does not cut it) is stopped once the bytes read pass a limit."""
+    from blocks.fmu_archive import _chunks
+
+    archive = zip_files(tmp_path / "a.zip", {"x.bin": os.urandom(5000)})
+    with zipfile.ZipFile(archive) as zf:
+        info = zf.getinfo("x.bin")
+        info.file_size = 10**9
+        with pytest.raises(ArchiveError, match="is 5000 bytes uncompressed, more than the limit of 1000"):
+            list(_chunks(zf, info, 0, "a.zip", Limits(member_bytes=1000)))
+        with pytest.raises(ArchiveError, match="add up to more than the limit of 6000"):
+            list(_chunks(zf, info, 2000, "a.zip", Limits(total_bytes=6000)))
 
 
 def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
@@ -505,7 +642,7 @@ def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
     archive.write_bytes(bytes(data))
     (tmp_path / "out").mkdir()
     with pytest.raises((ArchiveError, zipfile.BadZipFile)):
-        extract_archive(archive, tmp_path / "out", max_member_bytes=100)
+        extract_archive(archive, tmp_path / "out", Limits(member_bytes=100))
     assert not (tmp_path / "out" / "x.bin").exists()
 
 

@@ -80,3 +80,19 @@ def test_a_bad_index_in_set_is_one_line_naming_the_set(key, text):
     with pytest.raises(DiagramError) as info:
         loads_diagram(WEIGHTS, trust=True, overrides={key: 1.0})
     assert [str(i) for i in info.value.issues] == [text]
+
+
+def test_override_issues_name_how_the_user_gave_them():
+    with pytest.raises(DiagramError) as info:
+        loads_diagram(WEIGHTS, overrides={"w.weights.x": 1, "w.nope": 2, "v.k": 3}, trust=True,
+                      origins={"w.weights.x": "--grid w.weights.x=1,2", "v.k": "--points p.csv:1: column 'v.k'"})
+    found = {i.override: str(i) for i in info.value.issues}
+    assert found["w.weights.x"].startswith("--grid w.weights.x=1,2: 'w.weights' is a list")
+    assert found["w.nope"].startswith("--set w.nope=2: block 'w' ")
+    assert found["v.k"].startswith("--points p.csv:1: column 'v.k': no block named 'v'")
+
+
+def test_issues_of_the_file_are_no_override():
+    with pytest.raises(DiagramError) as info:
+        loads_diagram(WEIGHTS + "  x: {type: Nope}\n", trust=True)
+    assert [i.override for i in info.value.issues] == [None]

@@ -1,6 +1,10 @@
-"""YAML with positions: lines of keys and items, duplicate keys, recursive aliases, syntax errors."""
+"""YAML with positions: lines of keys and items, duplicate keys, recursive aliases, syntax
+errors, and the limits on hostile text: size, kind, encoding, nesting and alias expansion."""
 
 from __future__ import annotations
+
+import os
+import time
 
 import pytest
 import yaml
@@ -8,7 +12,8 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from blocks.yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml
+from blocks.limits import MAX_ALIAS_VALUES, MAX_YAML_BYTES, MAX_YAML_DEPTH
+from blocks.yamlsource import LineDict, LineList, YamlSourceError, line_at, line_of, load_yaml, read_yaml_file
 
 TEXT = """\
 # a comment on line 1
@@ -110,6 +115,159 @@ def test_plain_aliases_are_allowed():
     data = load_yaml("base: &b [1, 2]\ncopy: *b\nmerged:\n  <<: {x: 1}\n  y: 2\n")
     assert data["copy"] == [1, 2]
     assert data["merged"] == {"x": 1, "y": 2}
+
+
+def test_merge_keys_follow_yaml_and_keep_lines():
+    text = "a: &a {x: 1, y: 2}\nb: &b {y: 3, z: 4}\nm:\n  <<: [*a, *b]\n  x: 5\n"
+    data = load_yaml(text)
+    assert data["m"] == yaml.safe_load(text)["m"] == {"x": 5, "y": 2, "z": 4}
+    assert data["m"].line_of("x") == 5 and data["m"].line_of("y") == 1 and data["m"].line_of("z") == 2
+
+
+def test_merge_key_of_a_scalar_is_an_error_with_a_line():
+    with pytest.raises(YamlSourceError) as info:
+        load_yaml("ok: 1\nm:\n  <<: 3\n")
+    assert info.value.line == 3 and "merge key" in info.value.message
+
+
+def laughs(levels: int, width: int = 10) -> str:
+    lines = ["l0: &l0 [" + ", ".join(["lol"] * width) + "]"]
+    lines += [f"l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * width) + "]" for i in range(1, levels)]
+    return "\n".join(lines) + "\n"
+
+
+def test_billion_laughs_is_refused_fast_at_the_line_of_the_alias():
+    start = time.perf_counter()
+    with pytest.raises(YamlSourceError) as info:
+        load_yaml(laughs(9))
+    assert time.perf_counter() - start < 2
+    assert f"more than {MAX_ALIAS_VALUES}" in info.value.message
+    assert info.value.line == 5  # l4 repeats l3 (11 111 values) ten times: the first level past the limit
+    assert "alias" in info.value.hint
+
+
+def test_billion_laughs_through_merge_keys_is_refused():
+    text = "m0: &m0 {a: 1, b: 2}\n" + "".join(
+        f"m{i}: &m{i} {{<<: [*m{i - 1}, *m{i - 1}, *m{i - 1}]}}\n" for i in range(1, 40))
+    with pytest.raises(YamlSourceError) as info:
+        load_yaml(text)
+    assert "aliases repeat" in info.value.message
+
+
+def test_aliases_repeating_fewer_values_than_the_limit_load():
+    data = load_yaml(laughs(4))  # 12 330 repeated values
+    assert len(data["l3"]) == 10 and data["l3"][9][9][9][9] == "lol"
+
+
+def test_nesting_deeper_than_the_limit_is_refused_before_parsing_it_all():
+    for text, line in [("a: 1\nb: " + "[" * 50_000, 2), ("- " * 50_000 + "x\n", 1),
+                       ("a:\n" + "".join(" " * i + f"k{i}:\n" for i in range(1, 200)), 101)]:
+        start = time.perf_counter()
+        with pytest.raises(YamlSourceError) as info:
+            load_yaml(text)
+        assert time.perf_counter() - start < 1
+        assert info.value.line == line and f"deeper than {MAX_YAML_DEPTH}" in info.value.message
+
+
+def test_nesting_at_the_limit_loads():
+    data = load_yaml("[" * MAX_YAML_DEPTH + "]" * MAX_YAML_DEPTH)
+    for _ in range(MAX_YAML_DEPTH - 1):
+        data = data[0]
+    assert data == []
+
+
+def test_nesting_through_aliases_is_refused():
+    with pytest.raises(YamlSourceError) as info:  # each part 61 levels deep, together 101
+        load_yaml("a: &a " + "[" * 60 + "1" + "]" * 60 + "\nb: " + "[" * 40 + "*a" + "]" * 40 + "\n")
+    assert "through aliases" in info.value.message and info.value.line == 2
+
+
+def test_a_chain_of_merge_keys_is_nesting():
+    text = "m0: &m0 {a: 1}\n" + "".join(f"m{i}: &m{i} {{<<: *m{i - 1}}}\n" for i in range(1, 1000))
+    with pytest.raises(YamlSourceError) as info:
+        load_yaml(text)
+    assert "through aliases" in info.value.message and info.value.line == MAX_YAML_DEPTH  # m99: 99 merges deep
+
+
+def test_control_character_has_line_and_column():
+    with pytest.raises(YamlSourceError) as info:
+        load_yaml("a: 1\nb: \u00e9\x07\n")
+    assert info.value.line == 2 and "U+0007 at column 5" in info.value.message
+
+
+@pytest.mark.parametrize("path, found, line", [
+    (("a",), 1, 1), (("b", 0), 2, 3), (("b", 1, "c"), 3, 4), (("b", 1, "c", 0, "x"), 4, 4),
+    (("b", 7), 1, 2), (("nope", "x"), 0, 1), ((), 0, 1),
+])
+def test_line_at_finds_the_deepest_part_of_a_path(path, found, line):
+    data = load_yaml("a: 1\nb:\n  - 2\n  - c: [1, 2]\n")
+    assert line_at(data, path) == (line, found)
+
+
+def test_line_at_of_plain_values():
+    assert line_at({"a": 1}, ("a",)) == (None, 0)
+
+
+def test_read_yaml_file_reads_utf8(tmp_path):
+    (tmp_path / "f.yaml").write_text("a: caf\u00e9\n", encoding="utf-8")
+    assert read_yaml_file(tmp_path / "f.yaml") == "a: caf\u00e9\n"
+
+
+def test_read_yaml_file_passes_a_missing_file_on(tmp_path):
+    with pytest.raises(FileNotFoundError):
+        read_yaml_file(tmp_path / "missing.yaml")
+
+
+@pytest.mark.parametrize("content, line, text", [
+    (b"a: 1\nb: caf\xe9\n", 2, "byte 0xe9 at column 7"),
+    ("a: 1\nb: \u00e9\u00e9".encode() + b"\xff\n", 2, "byte 0xff at column 6"),
+    (b"a: 1\nb: 2\x00\n", 2, "NUL byte at column 5"),
+])
+def test_read_yaml_file_bad_text_has_line_and_column(tmp_path, content, line, text):
+    (tmp_path / "f.yaml").write_bytes(content)
+    with pytest.raises(YamlSourceError) as info:
+        read_yaml_file(tmp_path / "f.yaml")
+    assert info.value.line == line and text in info.value.message
+
+
+def test_read_yaml_file_refuses_a_big_file_without_reading_it(tmp_path):
+    path = tmp_path / "big.yaml"
+    with open(path, "wb") as fh:
+        fh.truncate(MAX_YAML_BYTES + 1)  # sparse: its size alone must refuse it
+    with pytest.raises(YamlSourceError) as info:
+        read_yaml_file(path)
+    assert f"larger than {MAX_YAML_BYTES}" in info.value.message and info.value.line is None
+
+
+def test_read_yaml_file_at_the_size_limit(tmp_path):
+    path = tmp_path / "full.yaml"
+    path.write_bytes(b"a: 1\n" + b"#" * (MAX_YAML_BYTES - 5))
+    assert len(read_yaml_file(path)) == MAX_YAML_BYTES
+
+
+@pytest.mark.parametrize("make", ["folder", "fifo", "device"])
+def test_read_yaml_file_refuses_what_is_not_a_regular_file(tmp_path, make):
+    path = tmp_path / "thing"
+    if make == "folder":
+        path.mkdir()
+    elif make == "fifo":
+        os.mkfifo(path)  # opening it must not wait for a writer
+    else:
+        path = "/dev/zero"
+    with pytest.raises(YamlSourceError) as info:
+        read_yaml_file(path)
+    assert "not a regular file" in info.value.message
+
+
+def test_read_yaml_file_unreadable(tmp_path):
+    path = tmp_path / "secret.yaml"
+    path.write_text("a: 1\n")
+    path.chmod(0)
+    if os.access(path, os.R_OK):
+        pytest.skip("running as a user who reads everything")
+    with pytest.raises(YamlSourceError) as info:
+        read_yaml_file(path)
+    assert "cannot open" in info.value.message
 
 
 @pytest.mark.parametrize("text, line", [

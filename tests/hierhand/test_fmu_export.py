@@ -272,6 +272,23 @@ def test_communication_step_must_be_a_multiple_of_the_internal_step(fmus, fmi, t
         slave.close()
 
 
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_the_fmu_block_refuses_a_step_the_plant_would_refuse_at_load_time(fmus, fmi):
+    """The export declares its internal step (fixedInternalStepSize), so a diagram with a
+    period that is no multiple of it fails to load instead of failing once it runs."""
+    from blocks import DiagramError, loads_diagram
+
+    text = f"""
+time: {{t_end: 1 ms}}
+blocks:
+  plant: {{type: FMU, period: 0.15 ms, params: {{path: "{fmus[fmi]}"}}}}
+"""
+    with pytest.raises(DiagramError, match=r"d\.yaml:4: block 'plant' \(FMU\): the period 150 us is not a "
+                                           r"whole multiple of the fixed internal step 100 us"):
+        loads_diagram(text, filename="d.yaml")
+    assert loads_diagram(text.replace("0.15 ms", "0.2 ms")).blocks["plant"].period == Fraction(1, 5000)
+
+
 def test_several_instances_and_exports_run_side_by_side_in_one_process(fmus, tmp_path):
     hand_file = tmp_path / "heavy.yaml"
     hand_file.write_text("object: {mass: 0.6, inertia: 1.25e-4}\n")
@@ -507,7 +524,7 @@ def test_cli_reports_an_invalid_hand_file_in_one_line(tmp_path):
     done = subprocess.run([sys.executable, "-m", "hierhand", "fmu", "export", "--hand", str(bad), "-o",
                            str(tmp_path)], capture_output=True, text=True, timeout=120)
     assert done.returncode == 2
-    assert done.stderr.strip() == f"hierhand: error: {bad}: object.mass must be > 0, got -1"
+    assert done.stderr.strip() == f"{bad}:1: object.mass must be > 0, got -1"
     assert not list(tmp_path.glob("*.fmu"))
 
 

@@ -144,3 +144,48 @@ def test_com_given_as_pair_is_used():
     data["fingers"][0]["links"][1]["com"] = [0.01, 0.002]
     link = load_hand(data).params.fingers[0].links[1]
     assert (link.com_along, link.com_across) == (0.01, 0.002)
+
+
+def test_field_path():
+    from hierhand.model.handfile import field_path
+
+    assert field_path("fingers[1].links[2].mass") == ("fingers", 1, "links", 2, "mass")
+    assert field_path("object.bogus") == ("object", "bogus")
+    assert field_path("") == ()
+
+
+def test_file_errors_carry_the_line_of_each_field(tmp_path):
+    path = tmp_path / "hand.yaml"
+    path.write_text("gravity: [0.0, -9.81]\nobject:\n  mass: 0.3\n  bogus: 1\ncontact:\n  k_n: 3.0e3\n  mu: 2\n")
+    with pytest.raises(HandFileError) as info:
+        load_hand(path)
+    err = info.value
+    assert err.fields == ["object.bogus", "contact.mu"] and err.lines == [4, 7]
+    assert [str(i) for i in err.issues()] == [f"{path}:4: {err.errors[0]}", f"{path}:7: {err.errors[1]}"]
+
+
+def test_value_errors_of_the_c_core_carry_the_line_of_the_field(tmp_path):
+    path = tmp_path / "hand.yaml"
+    path.write_text("contact:\n  mu_s: 0.5\n  k_n: -1\nobject:\n  mass: -2\n")
+    with pytest.raises(HandFileError) as info:
+        load_hand(path)
+    assert dict(zip(info.value.fields, info.value.lines)) == {"object.mass": 5, "contact.k_n": 3}
+
+
+@pytest.mark.parametrize("text, line, message", [
+    ("gravity: [0.0, -9.81]\nobject: mass: 1\n", 2, "YAML syntax error"),
+    ("- 1\n- 2\n", 1, "the file must be a mapping"),
+    ("gravity: " + "[" * 500, 1, "nested deeper than"),
+])
+def test_unreadable_hand_files_are_one_error_at_a_line(tmp_path, text, line, message):
+    path = tmp_path / "hand.yaml"
+    path.write_text(text)
+    with pytest.raises(HandFileError) as info:
+        load_hand(path)
+    assert info.value.lines == [line] and message in info.value.errors[0]
+
+
+def test_plant_parameter_errors_name_their_fields():
+    with pytest.raises(HandFileError) as info:
+        HandPlant(object={"mass": -1.0, "bogus": 2})
+    assert info.value.problems == [(("object", "bogus"), info.value.errors[0])]

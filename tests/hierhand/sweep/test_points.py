@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from hierhand.sweep import SweepError
-from hierhand.sweep.points import (combine, csv_points, grid_points, parse_grid, parse_random, point_hash,
-                                   random_points, split_top_level, unique_points)
+from hierhand.sweep.points import (combine, csv_points, grid_points, origins, parse_grid, parse_random,
+                                   point_hash, random_points, split_top_level, unique_points)
 
 
 def test_grid_is_the_cartesian_product_with_yaml_values():
@@ -87,3 +87,14 @@ def test_hash_depends_on_diagram_values_and_end_time_not_key_order():
     assert len({h, point_hash("d2", {"a.k": 1, "b.x": 2}), point_hash("d1", {"a.k": 1, "b.x": 3}),
                 point_hash("d1", {"a.k": 1, "b.x": 2}, "0.5")}) == 4
     assert len(unique_points([{"a.k": 1}, {"a.k": 1}, {"a.k": 2}], "d", None)) == 2
+
+
+def test_origins_name_the_option_as_typed():
+    assert origins(["a.k=1,2", " b.x =[1],[2]"], ["c.y=uniform(0, 1)"], None, []) == {
+        "a.k": "--grid a.k=1,2", "b.x": "--grid  b.x =[1],[2]", "c.y": "--random c.y=uniform(0, 1)"}
+
+
+def test_origins_of_a_points_file_are_its_header_columns(tmp_path):
+    path = tmp_path / "p.csv"
+    assert origins([], [], path, [{"a.k": 1, "b.x": 2}]) == {
+        "a.k": f"--points {path}:1: column 'a.k'", "b.x": f"--points {path}:1: column 'b.x'"}

@@ -198,3 +198,11 @@ def test_a_point_that_kills_its_worker_fails_alone(tmp_path, monkeypatch, capfd)
     assert sorted(got) == [float(v) for v in range(1, 17)]
     assert got[12.0]["status"] == "failed" and "KilledWorker" in got[12.0]["error"]
     assert all(r["status"] == "ok" and float(r["y"]) == v for v, r in got.items() if v != 12.0)
+
+
+def test_a_point_that_fails_to_load_names_the_option_that_gave_it():
+    from hierhand.sweep.runner import SweepJob, run_point
+
+    job = SweepJob(diagram=TOY, t_end="10 ms", origins=(("prop.k.x", "--grid prop.k.x=1,2"),))
+    outcome = run_point(job, {"prop.k.x": 1})
+    assert outcome.status == "failed" and outcome.error.startswith("--grid prop.k.x=1,2: 'prop.k' is a float")

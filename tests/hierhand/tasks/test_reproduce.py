@@ -101,3 +101,13 @@ def test_the_summary_takes_the_hand_of_the_plant_the_controller_refers_to():
 
     parameters = {"manip": {"hand": "arm", "kp": 1.0}, "arm": {"object": {"pos": [0.01, 0.07]}}, "plant": {}}
     assert run_hand(parameters).object_pose0.tolist() == [0.01, 0.07, 0.0]
+
+
+def test_a_missing_task_diagram_is_bad_input_found_before_anything_runs(tmp_path):
+    from hierhand.tasks.reproduce import MissingDiagram, reproduce
+
+    (tmp_path / "diagrams").mkdir()
+    (tmp_path / "diagrams" / "grasp.yaml").write_text((ROOT / "diagrams" / "grasp.yaml").read_text())
+    with pytest.raises(MissingDiagram, match=r"manipulate\.yaml: task diagram not found"):
+        reproduce(tmp_path / "out", tmp_path / "diagrams")
+    assert not (tmp_path / "out").exists()

@@ -1,0 +1,37 @@
+"""The limits on what the loader reads, in one place.
+
+A diagram, a params file or a hand file may come from someone else, so every input stops
+at one of these limits with a one-line message instead of exhausting memory, the C stack
+or the user's patience. Each limit is far above what a real file needs (the shipped
+diagrams and hand are a few KB, nest at most 8 levels deep and use no aliases) and far
+below what would hurt.
+"""
+
+from __future__ import annotations
+
+MAX_YAML_BYTES = 4 * 1024 * 1024
+"""Largest diagram, params file or hand file, in bytes (4 MiB). Checked on the open file
+before it is read, and no more than this is ever read (a file that grows, or a /proc file
+that reports size 0, stops here too). 4 MiB holds a 400 000-entry matrix; loading it takes
+a few seconds."""
+
+MAX_YAML_DEPTH = 100
+"""Deepest nesting of YAML lists and mappings. libyaml's composer recurses once per level
+on the C stack, so 50 000 nested brackets crash the process; the depth is measured from
+the parser's events, which need no recursion, before anything is composed. A diagram
+nests about 8 levels deep."""
+
+MAX_ALIAS_VALUES = 100_000
+"""Most values YAML aliases (``*name``) and merge keys (``<<: *name``) may add by repeating
+an anchored value. An alias repeats its anchor's whole value, so ten levels of ten aliases
+make 10^10 values from 1 KB of text (the 'billion laughs'); a diagram that shares a
+matrix or a block's settings repeats a few hundred."""
+
+MAX_PORT_WIDTH = 1_000_000
+"""Widest port a block may declare: a signal is copied at every hit, so a width beyond
+this is a mistake in a block's parameters rather than a signal anyone logs."""
+
+MAX_FOLDER_NAME = 100
+"""Longest folder name made from a diagram's ``name:`` (the default ``runs/<name>``), in
+bytes of UTF-8: file systems refuse names beyond 255 bytes, and a results path must leave
+room for the folder it is in."""

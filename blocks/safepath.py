@@ -1,0 +1,37 @@
+"""Paths that come from a diagram, which may be someone else's: keep them where they belong.
+
+A diagram names files to read (``params_file``); unless the user trusts it (``--trust``),
+those must lie in the diagram's own folder or below, so that a diagram from elsewhere
+cannot read, and copy into its results, a file of the user's that it has no business
+with (``~/.ssh/...``, ``/etc/...``). And a diagram's ``name:`` names its results folder
+(``runs/<name>``), so it is made one safe folder name, never a path.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from .limits import MAX_FOLDER_NAME
+
+_UNSAFE = re.compile(r"(?:[^\w.-]|\.{2,})+")
+"""Runs of anything but letters, digits (of any script), '_', '-' and single dots: path
+separators, NUL and other control characters, spaces, and '..'."""
+
+
+def inside(path: str | Path, folder: str | Path) -> bool:
+    """Whether ``path`` is ``folder`` or below it once links and '..' are resolved (so a
+    link inside the folder that points out of it is outside)."""
+    try:
+        return Path(path).resolve().is_relative_to(Path(folder).resolve())
+    except (OSError, RuntimeError, ValueError):  # a loop of links, a NUL in the name
+        return False
+
+
+def folder_name(name: str, default: str = "diagram") -> str:
+    """``name`` as one folder name that stays where it is put: each run of unsafe characters
+    (``_UNSAFE``) becomes '_', leading dots and dashes go (no hidden folder, nothing that
+    reads as an option), and the rest is cut to MAX_FOLDER_NAME bytes of UTF-8;
+    ``default`` when nothing is left. ``../../x`` -> ``_x``, ``/tmp/x`` -> ``_tmp_x``."""
+    safe = _UNSAFE.sub("_", name).lstrip(".-")
+    return safe.encode("utf-8")[:MAX_FOLDER_NAME].decode("utf-8", "ignore") or default

@@ -1,0 +1,94 @@
+"""Builds the test FMUs of ``fmu_sources/`` at test time, for the FMU block tests and the
+hostile-input corpus.
+
+The shared libraries are compiled with the system C compiler against fmpy's FMI headers;
+``build_error()`` says why that cannot be done here (no compiler, Windows, no headers), and
+the tests that need a library skip with that reason.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import shutil
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+import fmpy
+
+SOURCES = Path(__file__).parent / "fmu_sources"
+HEADERS = Path(fmpy.__file__).parent / "c-code"
+EXT = fmpy.sharedLibraryExtension
+
+
+def compiler() -> str | None:
+    """The C compiler to use ($CC, cc, gcc or clang), or None."""
+    for name in (os.environ.get("CC"), "cc", "gcc", "clang"):
+        if name and shutil.which(name):
+            return shutil.which(name)
+    return None
+
+
+def build_error() -> str | None:
+    """Why the test FMUs cannot be built here, or None if they can."""
+    if sys.platform.startswith("win"):
+        return "the test FMUs are built with a Unix C compiler"
+    if compiler() is None:
+        return "no C compiler (cc, gcc or clang) on PATH to build the test FMUs"
+    if not (HEADERS / "fmi2Functions.h").is_file() or not (HEADERS / "fmi3Functions.h").is_file():
+        return f"fmpy's FMI headers are missing (looked in {HEADERS})"
+    return None
+
+
+def compile_library(target: Path, *sources: str, defines: dict[str, str] | None = None) -> bytes:
+    """Compile ``sources`` (names in ``fmu_sources/``) into the shared library ``target``;
+    ``defines`` become ``-D`` options. Returns the library's bytes."""
+    flags = [f"-D{k}={v}" for k, v in (defines or {}).items()]
+    cmd = [compiler(), "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *flags,
+           *(str(SOURCES / s) for s in sources), "-o", str(target)]
+    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    if done.returncode != 0:
+        raise RuntimeError(f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}")
+    return target.read_bytes()
+
+
+def zip_files(path: Path, files: dict[str, bytes | str]) -> Path:
+    """Write a zip archive of ``files`` (member name -> content)."""
+    path.write_bytes(zip_bytes(files))
+    return path
+
+
+def zip_bytes(files: dict[str, bytes | str]) -> bytes:
+    """A zip archive of ``files`` (member name -> content), in memory."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as zf:
+        for name, data in files.items():
+            zf.writestr(name, data)
+    return buffer.getvalue()
+
+
+def fmi2_files(library: bytes, xml: str | None = None, identifier: str = "FirstOrder") -> dict[str, bytes | str]:
+    """The members of an FMI 2 first-order FMU: its modelDescription (by default the one of
+    ``first_order_fmi2.xml``, under model identifier ``identifier``) and ``library``."""
+    if xml is None:
+        xml = (SOURCES / "first_order_fmi2.xml").read_text()
+    xml = xml.replace('modelIdentifier="FirstOrder"', f'modelIdentifier="{identifier}"')
+    return {"modelDescription.xml": xml, f"binaries/{fmpy.platform}/{identifier}{EXT}": library}
+
+
+def marker_library(build: Path, markers: Path) -> bytes:
+    """The FMI 2 first-order FMU's library with ``marker.c``: it leaves
+    ``<library file>.loaded`` in ``markers`` when loaded and ``<library file>.instantiated``
+    when fmi2Instantiate runs (see ``fmu_sources/marker.c``)."""
+    return compile_library(build / f"marker{EXT}", "first_order_fmi2.c", "marker.c",
+                           defines={"TRACE_RUNS": "1", "MARKER_DIR": f'"{markers}"'})
+
+
+def interrupting_library(build: Path, status: int, at: float = 0.2) -> bytes:
+    """The FMI 2 first-order FMU's library whose doStep, from time ``at`` on, sends the
+    process SIGINT (as Ctrl-C would), logs a message and returns ``status`` (0 ok, 3 error,
+    4 fatal: what an FMU does whose memory callback Ctrl-C broke)."""
+    return compile_library(build / f"interrupting{status}{EXT}", "first_order_fmi2.c",
+                           defines={"SIGINT_AT": repr(at), "SIGINT_STATUS": str(status)})
