@@ -8,11 +8,11 @@ from .block import Block, BlockError, ParameterError
 from .diagram import Diagram, DiagramError, Issue, load_diagram, loads_diagram
 from .results import Results, ResultsError
 from .schedule import Schedule, build_schedule
-from .simulate import SimulationError, simulate
+from .simulate import SimulationError, StopRequest, simulate
 from .timebase import parse_duration
 
 __all__ = [
     "Block", "BlockError", "Diagram", "DiagramError", "Issue", "ParameterError", "Results", "ResultsError",
-    "Schedule", "SimulationError", "build_schedule", "load_diagram", "loads_diagram",
+    "Schedule", "SimulationError", "StopRequest", "build_schedule", "load_diagram", "loads_diagram",
     "parse_duration", "simulate",
 ]

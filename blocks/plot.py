@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import Sequence
 
@@ -11,6 +12,7 @@ from .results import Results
 
 AXES_PER_PAGE = 8
 MAX_LEGEND = 12
+TITLE_WIDTH = 100
 
 
 def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | None = None,
@@ -18,7 +20,8 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
     """Write PNG(s) of ``signals`` (default all) to ``path``; more than 8 signals make pages.
 
     Discrete signals hold between samples, so they are drawn as steps; a signal's last
-    value is held to the run's end time. Returns the files written.
+    value is held to the run's end time, or for a failed or interrupted run to where it
+    stopped, which a vertical line marks with the status. Returns the files written.
     """
     import matplotlib
 
@@ -32,31 +35,57 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
         raise ValueError("no signals to plot: the run logged none (add a 'log:' list to the diagram)")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    t_end = results.info.get("t_end")
     pages = [names[i:i + AXES_PER_PAGE] for i in range(0, len(names), AXES_PER_PAGE)]
     written = []
     for number, page in enumerate(pages, start=1):
-        fig, axes = plt.subplots(len(page), 1, sharex=True, squeeze=False,
-                                 figsize=(9, 1.2 + 2.0 * len(page)))
-        for ax, name in zip(axes[:, 0], page):
-            t, v = results[name]
-            if t_end is not None and len(t) and t[-1] < t_end:
-                t, v = np.append(t, t_end), np.vstack([v, v[-1:]])
-            width = v.shape[1]
-            for j in range(width):
-                ax.step(t, v[:, j], where="post", label=f"[{j}]" if width > 1 else None, lw=1.2)
-            ax.set_ylabel(name, rotation=0, ha="right", va="center")
-            ax.grid(True, alpha=0.3)
-            if 1 < width <= MAX_LEGEND:
-                ax.legend(loc="upper right", fontsize="small", ncol=min(width, 6))
-        axes[-1, 0].set_xlabel("time (s)")
-        heading = title or results.info.get("diagram", "")
-        if results.info.get("status", "complete") != "complete":
-            heading += f"  [{results.info['status']}]"
-        fig.suptitle(heading)
-        fig.tight_layout()
+        fig = figure(results, page, title)
         out = path if len(pages) == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
         fig.savefig(out, dpi=110)
         plt.close(fig)
         written.append(out)
     return written
+
+
+def figure(results: Results, names: Sequence[str], title: str | None = None):
+    """One page: an axis per signal of ``names``, over the time the run covered."""
+    import matplotlib.pyplot as plt
+
+    end, stop = time_span(results)
+    fig, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False, figsize=(9, 1.2 + 2.0 * len(names)))
+    for ax, name in zip(axes[:, 0], names):
+        t, v = results[name]
+        if end is not None and len(t) and t[-1] < end:
+            t, v = np.append(t, end), np.vstack([v, v[-1:]])
+        width = v.shape[1]
+        for j in range(width):
+            ax.step(t, v[:, j], where="post", label=f"[{j}]" if width > 1 else None, lw=1.2)
+        if stop is not None:
+            ax.axvline(stop, color="tab:red", ls="--", lw=1.0)
+        ax.set_ylabel(name, rotation=0, ha="right", va="center")
+        ax.grid(True, alpha=0.3)
+        if 1 < width <= MAX_LEGEND:
+            ax.legend(loc="upper right", fontsize="small", ncol=min(width, 6))
+    if stop is not None:
+        axes[0, 0].annotate(results.status.split(": ", 1)[0], xy=(stop, 1.0), xycoords=("data", "axes fraction"),
+                            xytext=(0, 3), textcoords="offset points", ha="right", va="bottom",
+                            color="tab:red", fontsize="small")
+    axes[-1, 0].set_xlabel("time (s)")
+    heading = title or results.info.get("diagram", "")
+    if not results.complete:
+        heading += "\n" + textwrap.fill(f"[{results.status}]", TITLE_WIDTH)
+    fig.suptitle(heading)
+    fig.tight_layout()
+    return fig
+
+
+def time_span(results: Results) -> tuple[float | None, float | None]:
+    """(the time the plots reach, the time a failed or interrupted run stopped or None).
+
+    A complete run reaches its t_end; an incomplete one where it stopped (its last sample
+    when its run.json does not say), never its t_end: its signals were not held that far."""
+    if results.complete:
+        return results.info.get("t_end"), None
+    stop = results.stop_time
+    if stop is None:
+        stop = max((float(t[-1]) for t, _ in results.signals.values() if len(t)), default=None)
+    return stop, stop

@@ -1,23 +1,22 @@
 """Logged signals of a run, their files (signals.npz, signals.csv, run.json) and reloading.
 
-Each signal keeps its own sample times. Files are written atomically (temporary file in
-the same folder, then rename), so a reader never sees half a file, and a failed run's
-partial results are saved the same way with a status saying where it stopped.
+Each signal keeps its own sample times. A run's files replace the previous run's in the
+results folder as one set (``results_folder``), so a reader never sees half a file nor
+files of two runs, and a failed or interrupted run's partial results are saved the same
+way with a status saying where it stopped.
 """
 
 from __future__ import annotations
 
 import json
-import os
-import tempfile
+import re
 from pathlib import Path
 from typing import Iterator
 
 import numpy as np
 
-SIGNALS_NPZ = "signals.npz"
-SIGNALS_CSV = "signals.csv"
-RUN_JSON = "run.json"
+from .results_folder import RUN_JSON, SIGNALS_CSV, SIGNALS_NPZ, reading, writing
+
 TIME_PREFIX = "time:"
 
 
@@ -63,8 +62,19 @@ class Results:
 
     @property
     def interrupted(self) -> bool:
-        """True when the run was stopped by Ctrl-C rather than by its end time or a failure."""
+        """True when the run was stopped (Ctrl-C, SIGTERM) rather than by its end time or a failure."""
         return self.status.startswith("interrupted")
+
+    @property
+    def stop_time(self) -> float | None:
+        """Where a failed or interrupted run stopped: run.json's ``t_stop``, or the time in
+        the status of files written before it was recorded; None for a complete run."""
+        if self.complete:
+            return None
+        if self.info.get("t_stop") is not None:
+            return float(self.info["t_stop"])
+        found = re.match(r"\w+ at t=([-+0-9.eE]+) s", self.status)
+        return float(found.group(1)) if found else None
 
     def value_at(self, name: str, t: float) -> np.ndarray:
         """The held (zero-order hold) value of a signal at time ``t``."""
@@ -77,22 +87,28 @@ class Results:
     # -- files ---------------------------------------------------------------------
 
     def save(self, directory: str | Path, csv: bool = False) -> Path:
-        """Write signals.npz and run.json (and signals.csv) into ``directory``."""
-        directory = Path(directory)
-        directory.mkdir(parents=True, exist_ok=True)
+        """Write signals.npz and run.json (and signals.csv) into ``directory``, replacing
+        the result files of the run saved there before as one set."""
+        with writing(directory) as staged:
+            self.write_files(staged, csv)
+        return Path(directory)
+
+    def write_files(self, folder: Path, csv: bool = False) -> None:
+        """Write signals.npz, run.json (and signals.csv) into ``folder`` as they are: the
+        staging folder of ``results_folder.writing``, which makes them one set."""
         arrays = {}
         for name, (t, v) in self.signals.items():
             arrays[name] = v
             arrays[TIME_PREFIX + name] = t
-        _atomic_write(directory / SIGNALS_NPZ, lambda f: np.savez(f, **arrays))
+        with open(folder / SIGNALS_NPZ, "wb") as f:
+            np.savez(f, **arrays)
         if csv:
-            _atomic_write(directory / SIGNALS_CSV, lambda f: self.write_csv(f))
+            with open(folder / SIGNALS_CSV, "wb") as f:
+                self.write_csv(f)
         info = dict(self.info)
         info["signals"] = {n: {"width": int(v.shape[1]), "samples": int(v.shape[0])}
                            for n, (t, v) in self.signals.items()}
-        text = json.dumps(info, indent=2, default=str) + "\n"
-        _atomic_write(directory / RUN_JSON, lambda f: f.write(text.encode("utf-8")))
-        return directory
+        (folder / RUN_JSON).write_text(json.dumps(info, indent=2, default=str) + "\n", encoding="utf-8")
 
     def write_csv(self, f) -> None:
         """Columns ``time`` (every logged sample time) and each signal held at those times."""
@@ -115,24 +131,17 @@ class Results:
         """Read a results folder written by ``save`` (or ``hierhand run``)."""
         directory = Path(directory)
         npz, meta = directory / SIGNALS_NPZ, directory / RUN_JSON
-        if not npz.is_file():
-            raise ResultsError(f"{directory}: no {SIGNALS_NPZ} here; is this the -o folder of a run?")
-        try:
-            info = json.loads(meta.read_text(encoding="utf-8")) if meta.is_file() else {}
-            with np.load(npz, allow_pickle=False) as data:
-                signals = {k: (data[TIME_PREFIX + k], data[k]) for k in data.files
-                           if not k.startswith(TIME_PREFIX)}
-        except (OSError, ValueError, KeyError) as exc:
-            raise ResultsError(f"{directory}: cannot read results: {exc}") from None
+        with reading(directory):
+            if not npz.is_file():
+                raise ResultsError(f"{directory}: no {SIGNALS_NPZ} here; is this the -o folder of a run?")
+            if not meta.is_file():
+                raise ResultsError(f"{directory}: no {RUN_JSON} beside {SIGNALS_NPZ}: the results were "
+                                   "being replaced when their run stopped; run it again")
+            try:
+                info = json.loads(meta.read_text(encoding="utf-8"))
+                with np.load(npz, allow_pickle=False) as data:
+                    signals = {k: (data[TIME_PREFIX + k], data[k]) for k in data.files
+                               if not k.startswith(TIME_PREFIX)}
+            except (OSError, ValueError, KeyError) as exc:
+                raise ResultsError(f"{directory}: cannot read results: {exc}") from None
         return cls(signals, info)
-
-
-def _atomic_write(path: Path, write) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            write(f)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise

@@ -46,6 +46,15 @@ class SimulationError(Exception):
         self.port = port
 
 
+class StopRequest(KeyboardInterrupt):
+    """A request to stop a run early, like Ctrl-C, with a ``reason`` for the status
+    (a program that turns SIGTERM into a stop raises ``StopRequest("SIGTERM")``)."""
+
+    def __init__(self, reason: str):
+        super().__init__(reason)
+        self.reason = reason
+
+
 class _StepFailure(Exception):
     def __init__(self, block: str, phase: str, tick: int, error: BaseException):
         super().__init__(str(error))
@@ -165,6 +174,8 @@ class _Run:
             self.loggers[e.block].append(lg)
             self.all_loggers.append(lg)
         self.checked: set[str] = set()
+        self.reached: int | None = None
+        """The tick an interrupted advance span had logged, when the interrupt came in one."""
 
     # -- building the per-event programs ------------------------------------------------
 
@@ -176,7 +187,7 @@ class _Run:
                    for i, (b, ports) in enumerate(program.evaluate)]
         updates = [self.update_op(b) for b in program.update]
         samples = [self.sample_op(self.d.connections[i]) for i in program.sample]
-        advances = [self.advance_op(b) for b in program.advance]
+        advances = [self.advance_op(b, last=b == program.advance[-1]) for b in program.advance]
 
         def run(k: int, next_k: int) -> None:
             t = k * num / den
@@ -238,7 +249,10 @@ class _Run:
 
         return op
 
-    def advance_op(self, name: str):
+    def advance_op(self, name: str, last: bool):
+        """Steps ``name`` to the next event in chunks. An interrupt in the span records how
+        far the last advanced block of the event got (the earlier ones are further, the
+        later ones still at the event): every block was computed up to there."""
         blk = self.d.blocks[name].block
         advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
         period, dt = self.s.period_ticks[name], float(blk.period)
@@ -265,14 +279,25 @@ class _Run:
                     done += m
                     t += m * dt
                 for p, dests in targets:
-                    last = rows[p][-1]
+                    value = rows[p][-1]
                     for d, dp in dests:
-                        d[dp] = last
+                        d[dp] = value
+            except KeyboardInterrupt:
+                if last:
+                    self.reached = self.logged_tick(name, k + done * period)
+                raise
             except Exception as exc:
                 done += self.log_partial_rows(name, exc, ports, loggers)
                 raise _StepFailure(name, "advance", k + done * period, exc) from exc
 
         return op
+
+    def logged_tick(self, name: str, counted: int) -> int:
+        """The tick of the last hit of ``name`` that its logs hold, which is where its data
+        reach even when an interrupt fell between logging a chunk and counting it;
+        ``counted`` when nothing of it is logged."""
+        hits = max((lg.hits + sum(len(rows) for rows in lg.pending) for lg in self.loggers[name]), default=0)
+        return int(self.s.nth_hits(name, np.array([hits - 1]))[0]) if hits else counted
 
     def check_outputs(self, name: str, out: Any, ports: tuple[str, ...]) -> None:
         blk = self.d.blocks[name].block
@@ -331,7 +356,7 @@ class _Run:
         n = self.n_ticks
         wall0 = time.perf_counter()
         failure: _StepFailure | None = None
-        interrupted = False
+        interrupted: KeyboardInterrupt | None = None
         k = 0
         stream = self.events()
         initial = self.compile(self.s.initial)
@@ -354,10 +379,12 @@ class _Run:
             final(n, n)
         except _StepFailure as exc:
             failure = exc
-        except KeyboardInterrupt:
-            interrupted = True
+        except KeyboardInterrupt as exc:
+            interrupted = exc
+            if self.reached is not None:
+                k = max(k, self.reached)
         wall = time.perf_counter() - wall0
-        if progress is not None and failure is None and not interrupted:
+        if progress is not None and failure is None and interrupted is None:
             progress(1.0, wall)
         t_fail = float((failure.tick if failure is not None else k) * self.s.base_tick)
         if failure is not None:
@@ -367,14 +394,24 @@ class _Run:
             signal = f", signal {failure.block}.{port}" if port else ""
             status = (f"failed at t={t_fail:.9g} s: block '{failure.block}' ({spec.type_name}){signal} "
                       f"{failure.phase}: {err}")
-        elif interrupted:
-            status = f"interrupted at t={t_fail:.9g} s"
+        elif interrupted is not None:
+            by = f" by {interrupted.reason}" if isinstance(interrupted, StopRequest) else ""
+            status = f"interrupted at t={t_fail:.9g} s{by}"
         else:
             status = "complete"
-        results = Results(self.collect(), self.info(status, wall, t_fail if status != "complete" else None))
+        t_stop = t_fail if status != "complete" else None
+        results = Results(self.collect_through_interrupt(), self.info(status, wall, t_stop))
         if failure is not None:
             return results, SimulationError(status, results, failure.block, t_fail, port)
         return results, None
+
+    def collect_through_interrupt(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """``collect``, once more if an interrupt cuts it short: the signals are all there
+        is of the run (a program that defers later interrupts lets the second try finish)."""
+        try:
+            return self.collect()
+        except KeyboardInterrupt:
+            return self.collect()
 
     def collect(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         for lg in self.all_loggers:
@@ -399,6 +436,7 @@ class _Run:
             "base_tick": format_duration(self.s.base_tick),
             "wall_time_s": wall,
             "real_time_factor": simulated / wall if wall > 0 else None,
+            "t_stop": t_stop,
             "block_types": {name: spec.type_name for name, spec in self.d.blocks.items()},
             "parameters": self.d.parameters(),
             "versions": dict(package_versions()),

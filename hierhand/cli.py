@@ -1,7 +1,9 @@
 """The ``hierhand`` command line: run, validate, graph, plot, sweep and list blocks.
 
 Exit codes: 0 ok, 2 bad input (a one-line message per problem, no traceback), 1 a failure
-during a simulation (the message names block, time and signal; partial results are kept).
+during a simulation (the message names block, time and signal; partial results are kept)
+or results that could not be saved where asked, 130 Ctrl-C and 143 SIGTERM (a run saves
+what it computed, marked interrupted).
 """
 
 from __future__ import annotations
@@ -36,9 +38,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (UsageError, ResultsError) as exc:
         print(f"hierhand: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        from hierhand.stop_signals import exit_code
+
         print("hierhand: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return exit_code(exc)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -255,32 +259,50 @@ class ProgressBar:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from blocks import simulate
-    from blocks.plot import plot_signals
+    """Simulate and save. The output folder is checked before the run; Ctrl-C or SIGTERM
+    stops the run and its results so far are saved, and no signal cuts the saving short
+    (``stop_signals``); after an interrupt the plots are skipped, to stop soon."""
+    from blocks import DiagramError, simulate
+    from blocks.results_folder import OutputFolderError
     from blocks.safepath import folder_name
+    from hierhand.run_output import check_output, remove_if_empty, save_run
+    from hierhand.stop_signals import StopSignals, exit_code
 
     diagram = load(args)
     t_end = end_time(args, diagram)
     out = args.output or Path("runs") / folder_name(diagram.name)
-    bar = ProgressBar(float(t_end), enabled=not args.quiet)
     try:
-        results = simulate(diagram, t_end=t_end, progress=bar)
-    finally:
-        bar.close()
-    results.save(out, csv=args.csv)
-    plots = []
-    if args.plot and len(results):
-        plots = plot_signals(results, out / "plots" / "signals.png")
+        created = check_output(out)
+    except OutputFolderError as exc:
+        raise UsageError(f"output folder {exc}") from None
+    bar = ProgressBar(float(t_end), enabled=not args.quiet)
+    with StopSignals() as stops:
+        try:
+            results = simulate(diagram, t_end=t_end, progress=bar)
+        except (DiagramError, KeyboardInterrupt):  # refused, or stopped, before it started
+            if created:
+                remove_if_empty(out)
+            raise
+        finally:
+            bar.close()
+        with stops.held():
+            saved = save_run(results, out, csv=args.csv, plot=args.plot and not results.interrupted)
     if not results.complete:
         print(f"hierhand: {diagram.file}: {results.status}", file=sys.stderr)
-        print(f"hierhand: partial results (marked incomplete) saved in {out}", file=sys.stderr)
-        return EXIT_INTERRUPTED if results.interrupted else EXIT_FAILED
+    if saved.problem:
+        print(f"hierhand: {saved.problem}", file=sys.stderr)
+        return EXIT_FAILED
+    if not results.complete:
+        skipped = (f"; plots skipped after the interrupt ('hierhand plot {out}' draws them)"
+                   if args.plot and results.interrupted else "")
+        print(f"hierhand: partial results (marked incomplete) saved in {out}{skipped}", file=sys.stderr)
+        return exit_code(stops.received) if results.interrupted else EXIT_FAILED
     if not args.quiet:
         info = results.info
         rtf = info.get("real_time_factor")
         print(f"{diagram.name}: {float(t_end):g} s simulated in {info['wall_time_s']:.3g} s"
               + (f" ({rtf:.3g}x real time)" if rtf else "") + f"; results in {out}"
-              + (f", plots: {', '.join(str(p) for p in plots)}" if plots else ""))
+              + (f", plots: {', '.join(str(p) for p in saved.plots)}" if saved.plots else ""))
     return EXIT_OK
 
 

@@ -205,7 +205,7 @@ class HandPlant(Block):
             tau, f_ext = self._arguments(state, inputs)
             code, done, which = _step(self._model, state, tau, f_ext)
         if code:
-            raise self._error(code, which, t + done * self.dt)
+            raise self._error(code, which, t, step=True)
         return state
 
     def advance(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray], n: int):
@@ -217,8 +217,8 @@ class HandPlant(Block):
             tau, f_ext = self._arguments(state, inputs)
             code, done, which = _advance(self._model, state, tau, f_ext, rows)
         if code:
-            error = self._error(code, which, t + done * self.dt)
             written = max(done - 1, 0)  # the state after update ``done`` is the bad one: no row for it
+            error = self._error(code, which, t + written * self.dt, step=True)
             error.rows = {name: rows[:written][index] for name, index in _PORT_COLUMNS}
             raise error
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
@@ -266,9 +266,12 @@ class HandPlant(Block):
         if self._model is None:
             raise BlockError("HandPlant is not bound to a period; call bind(period) first")
 
-    def _error(self, code: int, which: int, t: float | None) -> BlockError:
+    def _error(self, code: int, which: int, t: float | None, step: bool = False) -> BlockError:
+        """The error for a native failure code. ``t`` is the time of the state that was
+        evaluated, or with ``step`` the time of the step that failed: the executor's failure
+        time, so that a run's status names one time (the bad state is the one after it)."""
         names = self.hand.names
-        when = "in the given state" if t is None else f"at t={t:.10g} s"
+        when = "in the given state" if t is None else f"in the step at t={t:.10g} s" if step else f"at t={t:.10g} s"
         if code == ERR_PENETRATION:
             r = self.hand.tip_radius[which]
             return BlockError(

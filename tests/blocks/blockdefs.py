@@ -151,6 +151,38 @@ class Weights(Block):
         return {"y": self.weights.copy(), "extra": self.extra.copy()}
 
 
+class InterruptedAccumulator(FastAccumulator):
+    """A FastAccumulator whose ``advance`` raises KeyboardInterrupt at its ``calls``-th call,
+    as Ctrl-C does when it lands inside a long span of advanced hits."""
+
+    def __init__(self, calls: int = 3):
+        super().__init__(1)
+        self.calls = calls
+        self.made = 0
+
+    def advance(self, t, state, inputs, n):
+        self.made += 1
+        if self.made == self.calls:
+            raise KeyboardInterrupt
+        return super().advance(t, state, inputs, n)
+
+
+class Touch(Block):
+    """A source that creates the file ``path`` when it first computes its output (at t = 0):
+    the sign a test waits for that a run has started."""
+
+    outputs = {"y": 1}
+    feedthrough = False
+
+    def __init__(self, path: str = ""):
+        self.path = path
+
+    def output(self, t, state, inputs):
+        with open(self.path, "a", encoding="utf-8"):
+            pass
+        return {"y": np.zeros(1)}
+
+
 class Limits(Block):
     """y = sum of ``gains``; every gain must be positive: each negative one is a
     ``ParameterError`` problem at ``("gains", name)``, a non-mapping ``gains`` a ValueError."""

@@ -327,3 +327,23 @@ log: [b.y]
     assert len(blocks.build_schedule(diagram, diagram.t_end).advanced) <= 1
     reference = loads_diagram(text.replace("FastAccumulator", "Accumulator"), trust=True)
     np.testing.assert_allclose(simulate(diagram)["b.y"][1], simulate(reference)["b.y"][1], rtol=1e-12)
+
+
+def test_an_interrupt_inside_one_long_advance_span_records_the_time_reached():
+    """No other block fires after t = 0, so the whole run is one advance span, made of
+    chunks of ADVANCE_CHUNK hits; Ctrl-C in the third chunk stops it after two."""
+    from blocks.simulate import ADVANCE_CHUNK
+
+    r = run(f"""
+time: {{t_end: 1000 s}}
+blocks:
+  one: {{type: Constant, params: {{value: 1.0}}}}
+  acc: {{type: "{DEFS}:InterruptedAccumulator", period: 1 ms, params: {{calls: 3}}}}
+connections: [one.y -> acc.u]
+log: [acc.y]
+""")
+    reached = 2 * ADVANCE_CHUNK * 1e-3
+    assert r.interrupted and r.status == f"interrupted at t={reached:.9g} s", r.status
+    t, y = r["acc.y"]
+    assert t[-1] == pytest.approx(reached) and y[-1, 0] == 2 * ADVANCE_CHUNK
+    assert r.info["t_stop"] == pytest.approx(reached)

@@ -12,6 +12,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tempfile
 import textwrap
 import zipfile
 from fractions import Fraction
@@ -55,6 +56,16 @@ def native(hand: dict | None = None, f_ext=(0.0, 0.0, 0.0), n_steps: int = N_STE
         for port, values in rows.items():
             values.append(out[port][-1].copy())
     return {port: np.array(r) for port, r in rows.items()}
+
+
+def simulate_in(folder: Path, fmu: Path, **options):
+    """``fmpy.simulate_fmu`` on the FMU unpacked into ``folder`` (a pytest tmp_path).
+
+    Given the .fmu file, fmpy unpacks it into a fresh folder in the system temp and removes
+    that only when the simulation returns: a failing FMU or test left a 1 MB copy of the
+    binaries in /tmp. Given a folder, fmpy unpacks nothing.
+    """
+    return simulate_fmu(extract(str(fmu), folder / "simulated"), **options)
 
 
 def columns(result, names) -> np.ndarray:
@@ -157,21 +168,30 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
-def test_fmu_steps_exactly_as_the_native_block(fmus, fmi):
+def test_fmu_steps_exactly_as_the_native_block(fmus, fmi, tmp_path):
     ref = native()
-    result = simulate_fmu(str(fmus[fmi]), stop_time=N_STEPS * STEP, output_interval=STEP, output=Q + OBJ)
+    result = simulate_in(tmp_path, fmus[fmi], stop_time=N_STEPS * STEP, output_interval=STEP, output=Q + OBJ)
     assert np.allclose(result["time"], np.arange(N_STEPS + 1) * STEP, rtol=0, atol=1e-12)
     np.testing.assert_array_equal(columns(result, Q), ref["q"])
     np.testing.assert_array_equal(columns(result, OBJ), ref["obj"])
     assert np.abs(ref["q"][-1] - ref["q"][0]).max() > 1e-3  # the hand did move (it sags)
 
 
-def test_parameters_and_inputs_are_applied(fmus):
+def test_parameters_and_inputs_are_applied(fmus, tmp_path):
     ref = native(heavy_hand(), f_ext=(0.5, 0.0, 0.0), n_steps=20)
-    result = simulate_fmu(str(fmus[3]), stop_time=20 * STEP, output_interval=STEP, output=Q + OBJ,
+    result = simulate_in(tmp_path, fmus[3], stop_time=20 * STEP, output_interval=STEP, output=Q + OBJ,
                           start_values={"object.mass": 0.6, "f_ext[1]": 0.5})
     np.testing.assert_array_equal(columns(result, OBJ), ref["obj"])
     np.testing.assert_array_equal(columns(result, Q), ref["q"])
+
+
+def test_a_failing_simulation_leaves_nothing_in_the_system_temp(fmus, tmp_path, monkeypatch):
+    system_temp = tmp_path / "system-temp"
+    system_temp.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(system_temp))
+    with pytest.raises(Exception, match="ExitInitializationMode"):
+        simulate_in(tmp_path, fmus[2], stop_time=STEP, start_values={"object.mass": -1.0})
+    assert list(system_temp.iterdir()) == []
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
@@ -239,7 +259,7 @@ def test_a_numerical_blow_up_is_an_error_status_not_a_crash(fmus, fmi, tmp_path)
 
 @pytest.mark.parametrize("fmi", [2, 3])
 def test_communication_step_must_be_a_multiple_of_the_internal_step(fmus, fmi, tmp_path):
-    short = simulate_fmu(str(fmus[fmi]), stop_time=2 * STEP, output_interval=5e-4, output=["q[1]"])
+    short = simulate_in(tmp_path, fmus[fmi], stop_time=2 * STEP, output_interval=5e-4, output=["q[1]"])
     assert len(short) == 5  # 0.5 ms is 5 internal steps
     slave = Slave(fmus[fmi], tmp_path)
     try:

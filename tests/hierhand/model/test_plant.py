@@ -123,8 +123,8 @@ def test_non_finite_state_names_the_quantity_and_time():
 def test_blow_up_in_advance_names_the_joint_and_the_step():
     plant = make_plant()
     tau = np.zeros(9)
-    tau[4] = 1e306  # fore joint 2: the first step overflows
-    with pytest.raises(BlockError, match=r"at t=0\.0101 s: joint velocity qd\[[345]\] \(fore joint [123]\)") as info:
+    tau[4] = 1e306  # fore joint 2: the first step, the one at t = 0.01 s, overflows
+    with pytest.raises(BlockError, match=r"in the step at t=0\.01 s: joint velocity qd\[[345]\] \(fore joint [123]\)") as info:
         plant.advance(0.01, plant.initial_state(), {"tau": tau}, 10)
     assert info.value.port == "qd"
 
@@ -142,12 +142,12 @@ def test_penetration_deeper_than_the_tip_radius_is_an_error():
     """Soft contact and a hard squeeze push the fingertips into the object."""
     plant = make_plant(gravity=[0.0, 0.0], contact={"k_n": 10.0, "c_n": 0.0, "k_t": 10.0, "c_t": 0.0})
     tau = pinch_torques(plant.hand, 3.0, 0.0)
-    with pytest.raises(BlockError, match=r"penetration deeper than the fingertip radius at t=0\.\d+ s: the (thumb|fore) tip") as info:
+    with pytest.raises(BlockError, match=r"penetration deeper than the fingertip radius in the step at t=0\.\d+ s: the (thumb|fore) tip") as info:
         plant.advance(0.0, plant.initial_state(), {"tau": tau}, 5000)
     assert info.value.port == "contact"
     # the steps completed before the failing one come with the error, for the run's log
     t_fail = float(re.search(r"at t=([0-9.]+) s", str(info.value)).group(1))
-    done = round(t_fail / plant.dt) - 1  # rows for the good states before the one at t_fail
+    done = round(t_fail / plant.dt)  # rows for the good states up to the failing step's start
     assert 0 < done < 5000
     assert {name: rows.shape for name, rows in info.value.rows.items()} == \
         {name: (done, width) for name, width in plant.outputs.items()}
@@ -202,3 +202,29 @@ def test_a_set_path_into_the_whole_sections_starts_from_the_default_hand():
     # merged key by key: a partial object keeps deriving its inertia from its own mass
     assert HandPlant.param_default("object") is None and HandPlant.param_default("contact") is None
     assert HandPlant(object={"mass": 0.6}).hand.params.object.inertia == pytest.approx(0.6 * 0.005 / 12)
+
+
+BLOW_UP = """\
+name: blow-up
+time: {t_end: 10 ms}
+blocks:
+  tau: {type: Step, period: 1 ms, params: {time: 0.002, before: [0, 0, 0, 0, 0, 0, 0, 0, 0],
+                                           after: [0, 0, 0, 0, 1.0e150, 0, 0, 0, 0]}}
+  plant: {type: HandPlant, period: 0.1 ms}
+connections: [tau.y -> plant.tau]
+log: [plant.q]
+"""
+
+
+def test_a_blow_up_inside_an_advance_span_is_reported_at_one_time():
+    """From 2 ms the huge torque overflows the state in the third step of the span (the
+    step at 2.2 ms): the run's status and the plant's message name that one time, and the
+    log reaches it."""
+    from blocks import loads_diagram, simulate
+
+    results = simulate(loads_diagram(BLOW_UP))
+    times = re.findall(r"t=([0-9.e+-]+) s", results.status)
+    assert times == ["0.0022", "0.0022"], results.status
+    assert "in the step at t=0.0022 s" in results.status
+    t, _ = results["plant.q"]
+    assert t[-1] == pytest.approx(0.0022)

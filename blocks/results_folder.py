@@ -1,0 +1,143 @@
+"""A results folder written as one consistent set of files, whoever else writes there.
+
+A run's files (signals.npz, run.json, signals.csv with --csv, plots/signals*.png with
+--plot) must belong together: two runs into one folder must never leave one run's
+run.json beside the other's signals.npz, nor a run without --csv an earlier run's
+signals.csv. So a run writes its files into a private staging folder inside the results
+folder, then, holding an exclusive lock on the folder, replaces the previous run's result
+files with them: run.json is removed first and put in last, so a folder with a run.json
+holds one complete set, and a folder left without one (the machine stopped while the
+files were replaced) reads as incomplete, never as a mix. Readers hold a shared lock, so
+they never see a set half replaced either.
+
+The result files belong to the run that wrote them and go when the next run replaces
+them; any other file in the folder is the user's and stays. Locks are POSIX ``flock``
+on the folder; where there is none (Windows), writers are not serialised.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Iterator
+
+try:
+    import fcntl
+except ImportError:  # Windows: no flock
+    fcntl = None
+
+SIGNALS_NPZ = "signals.npz"
+SIGNALS_CSV = "signals.csv"
+RUN_JSON = "run.json"
+PLOTS = "plots"
+PLOT_PATTERN = "signals*.png"
+STAGING_PREFIX = ".staging-"
+"""Prefix of the private folders that runs write into before their files replace the old ones."""
+
+
+class OutputFolderError(OSError):
+    """A results folder that cannot be created or written: '``directory`` ``reason``'."""
+
+    def __init__(self, directory: Path, reason: str):
+        super().__init__(f"{directory} {reason}")
+        self.reason = reason
+
+
+def prepare(directory: str | Path) -> Path:
+    """Create ``directory`` if needed and prove that this process can write in it (a probe
+    file is created and removed), so that a bad output folder is found before a run rather
+    than after it, when the results would have nowhere to go."""
+    directory = Path(directory)
+    if directory.exists() and not directory.is_dir():
+        raise OutputFolderError(directory, "is a file, not a folder")
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        blocker = next((p for p in directory.parents if p.exists() and not p.is_dir()), directory)
+        raise OutputFolderError(directory, f"cannot be created: {blocker} is a file") from None
+    except OSError as exc:
+        raise OutputFolderError(directory, f"cannot be created: {exc.strerror or exc}") from None
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".write-probe-", dir=directory)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OutputFolderError(directory, f"is not writable: {exc.strerror or exc}") from None
+    return directory
+
+
+@contextlib.contextmanager
+def writing(directory: str | Path) -> Iterator[Path]:
+    """A fresh staging folder for one run's files; when the block ends without an error,
+    they replace the result files in ``directory`` as one set (see the module's note).
+    On an error the staging folder goes and the folder is left as it was."""
+    directory = Path(directory)
+    directory.mkdir(parents=True, exist_ok=True)
+    with _locked(directory, exclusive=True) as locked:
+        if locked:
+            for stale in directory.glob(STAGING_PREFIX + "*"):
+                shutil.rmtree(stale, ignore_errors=True)  # a writer that died: only writers hold the lock
+        staged = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=directory))
+        try:
+            yield staged
+            _replace(directory, staged)
+        finally:
+            shutil.rmtree(staged, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def reading(directory: str | Path) -> Iterator[None]:
+    """Hold a shared lock on ``directory`` while its files are read."""
+    with _locked(Path(directory), exclusive=False):
+        yield
+
+
+def _replace(directory: Path, staged: Path) -> None:
+    """Put the staged files in place of the folder's result files, run.json last."""
+    marker = directory / RUN_JSON
+    marker.unlink(missing_ok=True)
+    for name in (SIGNALS_NPZ, SIGNALS_CSV):
+        if (staged / name).exists():
+            os.replace(staged / name, directory / name)
+        else:
+            (directory / name).unlink(missing_ok=True)
+    _replace_plots(directory / PLOTS, staged / PLOTS)
+    if (staged / RUN_JSON).exists():
+        os.replace(staged / RUN_JSON, marker)
+
+
+def _replace_plots(plots: Path, staged: Path) -> None:
+    new = sorted(staged.glob(PLOT_PATTERN)) if staged.is_dir() else []
+    old = {p.name for p in plots.glob(PLOT_PATTERN)} if plots.is_dir() else set()
+    if new:
+        plots.mkdir(exist_ok=True)
+    for path in new:
+        os.replace(path, plots / path.name)
+    for name in old - {p.name for p in new}:
+        (plots / name).unlink(missing_ok=True)
+    if old and not new and not any(plots.iterdir()):
+        plots.rmdir()
+
+
+@contextlib.contextmanager
+def _locked(directory: Path, exclusive: bool) -> Iterator[bool]:
+    """flock ``directory``; yields whether the lock is held (False where locks are unavailable)."""
+    try:
+        fd = os.open(directory, os.O_RDONLY)
+    except OSError:
+        yield False
+        return
+    try:
+        held = False
+        if fcntl is not None:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+                held = True
+            except OSError:  # a file system without locks: go on unserialised
+                pass
+        yield held
+    finally:
+        os.close(fd)
