@@ -25,15 +25,15 @@ import functools
 import sys
 from typing import Any, Callable
 
-_noted = False
+_noted: KeyboardInterrupt | None = None
+"""The interrupt noted since the last check (kept whole: a StopRequest names its signal)."""
 _previous: Callable[[Any], None] | None = None
 
 
 def _hook(unraisable: Any) -> None:
     """``sys.unraisablehook``: note a KeyboardInterrupt lost in one of our callbacks."""
-    global _noted
     if issubclass(unraisable.exc_type, KeyboardInterrupt) and getattr(unraisable.object, "fmu_callback", False):
-        _noted = True
+        note(unraisable.exc_value)
         return
     (_previous or sys.__unraisablehook__)(unraisable)
 
@@ -54,31 +54,31 @@ def callback(function: Callable[..., None]) -> Callable[..., None]:
     def guarded(*args: Any) -> None:
         try:
             function(*args)
-        except KeyboardInterrupt:
-            note()
+        except KeyboardInterrupt as interrupt:
+            note(interrupt)
 
     guarded.fmu_callback = True  # type: ignore[attr-defined]
     return guarded
 
 
-def note() -> None:
+def note(interrupt: KeyboardInterrupt | None = None) -> None:
     """Remember an interrupt that could not be raised where it happened."""
     global _noted
-    _noted = True
+    _noted = interrupt if interrupt is not None else KeyboardInterrupt()
 
 
 def check() -> None:
-    """Raise KeyboardInterrupt if one was noted since the last check."""
+    """Raise the interrupt noted since the last check, if any, as it was raised."""
     global _noted
-    if _noted:
-        _noted = False
-        raise KeyboardInterrupt
+    if _noted is not None:
+        interrupt, _noted = _noted, None
+        raise interrupt
 
 
 def deliver() -> None:
     """Hand a noted interrupt back to Python's own signal handling, where it cannot be
     raised on the spot (freeing an instance from a finalizer)."""
     global _noted
-    if _noted:
-        _noted = False
+    if _noted is not None:
+        _noted = None
         _thread.interrupt_main()

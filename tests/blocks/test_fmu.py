@@ -354,14 +354,16 @@ def test_an_interrupt_lost_in_a_callback_is_raised_after_the_call():
         fmu_interrupt.check()
     fmu_interrupt.check()                                   # noted once, raised once
     fmu_interrupt.arm()
-    sys.unraisablehook(SimpleNamespace(exc_type=KeyboardInterrupt, object=log))
-    with pytest.raises(KeyboardInterrupt):
+    lost = KeyboardInterrupt()
+    sys.unraisablehook(SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=lost, object=log))
+    with pytest.raises(KeyboardInterrupt) as raised:
         fmu_interrupt.check()
+    assert raised.value is lost                             # the interrupt itself, e.g. a StopRequest
     seen = []
     before = sys.unraisablehook
     sys.unraisablehook = seen.append                        # others' hooks keep their messages
     fmu_interrupt.arm()
-    other = SimpleNamespace(exc_type=KeyboardInterrupt, object=print)
+    other = SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=KeyboardInterrupt(), object=print)
     sys.unraisablehook(other)
     assert seen == [other]
     fmu_interrupt.check()

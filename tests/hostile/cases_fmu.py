@@ -136,8 +136,8 @@ def _running_cases() -> list[Case]:
                       files={"d.yaml": diagram(), "plant.fmu": fmu(marker, identifier="Traced_run")},
                       check=ran("Traced_run", {"loaded", "instantiated"})))
     cases.append(Case("fmu-ctrl-c-in-do-step-is-an-interrupt", ("run", "d.yaml", "-o", "out", "-q"), 130,
-                      r"interrupted at t=0\.2 s", files={"d.yaml": diagram(), "plant.fmu": fmu(interrupting)},
-                      check=saved_as("interrupted at t=0.2 s")))
+                      r"interrupted at t=0\.2 s by SIGINT", files={"d.yaml": diagram(), "plant.fmu": fmu(interrupting)},
+                      check=saved_as("interrupted at t=0.2 s by SIGINT")))
     return cases
 
 
