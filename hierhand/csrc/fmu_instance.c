@@ -236,41 +236,45 @@ static void report_parameter(void *context, int param, const char *text)
     LOG_ERROR(inst, "invalid parameter: %s %s", hh_hand_param_name(param), text);
 }
 
-static void describe_failure(const hh_instance *inst, int code, int which, double t)
+/* Log a plant failure; 'step' says whether t is the time of the step that failed (its
+ * start, as HandPlant reports it) or of the state that was evaluated. */
+static void describe_failure(const hh_instance *inst, int code, int which, double t, int step)
 {
+    char when[64];
+    snprintf(when, sizeof when, "%s t=%.10g s", step ? "in the step at" : "at", t);
     static const char *axes[] = {"x", "y", "theta"}, *rates[] = {"vx", "vy", "omega"};
     const char *finger = inst->finger_names[(which / 3) % HH_FINGERS];
     switch (code) {
     case HH_ERR_PENETRATION:
         LOG_ERROR(inst,
-                  "contact penetration deeper than the fingertip radius at t=%.10g s: the %s tip centre is inside "
+                  "contact penetration deeper than the fingertip radius %s: the %s tip centre is inside "
                   "the object; the contact is too soft for the forces or the step too large",
-                  t, inst->finger_names[which % HH_FINGERS]);
+                  when, inst->finger_names[which % HH_FINGERS]);
         break;
     case HH_ERR_Q:
-        LOG_ERROR(inst, "non-finite value at t=%.10g s: joint angle q[%d] (%s joint %d) is not finite", t, which + 1,
+        LOG_ERROR(inst, "non-finite value %s: joint angle q[%d] (%s joint %d) is not finite", when, which + 1,
                   finger, which % 3 + 1);
         break;
     case HH_ERR_QD:
-        LOG_ERROR(inst, "non-finite value at t=%.10g s: joint velocity qd[%d] (%s joint %d) is not finite", t,
+        LOG_ERROR(inst, "non-finite value %s: joint velocity qd[%d] (%s joint %d) is not finite", when,
                   which + 1, finger, which % 3 + 1);
         break;
     case HH_ERR_OBJ:
-        LOG_ERROR(inst, "non-finite value at t=%.10g s: object pose obj[%d] (%s) is not finite", t, which + 1,
+        LOG_ERROR(inst, "non-finite value %s: object pose obj[%d] (%s) is not finite", when, which + 1,
                   axes[which % 3]);
         break;
     case HH_ERR_OBJ_VEL:
-        LOG_ERROR(inst, "non-finite value at t=%.10g s: object velocity obj_vel[%d] (%s) is not finite", t,
+        LOG_ERROR(inst, "non-finite value %s: object velocity obj_vel[%d] (%s) is not finite", when,
                   which + 1, rates[which % 3]);
         break;
     case HH_ERR_TAU:
-        LOG_ERROR(inst, "non-finite input at t=%.10g s: tau[%d] (%s joint %d)", t, which + 1, finger, which % 3 + 1);
+        LOG_ERROR(inst, "non-finite input %s: tau[%d] (%s joint %d)", when, which + 1, finger, which % 3 + 1);
         break;
     case HH_ERR_F_EXT:
-        LOG_ERROR(inst, "non-finite input at t=%.10g s: f_ext[%d]", t, which + 1);
+        LOG_ERROR(inst, "non-finite input %s: f_ext[%d]", when, which + 1);
         break;
     default:
-        LOG_ERROR(inst, "the plant failed at t=%.10g s (code %d)", t, code);
+        LOG_ERROR(inst, "the plant failed %s (code %d)", when, code);
     }
 }
 
@@ -297,7 +301,7 @@ static int build_model(hh_instance *inst)
     int which;
     int code = hh_output(&inst->model, &inst->work, inst->state, inst->outputs, &which);
     if (code != HH_OK) {
-        describe_failure(inst, code, which, inst->start_time);
+        describe_failure(inst, code, which, inst->start_time, 0);
         release_model(inst);
         return -1;
     }
@@ -463,9 +467,9 @@ hh_status hh_instance_do_step(hh_instance *inst, double current_time, double ste
     int which;
     int code = hh_advance(&inst->model, &inst->work, inst->state, inst->inputs, inst->inputs + 9, n, inst->outputs, 0,
                           &done, &which);
-    double failed_at = hh_instance_time(inst) + (double)done * inst->dt;
     if (code != HH_OK) {
-        describe_failure(inst, code, which, failed_at);
+        /* step 'done' is the one that failed: it started 'done - 1' steps in */
+        describe_failure(inst, code, which, hh_instance_time(inst) + (double)(done > 0 ? done - 1 : 0) * inst->dt, 1);
         inst->phase = HH_FAILED;
         return HH_STATUS_ERROR;
     }
