@@ -4,12 +4,21 @@ loader and the executor, against a hand-written Python loop of the same equation
 Prints microseconds per base tick (0.1 ms) for both, median of several runs, and the
 ratio. Target: at most 1 us per base tick through the executor.
 
-    python benchmarks/scheduler.py [--t-end 1] [--repeat 7]
+Then planning cost: chains ``src: Constant -> g0 -> ... -> g{n-1}`` of n Gain blocks,
+generated in memory, loaded and planned (``loads_diagram``) and run for 2 base ticks.
+Time per block should stay roughly constant from 1 000 to 100 000 blocks (near-linear
+planning); the ratio column compares it with the smallest chain. What growth remains is
+mostly Python's cyclic garbage collector walking a heap of millions of objects;
+``--no-gc`` pauses it during the chains to show the planner's own growth.
+
+    python benchmarks/scheduler.py [--t-end 1] [--repeat 7] [--chains 1000,10000,100000]
+                                   [--chain-repeat 3] [--no-gc]
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import statistics
 import time
 from pathlib import Path
@@ -50,10 +59,60 @@ def timed(fn, repeat: int) -> tuple[float, object]:
     return statistics.median(times), result
 
 
+def chain_text(n: int) -> str:
+    """A diagram of a Constant and ``n`` Gain blocks in a line, over 2 base ticks of 1 ms."""
+    lines = ["time: {t_end: 2 ms}", "blocks:", "  src: {type: Constant, period: 1 ms, params: {value: 1.0}}"]
+    lines += [f"  g{i}: {{type: Gain, params: {{k: 1.0}}}}" for i in range(n)]
+    lines += ["connections:", "  - src.y -> g0.u"] + [f"  - g{i - 1}.y -> g{i}.u" for i in range(1, n)]
+    lines.append(f"log: [g{n - 1}.y]")
+    return "\n".join(lines) + "\n"
+
+
+def chain_times(n: int, repeat: int) -> tuple[float, float]:
+    """Median seconds to load + plan, and to simulate 2 ticks, a chain of ``n`` blocks."""
+    text = chain_text(n)
+    plans, runs = [], []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        diagram = blocks.loads_diagram(text, filename=f"chain{n}")
+        t1 = time.perf_counter()
+        results = blocks.simulate(diagram)
+        t2 = time.perf_counter()
+        if results.status != "complete" or results[f"g{n - 1}.y"][1][-1, 0] != 1.0:
+            raise SystemExit(f"chain of {n} blocks: wrong run ({results.status})")
+        plans.append(t1 - t0)
+        runs.append(t2 - t1)
+    return statistics.median(plans), statistics.median(runs)
+
+
+def report_chains(sizes: list[int], repeat: int, collect: bool) -> None:
+    gc_note = "" if collect else ", garbage collector paused"
+    print(f"\nplanning cost: chains src -> g0 -> ... of n Gain blocks, 2 base ticks, median of {repeat}{gc_note}")
+    print(f"{'blocks':>8} {'load+plan s':>12} {'us/block':>9} {'ratio':>6} {'simulate s':>11} "
+          f"{'us/block':>9} {'ratio':>6}")
+    first = None
+    for n in sizes:
+        if not collect:
+            gc.disable()
+        try:
+            plan, run = chain_times(n, repeat)
+        finally:
+            gc.enable()
+        per = (plan / n * 1e6, run / n * 1e6)
+        first = first or per
+        print(f"{n:>8} {plan:>12.3f} {per[0]:>9.1f} {per[0] / first[0]:>6.2f} {run:>11.3f} "
+              f"{per[1]:>9.1f} {per[1] / first[1]:>6.2f}")
+    print("ratio: time per block against the smallest chain (near 1: linear growth)")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--t-end", type=float, default=1.0, help="simulated seconds per run")
     ap.add_argument("--repeat", type=int, default=7, help="runs per measurement (median)")
+    ap.add_argument("--chains", default="1000,10000,100000",
+                    help="comma-separated chain lengths for the planning cost ('' to skip)")
+    ap.add_argument("--chain-repeat", type=int, default=3, help="runs per chain length (median)")
+    ap.add_argument("--no-gc", action="store_true", help="pause the garbage collector during the chains")
     args = ap.parse_args()
     n_ticks = round(args.t_end / 1e-4)
 
@@ -75,6 +134,9 @@ def main() -> None:
     print(f"blocks (simulate only)     : {t_exec * per:7.3f} us/tick   ratio to hand loop {t_exec / t_hand:6.2f}")
     print(f"max |difference| to hand loop: {err:.2e}")
     print(f"target: <= 1 us/tick through loader + scheduler: {'met' if t_full * per <= 1.0 else 'NOT met'}")
+    sizes = [int(n) for n in args.chains.split(",") if n.strip()]
+    if sizes:
+        report_chains(sizes, args.chain_repeat, collect=not args.no_gc)
 
 
 if __name__ == "__main__":

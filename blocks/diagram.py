@@ -25,6 +25,7 @@ from .references import Reference, build_order, chain_text
 from .registry import RegistryError, resolve_type
 from .safepath import inside
 from .timebase import DurationError, parse_duration
+from .widths import propagate_widths
 from .yamlsource import LineDict, LineList, YamlSourceError, line_at, line_of, load_yaml, read_yaml_file
 
 TOP_KEYS = ("version", "name", "description", "time", "blocks", "connections", "log")
@@ -712,23 +713,8 @@ class _Loader:
 
     def infer_widths(self, blocks: dict[str, BlockSpec], connections: list[Connection]) -> None:
         """Give polymorphic ports (width None) the width of what they connect to."""
-        inferred: dict[str, int] = {}
-
-        def width(block: str, kind: str, port: str) -> int | None:
-            w = getattr(blocks[block].block, kind)[port]
-            return w if w is not None else inferred.get(block)
-
-        changed = True
-        while changed:
-            changed = False
-            for c in connections:
-                ws, wd = width(c.src_block, "outputs", c.src_port), width(c.dst_block, "inputs", c.dst_port)
-                if ws is not None and wd is None:
-                    inferred[c.dst_block] = ws
-                    changed = True
-                elif wd is not None and ws is None:
-                    inferred[c.src_block] = wd
-                    changed = True
+        inferred = propagate_widths(lambda block, kind, port: getattr(blocks[block].block, kind)[port],
+                                    connections)
         for name, spec in blocks.items():
             ports = {**spec.block.inputs, **spec.block.outputs}
             if any(w is None for w in ports.values()):

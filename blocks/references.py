@@ -40,28 +40,37 @@ def build_order(references: Mapping[str, Mapping[str, str]]) -> tuple[list[str],
     """
     order: list[str] = []
     done: set[str] = set()
-    path: list[str] = []
     cycles: list[list[Reference]] = []
-
-    def visit(name: str) -> None:
-        path.append(name)
-        for param, target in references[name].items():
-            if target not in references or target in done:
-                continue
-            if target in path:
-                members = path[path.index(target):]
-                cycle = [_closing(references, b, members[(i + 1) % len(members)]) for i, b in enumerate(members)]
-                if cycle not in cycles:  # two parameters naming the same block close it twice
-                    cycles.append(cycle)
-                continue
-            visit(target)
-        path.pop()
-        done.add(name)
-        order.append(name)
-
-    for name in references:
-        if name not in done:
-            visit(name)
+    found: set[tuple[Reference, ...]] = set()
+    for root in references:
+        if root in done:
+            continue
+        # depth-first, with an explicit stack so that a long chain of references does
+        # not reach Python's recursion limit; ``on_path`` gives a block's place in it
+        path = [root]
+        on_path = {root: 0}
+        pending = [iter(references[root].values())]
+        while pending:
+            for target in pending[-1]:
+                if target not in references or target in done:
+                    continue
+                if target in on_path:
+                    members = path[on_path[target]:]
+                    cycle = [_closing(references, b, members[(i + 1) % len(members)]) for i, b in enumerate(members)]
+                    if tuple(cycle) not in found:  # two parameters naming the same block close it twice
+                        found.add(tuple(cycle))
+                        cycles.append(cycle)
+                    continue
+                on_path[target] = len(path)
+                path.append(target)
+                pending.append(iter(references[target].values()))
+                break
+            else:
+                pending.pop()
+                name = path.pop()
+                del on_path[name]
+                done.add(name)
+                order.append(name)
     return order, cycles
 
 

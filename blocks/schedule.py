@@ -19,6 +19,7 @@ Everything that can be decided before a run is decided here, once:
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import reduce
@@ -131,6 +132,11 @@ class _Planner:
         self.sources: dict[str, set[str]] = {b: set() for b in diagram.blocks}
         for c in diagram.connections:
             self.sources[c.dst_block].add(c.src_block)
+        self.inherit_to: dict[str, dict[str, None]] = {b: {} for b in diagram.blocks}
+        """For each block, the blocks without a period that read it (in connection order)."""
+        for c in diagram.connections:
+            if diagram.blocks[c.dst_block].period is None:
+                self.inherit_to[c.src_block][c.dst_block] = None
 
     def fail(self, line: int | None, message: str, hint: str = "") -> None:
         raise DiagramError([Issue(self.d.file, line, message, hint)])
@@ -207,7 +213,13 @@ class _Planner:
             self.order_outputs(set(together))
 
     def fire_sets(self, period_ticks, offset_ticks, hyper):
-        """Periodic firing mask over one hyperperiod, and 'fires at t = 0', for every block."""
+        """Periodic firing mask over one hyperperiod, and 'fires at t = 0', for every block.
+
+        An inherited block fires when any of its sources does, so its mask is the union of
+        theirs and it fires at t = 0 if one of them does. Both are propagated along the
+        wires with a work list, which touches each wire once per change of its source
+        instead of sweeping every block until nothing changes (quadratic on a long chain).
+        """
         masks: dict[str, np.ndarray] = {}
         at_zero: dict[str, bool] = {}
         for n in self.d.blocks:
@@ -218,20 +230,24 @@ class _Planner:
             else:
                 at_zero[n] = True
             masks[n] = mask
-        inherited = [n for n in self.d.blocks if period_ticks[n] is None]
-        changed = True
-        while changed:
-            changed = False
-            for n in inherited:
-                srcs = self.sources[n]
-                if not srcs:
-                    continue
-                mask = masks[n] | reduce(np.logical_or, (masks[s] for s in srcs))
-                zero = any(at_zero[s] for s in srcs)
+        work = deque(n for n in self.d.blocks if masks[n].any())
+        while work:
+            s = work.popleft()
+            for n in self.inherit_to[s]:
+                mask = masks[n] | masks[s]
                 if not np.array_equal(mask, masks[n]):
                     masks[n] = mask
-                    changed = True
-                at_zero[n] = zero
+                    work.append(n)
+        # an inherited block with sources misses t = 0 once all of them do
+        waiting = {n: len(self.sources[n]) for n in self.d.blocks if period_ticks[n] is None}
+        work = deque(n for n in self.d.blocks if not at_zero[n])
+        while work:
+            s = work.popleft()
+            for n in self.inherit_to[s]:
+                waiting[n] -= 1
+                if not waiting[n]:
+                    at_zero[n] = False
+                    work.append(n)
         return masks, at_zero
 
     def advanced_blocks(self, masks, period_ticks, offset_ticks, lazy, delayed_into, n_ticks):
@@ -242,20 +258,22 @@ class _Planner:
             and offset_ticks[n] == 0 and s.block.is_stateful() and n not in delayed_into
             and (n_ticks is None or n_ticks % period_ticks[n] == 0)]
         upstream = {n: self.upstream_through(n, lazy) for n in candidates}
-        chosen: list[str] = []
+        chosen: dict[str, None] = {}
+        feeding_chosen: set[str] = set()
         for n in candidates:
-            if n in upstream[n] or upstream[n].intersection(chosen) or any(n in upstream[c] for c in chosen):
+            if n in upstream[n] or n in feeding_chosen or any(u in chosen for u in upstream[n]):
                 continue
-            chosen.append(n)
+            chosen[n] = None
+            feeding_chosen |= upstream[n]
         while True:
             events = np.zeros_like(next(iter(masks.values())))
             for n in d.blocks:
                 if n not in lazy and n not in chosen:
                     events |= masks[n]
-            bad = [n for n in chosen if np.any(events & ~masks[n])]
+            bad = {n for n in chosen if np.any(events & ~masks[n])}
             if not bad:
                 return frozenset(n for n in chosen if not np.array_equal(events, masks[n]))
-            chosen = [n for n in chosen if n not in bad]
+            chosen = {n: None for n in chosen if n not in bad}
 
     def upstream_through(self, block: str, lazy: frozenset[str]) -> set[str]:
         """Non-lazy blocks whose outputs reach ``block``'s inputs directly or via lazy blocks."""
@@ -279,12 +297,12 @@ class _Planner:
         stepped = firing - advanced if not initial else firing
         readers = firing if final else firing | advanced
         demanded: set[str] = set()
-        stack = [c.src_block for c in d.connections if c.dst_block in readers]
+        stack = [s for r in readers for s in self.sources[r]]
         while stack:
             s = stack.pop()
             if s in lazy and s not in demanded:
                 demanded.add(s)
-                stack.extend(c.src_block for c in d.connections if c.dst_block == s)
+                stack.extend(self.sources[s])
         evaluate = self.order_outputs(set(stepped) | demanded)
         by_order = sorted(firing, key=self.order.get)
         if final:

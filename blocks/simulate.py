@@ -158,8 +158,10 @@ class _Run:
             self.inputs[n] = {p: np.array(blk.input_defaults[p], dtype=float) if p in blk.input_defaults
                               else np.zeros(w) for p, w in blk.inputs.items()}
         self.fanout: dict[str, list[tuple[dict, str, str]]] = {n: [] for n in self.names}
+        self.sampled: dict[str, set[str]] = {n: set() for n in self.names}
         for c in diagram.connections:
             if c.delay:
+                self.sampled[c.src_block].add(c.src_port)
                 width = diagram.blocks[c.dst_block].block.inputs[c.dst_port]
                 init = np.zeros(width) if c.initial is None else np.broadcast_to(
                     np.asarray(c.initial, dtype=float), (width,)).copy()
@@ -227,7 +229,7 @@ class _Run:
     def hold_targets(self, name: str, ports) -> list[tuple[dict, str, str]]:
         """Where a block's new outputs must also be kept: only the ports that delayed
         connections sample (everything else reaches its readers through the fan-out)."""
-        sampled = {c.src_port for c in self.d.connections if c.delay and c.src_block == name}
+        sampled = self.sampled[name]
         return [(self.held[name], p, p) for p in ports if p in sampled]
 
     def update_op(self, name: str):
