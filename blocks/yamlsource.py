@@ -144,6 +144,9 @@ def load_yaml(text: str) -> Any:
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         problem = exc.problem or exc.context or "invalid YAML"
+        if "maximum nesting depth" in problem:  # libyaml's own limit, met while it scans ahead of our count
+            raise YamlSourceError(f"YAML lists and mappings nested deeper than {MAX_YAML_DEPTH} levels",
+                                  mark.line + 1 if mark else None, "a diagram needs about 8 levels") from None
         raise YamlSourceError(f"YAML syntax error: {problem}", mark.line + 1 if mark else None,
                               "check indentation, colons and brackets near that line") from None
     except yaml.reader.ReaderError as exc:
