@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from hierhand.control import (
@@ -227,6 +227,7 @@ def feasible_grasps(draw):
 
 @settings(max_examples=300)
 @given(feasible_grasps())
+@example((np.array([[1.0, 0.0]]), np.array([[3.0, 3.0]]), np.array([[1.0, 0.0]]), 0.9999999999999999))
 def test_friction_scale_puts_the_binding_contact_exactly_at_the_ratio(grasp):
     g, l, n, ratio = grasp
     s = friction_scale(g, l, n, ratio)
