@@ -76,6 +76,15 @@ class Results:
         found = re.match(r"\w+ at t=([-+0-9.eE]+) s", self.status)
         return float(found.group(1)) if found else None
 
+    def held(self, name: str, times: np.ndarray) -> np.ndarray:
+        """The signal's held (zero-order hold) values at each of ``times`` (one row per
+        time), NaN before its first sample."""
+        t, v = self[name]
+        idx = np.searchsorted(t, times, side="right") - 1
+        if not len(t):
+            return np.full((len(times), v.shape[1]), np.nan)
+        return np.where((idx >= 0)[:, None], v[np.clip(idx, 0, None)], np.nan)
+
     def value_at(self, name: str, t: float) -> np.ndarray:
         """The held (zero-order hold) value of a signal at time ``t``."""
         times, values = self[name]
@@ -118,10 +127,7 @@ class Results:
         grid = np.unique(np.concatenate([t for t, _ in self.signals.values()]))
         columns, header = [grid[:, None]], ["time"]
         for name, (t, v) in self.signals.items():
-            idx = np.searchsorted(t, grid, side="right") - 1
-            held = np.where((idx >= 0)[:, None], v[np.clip(idx, 0, None)], np.nan) if len(t) else \
-                np.full((grid.size, v.shape[1]), np.nan)
-            columns.append(held)
+            columns.append(self.held(name, grid))
             header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
         np.savetxt(f, np.hstack(columns), delimiter=",", header=",".join(header), comments="",
                    fmt="%.17g")

@@ -161,8 +161,8 @@ def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBl
     time."""
     events = regrasp_events(results, b)
     t_g, tau_g = _signal(results, f"{b.suppresser}.tau_g_eff")
-    t_m, tau_m = _signal(results, f"{b.manipulation}.tau_m")
-    held_m = np.abs(tau_m[np.clip(np.searchsorted(t_m, t_g, side="right") - 1, 0, None), joint])
+    _signal(results, f"{b.manipulation}.tau_m")  # a clear error if it was not logged
+    held_m = np.abs(results.held(f"{b.manipulation}.tau_m", t_g)[:, joint])
     separation = events["fore_separation_time_s"]
     end = separation - CONTACT_FADE if separation is not None else math.inf
     window = (t_g >= withdrawal[0]) & (t_g < end)

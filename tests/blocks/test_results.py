@@ -220,3 +220,10 @@ def test_empty_results_round_trip(tmp_path):
     assert len(back) == 0
     header, rows = read_csv(tmp_path / "signals.csv")
     assert header == ["time"] and rows == []
+
+
+def test_held_values_are_the_last_sample_at_or_before_each_time():
+    res = Results({"a.y": (np.array([0.1, 0.3]), np.array([[1.0], [2.0]]))}, {})
+    held = res.held("a.y", np.array([0.0, 0.1, 0.2, 0.3, 0.9]))
+    np.testing.assert_array_equal(held[1:, 0], [1.0, 1.0, 2.0, 2.0])
+    assert np.isnan(held[0, 0])  # before the first sample
