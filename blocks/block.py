@@ -35,6 +35,15 @@ class BlockError(Exception):
         self.rows = rows
 
 
+class EndRun(Exception):
+    """TEMPORARY stand-in until the executor's version is merged."""
+
+    def __init__(self, reason: str, state=None):
+        super().__init__(reason)
+        self.reason = reason
+        self.state = state
+
+
 class ParameterError(ValueError):
     """Invalid parameters found by a block's constructor, one entry per problem.
 
@@ -93,6 +102,11 @@ class Block:
     input_defaults: dict[str, Signal] = {}
     feedthrough: bool | Mapping[str, frozenset[str] | set[str]] = True
     period: Fraction | None = None
+    port_types: Mapping[str, str] = {}
+    """The value type a port's float64 values stand for, where it is not a plain real
+    number (``Float64``): an FMU's ``Int32`` or ``Boolean`` ports, in FMI 3 type names. A
+    connection between ports of different types is a conversion, which ``validate``
+    lists with the rules of ``input_rule`` / ``output_rule``."""
 
     # -- configuration hooks, called by the diagram loader -------------------------
 
@@ -150,6 +164,24 @@ class Block:
         return state, {p: np.asarray(v, dtype=float).reshape(n, self.outputs[p]) for p, v in rows.items()}
 
     # -- introspection helpers used by the loader, the scheduler and the CLI --------
+
+    def port_type(self, port: str) -> str:
+        """The type of values a port carries (``port_types``; ``Float64`` if not given)."""
+        return self.port_types.get(port, "Float64")
+
+    def input_rule(self, port: str) -> str | None:
+        """What values a typed input takes (e.g. "whole numbers from 0 to 255; any other
+        value stops the run"); None for a plain real input."""
+        return None
+
+    def output_rule(self, port: str) -> str | None:
+        """How a typed output's values become float64 (e.g. "exact"); None if plain."""
+        return None
+
+    def port_hint(self, port: str) -> str | None:
+        """Why ``port`` is not a port of this block when the name means something to it
+        (an FMU's String variable), for the loader's "has no input" message; else None."""
+        return None
 
     def describe(self) -> str:
         """A short note on where this block's configuration comes from, which

@@ -142,6 +142,20 @@ class LogEntry:
         return f"{self.block}.{self.port}"
 
 
+@dataclass(frozen=True)
+class Conversion:
+    """A connection between ports of different value types and the rule that converts it."""
+
+    connection: Connection
+    source_type: str
+    target_type: str
+    rule: str
+
+    def __str__(self) -> str:
+        c = self.connection
+        return f"{c.src} ({self.source_type}) -> {c.dst} ({self.target_type}): {self.rule}"
+
+
 @dataclass
 class Diagram:
     """A validated diagram: blocks, connections, logged signals and the end time."""
@@ -178,6 +192,19 @@ class Diagram:
         """Every block reference of the diagram (``reflex.hand -> plant``), in block order."""
         return [Reference(name, param, target) for name, spec in self.blocks.items()
                 for param, target in spec.references.items()]
+
+    def conversions(self) -> list[Conversion]:
+        """The connections between ports of different value types (an FMU's Int32 output
+        into a plain input, a plain output into an FMU's Boolean input), with the rules
+        that convert them, in connection order."""
+        out = []
+        for c in self.connections:
+            src, dst = self.blocks[c.src_block].block, self.blocks[c.dst_block].block
+            a, b = src.port_type(c.src_port), dst.port_type(c.dst_port)
+            if a != b:
+                rule = dst.input_rule(c.dst_port) or src.output_rule(c.src_port) or "exact"
+                out.append(Conversion(c, a, b, rule))
+        return out
 
     def parameters(self) -> dict[str, dict]:
         """Parameters of every block after params files and overrides (JSON-friendly)."""
@@ -706,6 +733,7 @@ class _Loader:
             if port in other:
                 hint = f"'{block}.{port}' is an {'input' if kind == 'outputs' else 'output'}; " \
                        f"connections go from an output to an input"
+            hint = spec.block.port_hint(port) or hint
             self.error(line, f"connection '{text}': block '{block}' ({spec.type_name}) has no "
                        f"{what} '{port}'", hint)
             return False
@@ -780,7 +808,8 @@ class _Loader:
             if port not in outputs:
                 self.error(line, f"log entry '{block}.{port}': block '{block}' "
                            f"({blocks[block].type_name}) has no output '{port}'",
-                           _suggest(port, outputs) or f"outputs: {_known(outputs)}")
+                           blocks[block].block.port_hint(port) or _suggest(port, outputs)
+                           or f"outputs: {_known(outputs)}")
                 continue
             if f"{block}.{port}" in seen:
                 self.error(line, f"signal '{block}.{port}' is logged twice")

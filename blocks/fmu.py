@@ -75,7 +75,7 @@ from typing import Any
 import numpy as np
 
 from blocks import fmu_interrupt
-from blocks.block import Block, BlockError, Signal
+from blocks.block import Block, BlockError, EndRun, Signal
 from blocks.fmu_archive import ArchiveError, extract_archive
 from blocks.fmu_info import MODEL_DESCRIPTION, read_description
 from blocks.timebase import format_duration
@@ -96,17 +96,75 @@ _STATUS = ("ok", "warning", "discard", "error", "fatal", "pending")
 _INDEXED = re.compile(r"^(?P<base>.*[^\s])\[(?P<index>\s*\d+\s*(?:,\s*\d+\s*)*)\]$")
 _NOT_IDENT = re.compile(r"[^A-Za-z0-9_]")
 
-# Variable types whose values a port carries, by FMI major version.
-_PORT_TYPES = {2: ("Real",), 3: ("Float64", "Float32")}
+EXACT_INTEGERS = 2**53
+"""Integers up to this magnitude are exact in a float64 port; a 64-bit output beyond it
+stops the run rather than change its value."""
 
-_INT_RANGES = {
-    "Int8": (-2**7, 2**7 - 1), "UInt8": (0, 2**8 - 1),
-    "Int16": (-2**15, 2**15 - 1), "UInt16": (0, 2**16 - 1),
-    "Int32": (-2**31, 2**31 - 1), "UInt32": (0, 2**32 - 1),
-    "Int64": (-2**63, 2**63 - 1), "UInt64": (0, 2**64 - 1),
-    "Integer": (-2**31, 2**31 - 1), "Enumeration": (-2**31, 2**31 - 1),
+
+@dataclass(frozen=True)
+class PortKind:
+    """How values of one FMI variable type travel as float64 port values.
+
+    ``name`` is the type in FMI 3 spelling (FMI 2's Real is Float64, its Integer Int32),
+    ``function`` the suffix of the FMI get/set functions that move it, ``ctype`` and
+    ``dtype`` its C and numpy types. Integer types have a range ``[low, high]``.
+    """
+
+    name: str
+    function: str
+    ctype: str
+    dtype: str
+    low: int | None = None
+    high: int | None = None
+
+    @property
+    def is_float(self) -> bool:
+        return self.low is None and self.name != "Boolean"
+
+    def input_rule(self) -> str:
+        """What a float64 value must be to reach a variable of this type."""
+        if self.name == "Float64":
+            return "any number"
+        if self.name == "Float32":
+            return "any number, rounded to the nearest Float32"
+        if self.name == "Boolean":
+            return "0 (false) or 1 (true); any other value stops the run"
+        return f"whole numbers from {self.low} to {self.high}; any other value stops the run"
+
+    def output_rule(self) -> str:
+        """How a value of this type becomes a float64."""
+        if self.name == "Boolean":
+            return "false -> 0, true -> 1"
+        if self.low is not None and max(-self.low, self.high) > EXACT_INTEGERS:
+            return "exact up to 2^53 in magnitude; a larger value stops the run"
+        return "exact"
+
+
+def _ints(name: str, bits: int, signed: bool, function: str | None = None) -> PortKind:
+    low, high = (-2**(bits - 1), 2**(bits - 1) - 1) if signed else (0, 2**bits - 1)
+    ctype = f"c_{'' if signed else 'u'}int{bits}"
+    return PortKind(name, function or name, ctype, f"{'' if signed else 'u'}int{bits}", low, high)
+
+
+_KINDS: dict[int, dict[str, PortKind]] = {
+    2: {"Real": PortKind("Float64", "Real", "c_double", "float64"),
+        "Integer": _ints("Int32", 32, True, "Integer"),
+        "Enumeration": _ints("Enumeration", 32, True, "Integer"),
+        "Boolean": PortKind("Boolean", "Boolean", "c_int", "int32")},
+    3: {"Float64": PortKind("Float64", "Float64", "c_double", "float64"),
+        "Float32": PortKind("Float32", "Float32", "c_float", "float32"),
+        **{f"{u}Int{b}": _ints(f"{u}Int{b}", b, not u) for u in ("", "U") for b in (8, 16, 32, 64)},
+        "Enumeration": _ints("Enumeration", 64, True, "Int64"),
+        "Boolean": PortKind("Boolean", "Boolean", "c_bool", "bool")},
 }
+"""The variable types that become ports, by FMI major version and the FMU's type name."""
 
+_NOT_PORTS = {
+    "String": "a String variable, which cannot be a port (ports carry numbers)",
+    "Binary": "a Binary variable, which cannot be a port (ports carry numbers)",
+    "Clock": ("a Clock; FMI 3 clocks are not supported (the FMU block steps co-simulation FMUs "
+              "without event mode)"),
+}
 
 def _fmpy():
     """fmpy, imported on first use (it takes a fifth of a second) with a clear error if missing."""
@@ -128,17 +186,18 @@ class _Port:
     """One port: the FMU variables (value references) behind it, in port order."""
 
     name: str
-    kind: str                 # the FMI type: Real, Float64 or Float32
+    kind: PortKind
     vrs: list[int]
     width: int
     source: str               # the variable or vector name in the FMU, for messages
+    labels: list[str] | None = None   # the FMU's own element indices ("1", "1,2"), if a vector
 
 
 @dataclass
 class _Group:
     """Ports of one FMI type read or written with one call: values laid out port by port."""
 
-    kind: str
+    kind: PortKind
     vrs: list[int]
     count: int
     slices: list[tuple[str, int, int]] = field(default_factory=list)
@@ -164,7 +223,7 @@ def _variable_width(v: Any) -> int:
     return int(math.prod(shape)) if v.dimensions else 1
 
 
-def _group_variables(variables: list, what: str, fmu: str) -> dict[str, _Port]:
+def _group_variables(variables: list, what: str, fmu: str, major: int) -> dict[str, _Port]:
     """Ports from variables: ``x[i]`` (and ``x[i,j]``) scalars become one vector per base name."""
     bases: dict[str, list[tuple[tuple[int, ...] | None, Any]]] = {}
     for v in variables:
@@ -182,7 +241,8 @@ def _group_variables(variables: list, what: str, fmu: str) -> dict[str, _Port]:
             width = _variable_width(v)
             if width < 1:
                 raise ValueError(f"{what} '{v.name}' of {fmu} is an array of size 0")
-            port = _Port(_port_name(base), v.type, [v.valueReference], width, v.name)
+            port = _Port(_port_name(base), _KINDS[major][v.type], [v.valueReference], width, v.name,
+                         _array_labels(v) if width > 1 else None)
         else:
             if any(index is None for index, _ in items):
                 raise ValueError(f"{what}s of {fmu}: '{base}' is both a variable and the vector "
@@ -213,8 +273,8 @@ def _group_variables(variables: list, what: str, fmu: str) -> dict[str, _Port]:
             if len(kinds) > 1:
                 raise ValueError(f"{what}s of {fmu}: vector '{base}' mixes the types "
                                  f"{', '.join(sorted(kinds))}")
-            port = _Port(_port_name(base), items[0][1].type, [v.valueReference for _, v in items],
-                         len(items), f"{base}[...]")
+            port = _Port(_port_name(base), _KINDS[major][items[0][1].type], [v.valueReference for _, v in items],
+                         len(items), f"{base}[...]", [",".join(map(str, i)) for i in indices])
         if port.name in ports:
             raise ValueError(f"{what}s of {fmu}: '{origin[port.name]}' and '{port.source}' both map to "
                              f"the port name '{port.name}'")
@@ -223,29 +283,35 @@ def _group_variables(variables: list, what: str, fmu: str) -> dict[str, _Port]:
     return ports
 
 
+def _array_labels(v: Any) -> list[str]:
+    """Element indices of an FMI 3 array variable, counted from 1 as FMI does, row-major."""
+    shape = [int(n) for n in (getattr(v, "shape", None) or ())]
+    return [",".join(map(str, i)) for i in itertools.product(*(range(1, n + 1) for n in shape))]
+
+
 def _groups(ports: dict[str, _Port]) -> list[_Group]:
     groups: dict[str, _Group] = {}
     for port in ports.values():
-        g = groups.setdefault(port.kind, _Group(port.kind, [], 0))
+        g = groups.setdefault(port.kind.name, _Group(port.kind, [], 0))
         g.vrs.extend(port.vrs)
         g.slices.append((port.name, g.count, g.count + port.width))
         g.count += port.width
     return list(groups.values())
 
 
-def _convert(kind: str, value: Any, name: str) -> Any:
-    """One start value converted to the variable's type, or ValueError."""
-    if kind in ("Real", "Float64", "Float32"):
+def _convert(kind: str, value: Any, name: str, major: int) -> Any:
+    """One start value converted to the variable's type ``kind`` (as the FMU names it), or ValueError."""
+    port_kind = _KINDS[major].get(kind)
+    if port_kind is not None and port_kind.is_float:
         if isinstance(value, bool) or not isinstance(value, (int, float, np.number)):
             raise ValueError(f"start value of '{name}' must be a number, got {value!r}")
         return float(value)
-    if kind in _INT_RANGES:
+    if port_kind is not None and port_kind.low is not None:
         if isinstance(value, (float, np.floating)) and float(value).is_integer():
             value = int(value)
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
             raise ValueError(f"start value of '{name}' must be an integer ({kind}), got {value!r}")
-        lo, hi = _INT_RANGES[kind]
-        if not lo <= int(value) <= hi:
+        if not port_kind.low <= int(value) <= port_kind.high:
             raise ValueError(f"start value of '{name}' is out of range for {kind}: {value!r}")
         return int(value)
     if kind == "Boolean":
@@ -270,7 +336,7 @@ def _start_of(v: Any) -> list | None:
     try:
         if v.type == "Boolean":
             return [{"true": True, "false": False, "1": True, "0": False}[x] for x in text.split()]
-        if v.type in _INT_RANGES:
+        if v.type == "Integer" or v.type == "Enumeration" or "Int" in v.type:
             return [int(x) for x in text.split()]
         return [float(x) for x in text.split()]
     except (KeyError, ValueError):
@@ -366,12 +432,14 @@ class _Model:
         self.default_step = _fraction_or_none(de.stepSize if de else None)
         self.default_tolerance = _float_or_none(de.tolerance if de else None)
         self.variables = {v.name: v for v in md.modelVariables}
-        kinds = _PORT_TYPES[major]
-        ports = [v for v in md.modelVariables if v.type in kinds and v.alias is None]
-        ins = [v for v in ports if v.causality == "input"]
+        kinds = _KINDS[major]
+        ports = [v for v in md.modelVariables if v.type in kinds]
+        ins = [v for v in ports if v.causality == "input" and v.alias is None]
         outs = [v for v in ports if v.causality == "output"]
-        self.inputs = _group_variables(ins, "input", shown)
-        self.outputs = _group_variables(outs, "output", shown)
+        self.inputs = _group_variables(ins, "input", shown, major)
+        self.outputs = _group_variables(outs, "output", shown, major)
+        self.not_ports = self._not_ports(md.modelVariables)
+        self.initial_reads = self._initial_reads(md)
         self.in_groups = _groups(self.inputs)
         self.out_groups = _groups(self.outputs)
         indexed: dict[str, list[tuple[tuple[int, ...], Any]]] = {}
@@ -382,6 +450,52 @@ class _Model:
                 indexed.setdefault(m.group("base"), []).append((index, v))
         self.vectors = {b: [v for _, v in sorted(items, key=lambda i: i[0])]
                         for b, items in indexed.items()}
+
+    def _not_ports(self, variables: list) -> dict[str, str]:
+        """Why each variable that is not a port is not one, by the port name it would have."""
+        why: dict[str, str] = {}
+        for v in variables:
+            name = _port_name(v.name)
+            if name in self.inputs or name in self.outputs:
+                continue
+            if v.type in _NOT_PORTS:
+                reason = f"'{v.name}' is {_NOT_PORTS[v.type]}"
+                if v.causality == "input" and v.type != "Clock":
+                    reason += "; give it a value with start_values"
+            elif v.alias is not None and v.causality == "input":
+                reason = f"'{v.name}' is an alias of the input '{v.alias.name}'; connect that one"
+            elif v.causality in ("parameter", "calculatedParameter", "structuralParameter"):
+                reason = f"'{v.name}' is a {v.causality} of the FMU, not a port"
+                if _settable(v) is None:
+                    reason += "; set it with start_values"
+            elif v.causality in ("local", "independent"):
+                reason = f"'{v.name}' is a {v.causality} variable of the FMU; only inputs and outputs are ports"
+            else:
+                continue
+            why.setdefault(name, reason)
+        return why
+
+    def _initial_reads(self, md: Any) -> dict[str, frozenset[str]]:
+        """For each output port, the input ports its value at initialisation may depend on
+        (the modelDescription's InitialUnknowns: listed dependencies, all inputs when the
+        list is absent; an output not listed has an exact start and depends on none)."""
+        port_of_vr = {vr: p.name for p in self.inputs.values() for vr in p.vrs}
+        listed = {u.variable.valueReference: u for u in md.initialUnknowns if u.variable is not None}
+        every = frozenset(self.inputs)
+        out = {}
+        for port in self.outputs.values():
+            reads: set[str] = set()
+            for vr in port.vrs:
+                u = listed.get(vr)
+                if u is None:
+                    continue
+                if u.dependencies is None:
+                    reads = set(every)
+                    break
+                reads |= {port_of_vr[d.valueReference] for d in u.dependencies
+                          if d.valueReference in port_of_vr}
+            out[port.name] = frozenset(reads)
+        return out
 
     # -- start values -------------------------------------------------------------------
 
@@ -410,7 +524,7 @@ class _Model:
                                  f"got {len(values)}")
             pos = 0
             for v, w in zip(targets, widths):
-                converted = [_convert(v.type, x, v.name) for x in values[pos:pos + w]]
+                converted = [_convert(v.type, x, v.name, self.major) for x in values[pos:pos + w]]
                 pos += w
                 out.append(_Assignment(v.name, v.type, v.valueReference, converted))
         return out
@@ -427,15 +541,10 @@ class _Model:
             for vr in port.vrs:
                 v = by_vr[vr]
                 width = _variable_width(v)
-                start = given.get(vr)
-                if start is None:
-                    try:
-                        start = [float(x) for x in str(v.start).split()] if v.start is not None else []
-                    except ValueError:
-                        start = []
+                start = given.get(vr) or _start_of(v) or [0.0]
                 if len(start) not in (1, width):
                     start = [0.0]
-                values.extend(start if len(start) == width else start * width)
+                values.extend(float(x) for x in (start if len(start) == width else start * width))
             out[port.name] = np.array(values, dtype=float)
         return out
 
@@ -673,27 +782,21 @@ class _Instance:
         self._buffers(ctypes)
 
     def _buffers(self, ctypes) -> None:
-        c_types = {"Real": ctypes.c_double, "Float64": ctypes.c_double, "Float32": ctypes.c_float}
-        np_types = {"Real": np.float64, "Float64": np.float64, "Float32": np.float32}
         s = self.slave
-        if self.model.major == 2:
-            get = {"Real": s.fmi2GetReal}
-            put = {"Real": s.fmi2SetReal}
-        else:
-            get = {"Float64": s.fmi3GetFloat64, "Float32": s.fmi3GetFloat32}
-            put = {"Float64": s.fmi3SetFloat64, "Float32": s.fmi3SetFloat32}
+        prefix = f"fmi{self.model.major}"
 
-        def plan(groups: list[_Group], table: dict):
+        def plan(groups: list[_Group], verb: str) -> list[_Transfer]:
             out = []
             for g in groups:
                 vrs = (ctypes.c_uint * len(g.vrs))(*g.vrs)
-                buf = (c_types[g.kind] * g.count)()
-                view = np.frombuffer(buf, dtype=np_types[g.kind])
-                out.append((table[g.kind], vrs, len(g.vrs), buf, g.count, view, g.slices))
+                buf = (getattr(ctypes, g.kind.ctype) * g.count)()
+                view = np.frombuffer(buf, dtype=g.kind.dtype)
+                function = getattr(s, f"{prefix}{verb}{g.kind.function}")
+                out.append(_Transfer(function, vrs, len(g.vrs), buf, g.count, view, g.slices, g.kind))
             return out
 
-        self.reads = plan(self.model.out_groups, get)
-        self.writes = plan(self.model.in_groups, put)
+        self.reads = plan(self.model.out_groups, "Get")
+        self.writes = plan(self.model.in_groups, "Set")
         # doStep straight through the library's function, its status checked here: fmpy's
         # wrapper (and, for FMI 3, its fresh output arguments) cost more than the call
         if self.model.major == 2:
@@ -713,8 +816,10 @@ class _Instance:
 
     # -- the life cycle -------------------------------------------------------------------
 
-    def start(self, t: float, assignments: list[_Assignment], tolerance: float | None) -> None:
-        """Reset if used before, set the start values and initialise at start time ``t``."""
+    def start(self, t: float, assignments: list[_Assignment], tolerance: float | None,
+              inputs: Mapping[str, Signal]) -> None:
+        """Reset if used before, set the start values, initialise at start time ``t`` with
+        ``inputs`` set before initialisation ends (as FMI and fmpy do)."""
         s = self.slave
         if self.used:
             s.reset()
@@ -729,28 +834,47 @@ class _Instance:
             s.enterInitializationMode()
         else:
             s.enterInitializationMode(tolerance=tolerance, startTime=t)
+        self.write(inputs, t)
         s.exitInitializationMode()
         self.started = True
 
-    def read(self) -> dict[str, Signal]:
-        """Fresh float64 outputs: one copy per group, each port a view of it."""
+    def read(self, t: float) -> dict[str, Signal]:
+        """Fresh float64 outputs at time ``t``: one copy per group, each port a view of it."""
         out: dict[str, Signal] = {}
         component = self.slave.component
-        for fn, vrs, nvr, buf, count, view, slices in self.reads:
-            if self.model.major == 2:
-                fn(component, vrs, nvr, buf)
+        two = self.model.major == 2
+        for x in self.reads:
+            if two:
+                x.function(component, x.vrs, x.nvr, x.buf)
             else:
-                fn(component, vrs, nvr, buf, count)
-            values = view.astype(np.float64)
-            for name, a, b in slices:
+                x.function(component, x.vrs, x.nvr, x.buf, x.count)
+            values = x.view.astype(np.float64)
+            if x.kind.low is not None and x.kind.high > EXACT_INTEGERS:
+                self._check_exact(x, values, t)
+            for name, a, b in x.slices:
                 out[name] = values[a:b]
         return out
 
+    def _check_exact(self, x: _Transfer, values: np.ndarray, t: float) -> None:
+        """BlockError if a 64-bit integer output does not survive the trip to float64."""
+        big = np.flatnonzero(np.abs(values) > EXACT_INTEGERS)
+        for i in big:
+            exact = int(x.view[i])
+            if int(values[i]) != exact:
+                name, a, b = next(sl for sl in x.slices if sl[1] <= i < sl[2])
+                element = f" element {i - a}" if b - a > 1 else ""
+                raise BlockError(f"{self.model.shown}: output '{name}'{element} ({x.kind.name}) is {exact} at "
+                                 f"t={t:.9g} s, which a float64 port cannot hold exactly (integers are "
+                                 f"exact up to 2^53)", port=name)
+
     def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
         """One doStep; (terminate requested, returned early, last successful time).
-        Raises fmpy's FMICallException for an error status, as fmpy's own call does."""
+        Raises fmpy's FMICallException for an error status, or for a discard that is not a
+        request to terminate, as fmpy's own call does."""
         if self.model.major == 2:
             status = self._do_step(self.slave.component, t, h, 1)
+            if status == 2 and self._terminated_fmi2():
+                return True, False, self._last_time_fmi2(t + h)
         else:
             status = self._do_step(self.slave.component, t, h, True, *self._step_refs)
         if status > 1:
@@ -762,15 +886,51 @@ class _Instance:
         _, terminate, early, last = self._step_flags
         return terminate.value, early.value, last.value
 
-    def write(self, inputs: Mapping[str, Signal]) -> None:
+    def _terminated_fmi2(self) -> bool:
+        """After an FMI 2 discard: whether the FMU asks to end the simulation (fmi2Terminated)."""
+        import ctypes
+
+        flag = ctypes.c_int(0)
+        fn = self.slave._functions.get("fmi2GetBooleanStatus")
+        return fn is not None and fn(self.slave.component, 3, ctypes.byref(flag)) <= 1 and bool(flag.value)
+
+    def _last_time_fmi2(self, default: float) -> float:
+        """After an FMI 2 discard: how far the step got (fmi2LastSuccessfulTime), else ``default``."""
+        import ctypes
+
+        value = ctypes.c_double(default)
+        fn = self.slave._functions.get("fmi2GetRealStatus")
+        if fn is None or fn(self.slave.component, 2, ctypes.byref(value)) > 1 or not math.isfinite(value.value):
+            return default
+        return value.value
+
+    def write(self, inputs: Mapping[str, Signal], t: float) -> None:
         component = self.slave.component
-        for fn, vrs, nvr, buf, count, view, slices in self.writes:
-            for name, a, b in slices:
-                view[a:b] = inputs[name]
-            if self.model.major == 2:
-                fn(component, vrs, nvr, buf)
+        two = self.model.major == 2
+        for x in self.writes:
+            if x.kind.is_float:
+                for name, a, b in x.slices:
+                    x.view[a:b] = inputs[name]
             else:
-                fn(component, vrs, nvr, buf, count)
+                for name, a, b in x.slices:
+                    x.view[a:b] = self._checked(x.kind, name, inputs[name], t)
+            if two:
+                x.function(component, x.vrs, x.nvr, x.buf)
+            else:
+                x.function(component, x.vrs, x.nvr, x.buf, x.count)
+
+    def _checked(self, kind: PortKind, name: str, value: np.ndarray, t: float) -> np.ndarray:
+        """``value`` if every element is one the input's type holds, else BlockError."""
+        if kind.name == "Boolean":
+            bad = (value != 0) & (value != 1)
+        else:
+            bad = ~((value >= kind.low) & (value < kind.high + 1) & (np.floor(value) == value))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            element = f" element {i}" if value.size > 1 else ""
+            raise BlockError(f"{self.model.shown}: input '{name}'{element} ({kind.name}) got {float(value[i]):.17g} at "
+                             f"t={t:.9g} s; it takes {kind.input_rule()}", port=name)
+        return value
 
     def free(self) -> None:
         if self.freed or self.slave is None:
@@ -784,6 +944,21 @@ class _Instance:
         finally:
             _fmi2_buffers.pop(self.serial, None)
         fmu_interrupt.deliver()
+
+
+@dataclass
+class _Transfer:
+    """One preallocated get or set call of an instance: a group's value references,
+    the C buffer and a numpy view of it, and where each port's values lie."""
+
+    function: Any
+    vrs: Any
+    nvr: int
+    buf: Any
+    count: int
+    view: np.ndarray
+    slices: list[tuple[str, int, int]]
+    kind: PortKind
 
 
 def _setters(slave: Any, major: int) -> dict[str, Any]:
@@ -810,7 +985,7 @@ class FMUState:
     early; otherwise that happens when the state is garbage collected.
     """
 
-    __slots__ = ("instance", "model", "time", "outputs", "_release", "__weakref__")
+    __slots__ = ("instance", "model", "time", "outputs", "ended", "_release", "__weakref__")
 
     def __init__(self, model: _Model):
         if model.closed:
@@ -819,6 +994,7 @@ class FMUState:
         self.model = model
         self.time: float | None = None
         self.outputs: dict[str, Signal] | None = None
+        self.ended: float | None = None
         self._release: weakref.finalize | None = None
 
     def acquire(self) -> _Instance:
@@ -886,7 +1062,9 @@ class FMU(Block):
         self.inputs = {p.name: p.width for p in model.inputs.values()}
         self.outputs = {p.name: p.width for p in model.outputs.values()}
         self.input_defaults = model.input_starts(self._assignments)
+        self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
         self.feedthrough = False
+        self.initial_feedthrough = model.initial_reads
         self._step = 0.0
 
     @property
@@ -920,6 +1098,24 @@ class FMU(Block):
             if values:
                 out[v.name] = values if v.dimensions else values[0]
         return out
+
+    def element_labels(self, port: str) -> list[str] | None:
+        """A vector port's elements by the FMU's own indices (``y[1]``, ``A[1,2]``), from 1."""
+        spec = self._model.inputs.get(port) or self._model.outputs.get(port)
+        return spec.labels if spec is not None else None
+
+    def input_rule(self, port: str) -> str | None:
+        spec = self._model.inputs.get(port)
+        return None if spec is None or spec.kind.name == "Float64" else spec.kind.input_rule()
+
+    def output_rule(self, port: str) -> str | None:
+        spec = self._model.outputs.get(port)
+        return None if spec is None or spec.kind.name == "Float64" else spec.kind.output_rule()
+
+    def port_hint(self, port: str) -> str | None:
+        """Why ``port`` is not a port of this FMU, when it names one of its variables."""
+        why = self._model.not_ports.get(port)
+        return f"{why} ({self._model.shown})" if why else None
 
     def variable_of(self, port: str) -> str:
         """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""
@@ -957,13 +1153,19 @@ class FMU(Block):
     def initial_state(self) -> FMUState:
         return FMUState(self._model)
 
-    def _start(self, t: float, state: FMUState) -> None:
-        """The run's first call: take an instance (loading the FMU) and initialise it at ``t``."""
+    def _start(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> None:
+        """The run's first call: take an instance (loading the FMU) and initialise it at
+        ``t`` with the inputs it has now (connected ones are computed first when the FMU's
+        initial outputs depend on them, see ``initial_feedthrough``)."""
         inst = state.acquire()
         try:
-            inst.start(t, self._assignments, self.tolerance)
+            inst.start(t, self._assignments, self.tolerance, inputs)
             state.time = t
-            state.outputs = inst.read()
+            state.outputs = inst.read(t)
+        except BlockError:
+            inst.broken = True
+            fmu_interrupt.check()
+            raise
         except Exception as exc:
             inst.broken = True
             fmu_interrupt.check()  # a failure that comes with Ctrl-C is the interrupt
@@ -973,32 +1175,39 @@ class FMU(Block):
 
     def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         if state.time is None:
-            self._start(t, state)
+            self._start(t, state, inputs)
         return state.outputs
 
     def update(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> FMUState:
         if state.time is None:
-            self._start(t, state)
+            self._start(t, state, inputs)
         inst = state.instance
         h = self._step
         if inst.broken:
             raise BlockError(f"{self._model.shown}: the FMU instance failed earlier and cannot step")
+        if state.ended is not None:
+            raise BlockError(f"{self._model.shown}: the FMU ended the simulation at t={state.ended:.9g} s "
+                             "and cannot step further")
         if abs(t - state.time) > 1e-9 * max(h, abs(t)):
             raise BlockError(f"{self._model.shown}: asked to step from t={t:.9g} s, but the FMU is at "
                              f"t={state.time:.9g} s (the block must fire every period)")
         try:
             _arm(inst.model.major)
-            inst.write(inputs)
+            inst.write(inputs, t)
             terminate, early, last = inst.do_step(t, h)
             fmu_interrupt.check()
-            if terminate or early:
+            if terminate:
+                state.time = state.ended = last
+                state.outputs = inst.read(last)
+                short = f" (its step to t={t + h:.9g} s stopped at t={last:.9g} s)" if last < t + h - 1e-9 * h else ""
+                raise EndRun(f"{self._model.shown} requested to terminate the simulation{short}", state)
+            if early:
                 inst.broken = True
-                what = "requested to terminate the simulation" if terminate else f"returned early at t={last:.9g} s"
-                raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) "
-                                 f"{what}{inst.log_text()}")
+                raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) returned early "
+                                 f"at t={last:.9g} s, which co-simulation here does not allow{inst.log_text()}")
             state.time = t + h
-            state.outputs = inst.read()
-        except BlockError:
+            state.outputs = inst.read(state.time)
+        except (BlockError, EndRun):
             raise
         except Exception as exc:
             inst.broken = True

@@ -6,8 +6,10 @@ naming the member, when it finds:
 
 - an absolute name (``/etc/x``, ``\\\\server\\x``, ``C:x``) or a ``..`` component;
 - a symbolic link or another special file (device, fifo, socket), or an encrypted member;
-- a name that is empty, holds a NUL or control character, or occurs twice (one member
-  could otherwise overwrite another, or a file collide with a folder);
+- a name that is empty, holds a NUL or control character, or occurs twice with different
+  contents (one member could otherwise overwrite another, or a file collide with a
+  folder). A name that occurs twice with the same bytes, as some FMU tools write their
+  ``extra/`` folders, is read once;
 - decompression bombs: a member list (central directory) larger than 1 KiB per allowed
   member (checked before zipfile reads it), more than ``MAX_MEMBERS`` members, a member
   larger than ``MAX_MEMBER_BYTES``, more than ``MAX_TOTAL_BYTES`` in all, or a member of
@@ -24,6 +26,7 @@ writing anything to disk.
 
 from __future__ import annotations
 
+import itertools
 import os
 import shutil
 import stat
@@ -138,7 +141,7 @@ def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",
     if len(infos) > limits.members:
         raise ArchiveError(f"{where} has {len(infos)} members, more than the limit of {limits.members}")
     total = 0
-    seen: dict[str, str] = {}
+    seen: dict[str, zipfile.ZipInfo] = {}
     prefixes: set[str] = set()
     files: set[str] = set()
     checked = []
@@ -160,8 +163,11 @@ def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",
         total += info.file_size
         key = "/".join(parts)
         if key in seen:
-            raise ArchiveError(f"{where}: member {name!r} occurs twice (also as {seen[key]!r})")
-        seen[key] = name
+            if _same_member(zf, seen[key], info, total, where, limits):
+                continue
+            raise ArchiveError(f"{where}: member {name!r} occurs twice with different contents "
+                               f"(also as {seen[key].filename!r})")
+        seen[key] = info
         for i in range(1, len(parts)):
             prefixes.add("/".join(parts[:i]))
         if not _is_dir(info):
@@ -169,9 +175,22 @@ def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",
         checked.append((info, parts))
     clash = files & prefixes
     if clash:
-        name = seen[min(clash)]
+        name = seen[min(clash)].filename
         raise ArchiveError(f"{where}: member {name!r} is a file but other members use it as a folder")
     return checked
+
+
+def _same_member(zf: zipfile.ZipFile, first: zipfile.ZipInfo, again: zipfile.ZipInfo, before: int,
+                 where: str, limits: Limits) -> bool:
+    """Whether a second member of the same name is the first one again: both folders, or
+    files of the same bytes (compared in full, within the limits)."""
+    if _is_dir(first) or _is_dir(again):
+        return _is_dir(first) and _is_dir(again)
+    if first.file_size != again.file_size or first.CRC != again.CRC:
+        return False
+    one = _chunks(zf, first, before, where, limits)
+    two = _chunks(zf, again, before, where, limits)
+    return all(a == b for a, b in itertools.zip_longest(one, two))
 
 
 def _is_dir(info: zipfile.ZipInfo) -> bool:

@@ -365,6 +365,11 @@ def print_references_and_notes(diagram) -> None:
     if notes:
         print("notes:")
         print("\n".join(notes))
+    conversions = diagram.conversions()
+    if conversions:
+        print("conversions (connections between ports of different types):")
+        for conversion in conversions:
+            print(f"  {conversion}")
 
 
 def cmd_graph(args: argparse.Namespace) -> int:
