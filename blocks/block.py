@@ -70,6 +70,11 @@ class Block:
     - ``input_defaults``: inputs that may stay unconnected, with the value they then hold.
     - ``feedthrough``: ``True`` if every output reads every input at the same hit,
       ``False`` if no output does, or a mapping output -> set of inputs it reads.
+    - ``initial_feedthrough``: the same, for the outputs at the initial tick (tick 0)
+      only; ``None`` (the default) means "as ``feedthrough``". An FMU's initial outputs
+      may follow the inputs set before initialisation although later outputs do not;
+      the planner drops such a t = 0 dependency where it would close a loop (the input
+      then holds its initial value at t = 0, see ``Schedule.initial_held``).
     - ``time_varying``: the outputs depend on ``t`` itself (sources such as Step).
 
     and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
@@ -101,6 +106,7 @@ class Block:
     outputs: dict[str, int | None] = {}
     input_defaults: dict[str, Signal] = {}
     feedthrough: bool | Mapping[str, frozenset[str] | set[str]] = True
+    initial_feedthrough: bool | Mapping[str, frozenset[str] | set[str]] | None = None
     period: Fraction | None = None
     port_types: Mapping[str, str] = {}
     """The value type a port's float64 values stand for, where it is not a plain real
@@ -230,7 +236,15 @@ class Block:
 
     def reads(self, output_port: str) -> frozenset[str]:
         """The input ports that ``output_port`` depends on at the same hit."""
-        ft = self.feedthrough
+        return self._read_by(self.feedthrough, output_port)
+
+    def initial_reads(self, output_port: str) -> frozenset[str]:
+        """The input ports that ``output_port`` depends on at the initial tick (tick 0)."""
+        ft = self.initial_feedthrough
+        return self.reads(output_port) if ft is None else self._read_by(ft, output_port)
+
+    def _read_by(self, ft, output_port: str) -> frozenset[str]:
+        """The inputs ``output_port`` reads under the feedthrough declaration ``ft``."""
         if ft is True:
             return frozenset(self.inputs)
         if ft is False:

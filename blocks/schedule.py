@@ -13,7 +13,11 @@ Everything that can be decided before a run is decided here, once:
   every event tick (and more). Between two events nothing else fires, so they are
   stepped over the whole span in one call;
 - for each distinct firing pattern, an ``EventProgram``: the output phase in feedthrough
-  order, the update phase, delayed-connection sampling and the advances.
+  order, the update phase, delayed-connection sampling and the advances;
+- the initial program (tick 0) orders outputs by ``initial_reads``. A dependency a block
+  has only at tick 0 (its ``initial_feedthrough``) is *soft*: every soft dependency that
+  lies on a cycle of the tick-0 graph is dropped, so that input holds its initial value at
+  t = 0 (``Schedule.initial_held``), where a loop of ordinary dependencies is an error.
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ from collections import deque
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import reduce
+from typing import NamedTuple
 
 import networkx as nx
 import numpy as np
@@ -32,17 +37,32 @@ from .timebase import format_duration, fraction_gcd
 
 MAX_HYPERPERIOD_TICKS = 10_000_000
 
+Steps = tuple[tuple[str, tuple[str, ...] | None], ...]
+"""An output phase: (block, the ports to compute or None for all of them), in order."""
+
+
+class HeldInput(NamedTuple):
+    """An input that holds its initial value (its default) when its block's outputs are
+    computed at t = 0, because the block's initial feedthrough from it would close ``loop``
+    (the port chain from the block's output back to this input)."""
+
+    block: str
+    port: str
+    loop: str
+
 
 @dataclass(frozen=True)
 class EventProgram:
     """What the executor does at one kind of event tick, in order."""
 
     firing: frozenset[str]
-    evaluate: tuple[tuple[str, tuple[str, ...] | None], ...]
+    evaluate: Steps
     update: tuple[str, ...]
     sample: tuple[int, ...]
     advance: tuple[str, ...]
     final: bool = False
+    held: tuple[HeldInput, ...] = ()
+    """Initial-feedthrough inputs this (initial) program evaluates before their source."""
 
     def describe(self) -> str:
         def step(b: str, ports: tuple[str, ...] | None) -> str:
@@ -75,6 +95,12 @@ class Schedule:
     initial: EventProgram
     delayed: list[Connection] = field(default_factory=list)
     final: EventProgram | None = None
+
+    @property
+    def initial_held(self) -> tuple[HeldInput, ...]:
+        """The inputs that hold their initial value at t = 0 although their block's initial
+        outputs read them: their dependency was dropped to break a loop at tick 0."""
+        return self.initial.held
 
     def hits(self, block: str, n_ticks: int) -> np.ndarray:
         """All ticks in [0, n_ticks] at which ``block`` fires (its sample times / base tick)."""
@@ -191,7 +217,7 @@ class _Planner:
                 index[firing] = len(programs)
                 programs.append(self.program(firing, lazy, advanced, final=False))
             event_programs.append(index[firing])
-        self.check_loops(masks, lazy)
+        self.check_loops(masks, at_zero, lazy)
         firing0 = frozenset(n for n in d.blocks if n not in lazy and (masks[n][0] or at_zero[n]))
         initial = self.program(firing0, lazy, advanced, final=n_ticks == 0, initial=True)
         final = None
@@ -202,15 +228,17 @@ class _Planner:
                         advanced, event_ticks, event_programs, programs, initial,
                         [c for c in d.connections if c.delay], final)
 
-    def check_loops(self, masks, lazy) -> None:
+    def check_loops(self, masks, at_zero, lazy) -> None:
         """Reject algebraic loops among all blocks that fire together, lazy ones included
-        (a loop of lazy blocks nobody reads is never evaluated, but is still an error)."""
+        (a loop of lazy blocks nobody reads is never evaluated, but is still an error);
+        at tick 0 through the blocks' initial dependencies."""
         if not lazy:
             return
         patterns = {frozenset(n for n in self.d.blocks if masks[n][r])
                     for r in np.flatnonzero(reduce(np.logical_or, (masks[n] for n in lazy)))}
         for together in patterns:
             self.order_outputs(set(together))
+        self.order_outputs({n for n in self.d.blocks if masks[n][0] or at_zero[n]}, initial=True)
 
     def fire_sets(self, period_ticks, offset_ticks, hyper):
         """Periodic firing mask over one hyperperiod, and 'fires at t = 0', for every block.
@@ -303,49 +331,59 @@ class _Planner:
             if s in lazy and s not in demanded:
                 demanded.add(s)
                 stack.extend(self.sources[s])
-        evaluate = self.order_outputs(set(stepped) | demanded)
+        evaluate, held = self.order_outputs(set(stepped) | demanded, initial)
         by_order = sorted(firing, key=self.order.get)
         if final:
-            return EventProgram(firing, evaluate, (), (), (), final=True)
+            return EventProgram(firing, evaluate, (), (), (), final=True, held=held)
         update = tuple(n for n in by_order if n not in advanced and d.blocks[n].block.is_stateful())
         sample = tuple(i for i, c in enumerate(d.connections) if c.delay and c.dst_block in firing)
         sample = tuple(sorted(sample))
         adv = tuple(n for n in by_order if n in advanced)
-        return EventProgram(firing, evaluate, update, sample, adv)
+        return EventProgram(firing, evaluate, update, sample, adv, held=held)
 
-    def feeds(self, nodes: set[str]):
-        """Same-tick dependencies among ``nodes``: (src, dst, connection) where dst reads src now."""
+    def feeds(self, nodes: set[str], initial: bool = False):
+        """Same-tick dependencies among ``nodes``: the connections whose destination reads its
+        source at the same tick (at tick 0 when ``initial``)."""
         for c in self.d.connections:
             if c.delay or c.src_block not in nodes or c.dst_block not in nodes:
                 continue
             dst = self.d.blocks[c.dst_block].block
-            if any(c.dst_port in dst.reads(p) for p in dst.outputs):
+            reads = dst.initial_reads if initial else dst.reads
+            if any(c.dst_port in reads(p) for p in dst.outputs):
                 yield c
 
-    def order_outputs(self, nodes: set[str]) -> tuple[tuple[str, tuple[str, ...] | None], ...]:
+    def order_outputs(self, nodes: set[str], initial: bool = False) -> tuple[Steps, tuple[HeldInput, ...]]:
+        """Evaluation steps for ``nodes`` (block, ports or None for all) and the inputs held
+        to break loops at tick 0 (``initial``); an algebraic loop is a DiagramError."""
         graph = nx.DiGraph()
         graph.add_nodes_from(nodes)
-        graph.add_edges_from((c.src_block, c.dst_block) for c in self.feeds(nodes))
+        graph.add_edges_from((c.src_block, c.dst_block) for c in self.feeds(nodes, initial))
         if nx.is_directed_acyclic_graph(graph):
             order = nx.lexicographical_topological_sort(graph, key=self.order.get)
-            return tuple((n, None) for n in order)
-        return self.order_ports(nodes)
+            return tuple((n, None) for n in order), ()
+        return self.order_ports(nodes, initial)
 
-    def order_ports(self, nodes: set[str]) -> tuple[tuple[str, tuple[str, ...] | None], ...]:
-        """Port-level order for blocks whose outputs have different feedthrough."""
+    def order_ports(self, nodes: set[str], initial: bool) -> tuple[Steps, tuple[HeldInput, ...]]:
+        """Port-level order for blocks whose outputs have different feedthrough, dropping
+        the soft (initial-only) dependencies that lie on a cycle when ``initial``."""
         graph = nx.DiGraph()
         wires: dict[tuple, Connection] = {}
+        soft: list[tuple] = []
         for n in sorted(nodes, key=self.order.get):
             blk = self.d.blocks[n].block
             for p in blk.outputs:
                 graph.add_node(("o", n, p))
-                for q in blk.reads(p):
+                hard = blk.reads(p)
+                for q in sorted(blk.initial_reads(p) if initial else hard):
                     graph.add_edge(("i", n, q), ("o", n, p))
+                    if q not in hard:
+                        soft.append((("i", n, q), ("o", n, p)))
         for c in self.d.connections:
             if not c.delay and c.src_block in nodes and c.dst_block in nodes:
                 edge = (("o", c.src_block, c.src_port), ("i", c.dst_block, c.dst_port))
                 graph.add_edge(*edge)
                 wires[edge] = c
+        held = self.drop_soft_cycles(graph, soft) if soft else ()
         try:
             cycle = nx.find_cycle(graph)
         except nx.NetworkXNoCycle:
@@ -354,9 +392,8 @@ class _Planner:
             start = min((i for i, e in enumerate(cycle) if e[0][0] == "o"),
                         key=lambda i: (self.order[cycle[i][0][1]], cycle[i][0][2]))
             cycle = cycle[start:] + cycle[:start]
-            chain = [f"{cycle[0][0][1]}.{cycle[0][0][2]}"] + [f"{v[1]}.{v[2]}" for _, v in cycle]
             line = next((wires[e].line for e in cycle if e in wires), None)
-            self.fail(line, f"algebraic loop: {' -> '.join(chain)}",
+            self.fail(line, f"algebraic loop: {_chain([cycle[0][0]] + [v for _, v in cycle])}",
                       "break it with a block without feedthrough (e.g. UnitDelay) or add "
                       "'delay: 1' to one connection")
         out_nodes = [v for v in nx.lexicographical_topological_sort(
@@ -367,4 +404,22 @@ class _Planner:
                 steps[-1][1].append(p)
             else:
                 steps.append((n, [p]))
-        return tuple((n, tuple(ps)) for n, ps in steps)
+        return tuple((n, tuple(ps)) for n, ps in steps), held
+
+    def drop_soft_cycles(self, graph: nx.DiGraph, soft: list[tuple]) -> tuple[HeldInput, ...]:
+        """Remove from ``graph`` every soft edge on a cycle (both ends in one strongly
+        connected component), which leaves only cycles of hard edges; one ``HeldInput`` per
+        block input that loses a dependency, with the loop it closed, in block order."""
+        component = {v: i for i, c in enumerate(nx.strongly_connected_components(graph)) for v in c}
+        cut = [(u, v) for u, v in soft if component[u] == component[v]]
+        held: dict[tuple[str, str], str] = {}
+        for u, v in cut:
+            if (u[1], u[2]) not in held:
+                held[u[1], u[2]] = _chain(nx.shortest_path(graph, v, u))
+        graph.remove_edges_from(cut)
+        return tuple(HeldInput(b, q, loop) for (b, q), loop in held.items())
+
+
+def _chain(ports) -> str:
+    """A path of port nodes as text: ``a.y -> b.u -> b.y``."""
+    return " -> ".join(f"{n}.{p}" for _, n, p in ports)

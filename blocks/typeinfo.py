@@ -40,14 +40,16 @@ def describe_type(cls: type[Block]) -> str:
         optional = f" (optional: {', '.join(block.input_defaults)})" if block.input_defaults else ""
         lines.append(f"  inputs: {ports(block.inputs)}{optional}")
         lines.append(f"  outputs: {ports(block.outputs)}")
-        lines.append(f"  feedthrough: {_feedthrough(block)}")
+        lines.append(f"  feedthrough: {_feedthrough(block.feedthrough)}")
+        if block.initial_feedthrough is not None:
+            lines.append(f"  feedthrough at t = 0: {_feedthrough(block.initial_feedthrough)}")
     if cls.time_varying:
         lines.append("  time-varying source: needs a period")
     return "\n".join(lines)
 
 
-def _feedthrough(block: Block) -> str:
-    ft = block.feedthrough
+def _feedthrough(ft) -> str:
+    """A feedthrough declaration (``True``, ``False`` or output -> inputs) as text."""
     if ft is True:
         return "yes"
     if ft is False:

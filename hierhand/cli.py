@@ -331,11 +331,18 @@ def cmd_validate(args: argparse.Namespace) -> int:
             notes.append("advanced between events")
         if blk.has_feedthrough():
             notes.append("feedthrough")
+        if any(blk.initial_reads(p) != blk.reads(p) for p in blk.outputs):
+            initial = sorted(set().union(*(blk.initial_reads(p) for p in blk.outputs)))
+            notes.append(f"feedthrough at t = 0 from {', '.join(initial)}" if initial
+                         else "no feedthrough at t = 0")
         print(f"  {name:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
               + (f"  ({', '.join(notes)})" if notes else ""))
     print_references_and_notes(diagram)
     print("execution order:")
     print(f"  t = 0: {s.initial.describe()}")
+    for held in s.initial_held:
+        print(f"    {held.block}.{held.port} holds its initial value at t = 0: {held.block} is computed "
+              f"before its source, which depends on it ({held.loop})")
     seen: dict[int, list[int]] = {}
     for r, j in zip(s.event_ticks, s.event_programs):
         seen.setdefault(j, []).append(int(r))

@@ -199,3 +199,48 @@ class Limits(Block):
 
     def output(self, t, state, inputs):
         return {"y": np.array([self.total])}
+
+
+class StartsFromInput(Block):
+    """A unit delay whose first output is its current input: y = u at its first hit, then
+    the u of the hit before. Like an FMU whose initial outputs follow the inputs set before
+    initialisation: no feedthrough but initial feedthrough. ``u`` defaults to -1."""
+
+    def __init__(self):
+        self.inputs = {"u": 1}
+        self.outputs = {"y": 1}
+        self.input_defaults = {"u": np.array([-1.0])}
+        self.feedthrough = False
+        self.initial_feedthrough = True
+
+    def initial_state(self):
+        return (False, np.zeros(1))
+
+    def output(self, t, state, inputs):
+        started, last = state
+        return {"y": (last if started else inputs["u"]).copy()}
+
+    def update(self, t, state, inputs):
+        return (True, inputs["u"].copy())
+
+
+class StartsFromOneInput(Block):
+    """Unit delays u -> y and w -> z (z starts at 0); only y's first output is its current
+    input (initial feedthrough ``{"y": {"u"}}``). Both inputs default to -1."""
+
+    def __init__(self):
+        self.inputs = {"u": 1, "w": 1}
+        self.outputs = {"y": 1, "z": 1}
+        self.input_defaults = {"u": np.array([-1.0]), "w": np.array([-1.0])}
+        self.feedthrough = False
+        self.initial_feedthrough = {"y": {"u"}}
+
+    def initial_state(self):
+        return (False, np.zeros(1), np.zeros(1))
+
+    def output(self, t, state, inputs):
+        started, last_u, last_w = state
+        return {"y": (last_u if started else inputs["u"]).copy(), "z": last_w.copy()}
+
+    def update(self, t, state, inputs):
+        return (True, inputs["u"].copy(), inputs["w"].copy())
