@@ -14,13 +14,21 @@ In a diagram::
       - plant.y -> ctrl.u
 
 Ports. Every input variable (causality ``input``) and output variable (causality
-``output``) of type Real (FMI 2) or Float64/Float32 (FMI 3) becomes a float64 port.
-Scalars named ``x[1]``, ``x[2]``, ... (and ``A[1,1]``, ``A[1,2]``, ... row-major) form
-one vector port ``x``; an FMI 3 array variable is one port of its flattened size. The
-indices must start at 1 and have no gaps. Port names are the variable (or vector) names
-with every character other than letters, digits and ``_`` replaced by ``_``
-(``body.v[2]`` -> port ``body_v``). Integer, Boolean and String inputs/outputs are not
-ports; give inputs of those types fixed values with ``start_values``.
+``output``) of a numeric type becomes a float64 port: Real, Integer, Enumeration and
+Boolean (FMI 2); Float64, Float32, Int8 ... UInt64, Enumeration and Boolean (FMI 3). An
+integer reaches the port exactly (a 64-bit one up to 2^53; a larger value stops the run
+with a BlockError rather than change), a Boolean as 0 or 1; an integer input takes whole
+numbers in its type's range and a Boolean input 0 or 1, anything else stops the run
+naming the port, value and time. ``port_types`` records each port's FMI type (in FMI 3
+names: FMI 2's Real is Float64, its Integer Int32), so ``validate`` lists connections
+between different types with their rules. Scalars named ``x[1]``, ``x[2]``, ... (and
+``A[1,1]``, ``A[1,2]``, ... row-major) form one vector port ``x``; an FMI 3 array variable
+is one port of its flattened size; ``element_labels`` keeps the FMU's indices for the CSV
+columns. The indices must start at 1 and have no gaps. Port names are the variable (or
+vector) names with every character other than letters, digits and ``_`` replaced by
+``_`` (``body.v[2]`` -> port ``body_v``). FMI 3 ``<Alias>`` outputs are ports of their own.
+String, Binary and Clock variables are not ports (``port_hint`` says so when a diagram
+names one); give String inputs values with ``start_values``.
 
 Co-simulation semantics. The block has no feedthrough: ``output(t)`` returns the FMU
 outputs at communication point ``t`` (read after the previous ``doStep``), and
@@ -29,7 +37,16 @@ therefore held over each communication step and an output never depends on the i
 the same instant, which makes the diagram free of algebraic loops through FMUs and the
 result independent of the evaluation order (the usual Jacobi co-simulation scheme). The
 first output, at the block's first hit ``t0`` (its offset), is the FMU's initial output
-after initialisation with start time ``t0``.
+after initialisation with start time ``t0``, with the inputs set before initialisation
+ends, as in FMPy. At t = 0 the blocks feeding the inputs the FMU's initial outputs depend
+on (its InitialUnknowns) are computed first (``initial_feedthrough``), unless that closes a
+loop, in which case the input keeps its start value there.
+
+Termination. An FMU that asks to end the simulation (FMI 2: ``fmi2Discard`` with
+``fmi2Terminated``; FMI 3: ``terminateSimulation``) ends the run with ``EndRun``: the run
+is complete and stops at the end of that communication step, where the FMU's outputs are
+those it reached (at ``lastSuccessfulTime``). A discard without that request, an early
+return or an error status is a failure.
 
 Loading and running. Loading a diagram reads only the archive's member list and its
 modelDescription.xml (``fmu_info.read_description``): ``hierhand validate`` and ``graph``
@@ -325,6 +342,15 @@ def _convert(kind: str, value: Any, name: str, major: int) -> Any:
     raise ValueError(f"start values of {kind} variables such as '{name}' are not supported")
 
 
+def _check_port_exact(name: str, values: list) -> None:
+    """ValueError if an input's start value would change on its way through a float64 port
+    (the block writes its inputs' values, so an unconnected input passes its start through one)."""
+    for x in values:
+        if isinstance(x, int) and not isinstance(x, bool) and int(float(x)) != x:
+            raise ValueError(f"start value of '{name}' is {x}, which its float64 port cannot hold exactly "
+                             "(integers are exact up to 2^53); use a value a float64 holds")
+
+
 def _start_of(v: Any) -> list | None:
     """A variable's modelDescription start, converted to its type (None if it has none,
     or one that does not read as its type)."""
@@ -407,8 +433,9 @@ class _Model:
             others = [k for k, v in (("model exchange", md.modelExchange),
                                      ("scheduled execution", md.scheduledExecution)) if v is not None]
             raise ValueError(f"{shown} has no co-simulation interface (it provides only "
-                             f"{' and '.join(others) or 'no interface'}); the FMU block runs "
-                             "co-simulation FMUs, so export the model for co-simulation")
+                             f"{' and '.join(others) or 'no interface'}); the FMU block runs FMI 2.0 "
+                             "and 3.0 co-simulation FMUs (not model exchange, not scheduled execution "
+                             "or clocks), so export the model for co-simulation")
         cs = md.coSimulation
         self.identifier = cs.modelIdentifier
         self.once_per_process = bool(cs.canBeInstantiatedOnlyOncePerProcess)
@@ -476,26 +503,23 @@ class _Model:
         return why
 
     def _initial_reads(self, md: Any) -> dict[str, frozenset[str]]:
-        """For each output port, the input ports its value at initialisation may depend on
-        (the modelDescription's InitialUnknowns: listed dependencies, all inputs when the
-        list is absent; an output not listed has an exact start and depends on none)."""
+        """For each output port, the input ports its value at initialisation depends on.
+
+        The modelDescription's InitialUnknowns say which inputs each output depends on
+        (all of them when the list is absent; none for an output not listed, whose start
+        is exact). An FMU is initialised once, as a whole, at its first output, so every
+        output waits for the union of those inputs.
+        """
         port_of_vr = {vr: p.name for p in self.inputs.values() for vr in p.vrs}
-        listed = {u.variable.valueReference: u for u in md.initialUnknowns if u.variable is not None}
-        every = frozenset(self.inputs)
-        out = {}
-        for port in self.outputs.values():
-            reads: set[str] = set()
-            for vr in port.vrs:
-                u = listed.get(vr)
-                if u is None:
-                    continue
-                if u.dependencies is None:
-                    reads = set(every)
-                    break
-                reads |= {port_of_vr[d.valueReference] for d in u.dependencies
-                          if d.valueReference in port_of_vr}
-            out[port.name] = frozenset(reads)
-        return out
+        reads: set[str] = set()
+        for u in md.initialUnknowns:
+            if u.variable is None or u.variable.causality != "output":
+                continue
+            if u.dependencies is None:
+                reads = set(self.inputs)
+                break
+            reads |= {port_of_vr[d.valueReference] for d in u.dependencies if d.valueReference in port_of_vr}
+        return {name: frozenset(reads) for name in self.outputs}
 
     # -- start values -------------------------------------------------------------------
 
@@ -526,6 +550,8 @@ class _Model:
             for v, w in zip(targets, widths):
                 converted = [_convert(v.type, x, v.name, self.major) for x in values[pos:pos + w]]
                 pos += w
+                if v.causality == "input" and v.type in _KINDS[self.major]:
+                    _check_port_exact(v.name, converted)
                 out.append(_Assignment(v.name, v.type, v.valueReference, converted))
         return out
 
@@ -857,7 +883,7 @@ class _Instance:
 
     def _check_exact(self, x: _Transfer, values: np.ndarray, t: float) -> None:
         """BlockError if a 64-bit integer output does not survive the trip to float64."""
-        big = np.flatnonzero(np.abs(values) > EXACT_INTEGERS)
+        big = np.flatnonzero(np.abs(values) >= EXACT_INTEGERS)
         for i in big:
             exact = int(x.view[i])
             if int(values[i]) != exact:

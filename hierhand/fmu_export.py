@@ -9,7 +9,8 @@ build it for another platform.
 
 - Inputs ``tau[1]``..``tau[9]``, ``f_ext[1]``..``f_ext[3]`` (start 0), held over a step.
 - Outputs: every element of every plant output port (``q[1]``, ..., ``normal[6]``),
-  ``initial="calculated"`` and independent of the inputs (no direct feedthrough).
+  ``initial="calculated"`` and independent of the inputs (no direct feedthrough, and
+  at initialisation they depend on the parameters only).
 - Parameters (``variability="fixed"``): every number of the hand file, named as the C
   core names them (``object.mass``, ``fingers[2].links[3].com[1]``, 1-based), start values
   from ``hand``; the FMU reads them from ``resources/hand_parameters.txt`` when
@@ -279,18 +280,23 @@ def model_description(fmi: int, identifier: str, token: str, hand) -> bytes:
             ET.SubElement(variables, "Float64", **attrs)
     structure = ET.SubElement(root, "ModelStructure")
     outputs = [(k + 1, v) for k, v in enumerate(entries) if v["causality"] == "output"]  # FMI 2: 1-based index
+    # initial outputs depend on the parameters only, never on the inputs: importers need
+    # not compute the inputs before initialising the FMU
+    parameters = [(k + 1, v) for k, v in enumerate(entries) if v["causality"] == "parameter"]
     if fmi == 2:
         block = ET.SubElement(structure, "Outputs")
         for index, _ in outputs:
             ET.SubElement(block, "Unknown", index=str(index), dependencies="")
         block = ET.SubElement(structure, "InitialUnknowns")
+        known = " ".join(str(index) for index, _ in parameters)
         for index, _ in outputs:
-            ET.SubElement(block, "Unknown", index=str(index))
+            ET.SubElement(block, "Unknown", index=str(index), dependencies=known)
     else:
         for _, v in outputs:
             ET.SubElement(structure, "Output", valueReference=str(v["vr"]), dependencies="")
+        known = " ".join(str(v["vr"]) for _, v in parameters)
         for _, v in outputs:
-            ET.SubElement(structure, "InitialUnknown", valueReference=str(v["vr"]))
+            ET.SubElement(structure, "InitialUnknown", valueReference=str(v["vr"]), dependencies=known)
     ET.indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
 

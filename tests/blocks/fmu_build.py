@@ -92,3 +92,16 @@ def interrupting_library(build: Path, status: int, at: float = 0.2) -> bytes:
     4 fatal: what an FMU does whose memory callback Ctrl-C broke)."""
     return compile_library(build / f"interrupting{status}{EXT}", "first_order_fmi2.c",
                            defines={"SIGINT_AT": repr(at), "SIGINT_STATUS": str(status)})
+
+
+def typed_fmu(build: Path, fmi: int, members: dict[str, bytes | str] | None = None) -> Path:
+    """The conformance FMU of ``typed_fmi2.c`` / ``typed_fmi3.c`` (a port of every type of
+    that FMI version, terminating at its parameter ``stop_at``), with extra ``members``."""
+    identifier = f"Typed{fmi}"
+    sources = ("typed_fmi2.c",) if fmi == 2 else ("typed_fmi3.c", "fmi3_unsupported.c")
+    library = compile_library(build / f"{identifier}{EXT}", *sources,
+                              defines={"TYPED_ACCESSORS": "1"} if fmi == 3 else None)
+    platform = fmpy.platform if fmi == 2 else fmpy.platform_tuple
+    files = {"modelDescription.xml": (SOURCES / f"typed_fmi{fmi}.xml").read_text(),
+             f"binaries/{platform}/{identifier}{EXT}": library, **(members or {})}
+    return zip_files(build / f"typed{fmi}.fmu", files)

@@ -155,6 +155,9 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
     outputs = [v for v in md.modelVariables if v.causality == "output"]
     assert all(v.initial == "calculated" for v in outputs)
     assert all(u.dependencies == [] for u in md.outputs)  # no direct feedthrough
+    # initial outputs depend on parameters only: an importer need not compute inputs first
+    assert {u.variable.name for u in md.initialUnknowns} == {v.name for v in outputs}
+    assert all({d.causality for d in u.dependencies} == {"parameter"} for u in md.initialUnknowns)
     assert md.coSimulation.canGetAndSetFMUstate and md.coSimulation.canSerializeFMUstate
     with zipfile.ZipFile(path) as archive:
         names = set(archive.namelist())

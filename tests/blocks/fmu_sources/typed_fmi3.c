@@ -7,6 +7,7 @@
  * that reaches the parameter stop_at sets terminateSimulation, lastSuccessfulTime stop_at.
  *
  * Value references: Float64 f_in 0, f_out 1, stop_at 2, m_out 3 (4 values), time_out 4;
+ * UInt64 u64_offset 5;
  * then input/output pairs Float32 10/11, Int8 12/13, UInt8 14/15, Int16 16/17,
  * UInt16 18/19, Int32 20/21, UInt32 22/23, Int64 24/25, UInt64 26/27, Boolean 28/29,
  * Enumeration 30/31 (through the Int64 functions); Binary bin_in 40; Clock tick 50.
@@ -29,7 +30,7 @@ typedef struct {
     fmi3Int32 i32[2];
     fmi3UInt32 u32[2];
     fmi3Int64 i64[2], e[2];
-    fmi3UInt64 u64[2];
+    fmi3UInt64 u64[2], u64_offset;
     fmi3Boolean b[2];
 } Model;
 
@@ -39,13 +40,14 @@ static void set_defaults(Model *m) {
     m->f32[0] = m->f32[1] = 0; m->i8[0] = m->i8[1] = 0; m->u8[0] = m->u8[1] = 0;
     m->i16[0] = m->i16[1] = 0; m->u16[0] = m->u16[1] = 0; m->i32[0] = m->i32[1] = 0;
     m->u32[0] = m->u32[1] = 0; m->i64[0] = m->i64[1] = 0; m->u64[0] = m->u64[1] = 0;
+    m->u64_offset = 0;
     m->b[0] = m->b[1] = fmi3False; m->e[0] = m->e[1] = 1;
 }
 
 static void follow_inputs(Model *m) {
     m->f[1] = m->f[0]; m->f32[1] = m->f32[0]; m->i8[1] = m->i8[0]; m->u8[1] = m->u8[0];
     m->i16[1] = m->i16[0]; m->u16[1] = m->u16[0]; m->i32[1] = m->i32[0]; m->u32[1] = m->u32[0];
-    m->i64[1] = m->i64[0]; m->u64[1] = m->u64[0]; m->b[1] = m->b[0]; m->e[1] = m->e[0];
+    m->i64[1] = m->i64[0]; m->u64[1] = m->u64[0] + m->u64_offset; m->b[1] = m->b[0]; m->e[1] = m->e[0];
 }
 
 static fmi3Status refuse(Model *m, fmi3ValueReference vr) {
@@ -78,7 +80,6 @@ PAIR(Int16, fmi3Int16, i16, 16)
 PAIR(UInt16, fmi3UInt16, u16, 18)
 PAIR(Int32, fmi3Int32, i32, 20)
 PAIR(UInt32, fmi3UInt32, u32, 22)
-PAIR(UInt64, fmi3UInt64, u64, 26)
 PAIR(Boolean, fmi3Boolean, b, 28)
 
 fmi3Status fmi3GetInt64(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, fmi3Int64 v[], size_t nv) {
@@ -97,6 +98,27 @@ fmi3Status fmi3SetInt64(fmi3Instance i, const fmi3ValueReference vr[], size_t nv
     for (size_t k = 0; k < nvr; k++) {
         if (vr[k] == 24) m->i64[0] = v[k];
         else if (vr[k] == 30) m->e[0] = v[k];
+        else return refuse(m, vr[k]);
+    }
+    return fmi3OK;
+}
+
+fmi3Status fmi3GetUInt64(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 v[], size_t nv) {
+    Model *m = i;
+    if (nvr != nv) return fmi3Error;
+    for (size_t k = 0; k < nvr; k++) {
+        if (vr[k] == 26 || vr[k] == 27) v[k] = m->u64[vr[k] - 26];
+        else if (vr[k] == 5) v[k] = m->u64_offset;
+        else return refuse(m, vr[k]);
+    }
+    return fmi3OK;
+}
+fmi3Status fmi3SetUInt64(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 v[], size_t nv) {
+    Model *m = i;
+    if (nvr != nv) return fmi3Error;
+    for (size_t k = 0; k < nvr; k++) {
+        if (vr[k] == 26) m->u64[0] = v[k];
+        else if (vr[k] == 5) m->u64_offset = v[k];
         else return refuse(m, vr[k]);
     }
     return fmi3OK;
