@@ -35,6 +35,32 @@ class BlockError(Exception):
         self.rows = rows
 
 
+_NOT_GIVEN: Any = object()
+
+
+class EndRun(Exception):
+    """Raised by a block's ``update`` to end the run normally (an FMU that requests
+    termination, say): the run is complete, only shorter.
+
+    The run finishes the tick of the request, goes on to the block's next hit (or to its
+    own end time if that comes first) and ends there as at a normal end time: the outputs
+    of the blocks that fire there are computed and logged, nothing is updated. ``reason``
+    is a short text for the status line; ``state``, when given, is the block's new state,
+    as ``update`` would have returned it (otherwise the state keeps what ``update`` did
+    to it in place). Only ``update`` may raise it: from ``output`` or ``advance`` it fails
+    the run.
+    """
+
+    def __init__(self, reason: str, state: Any = _NOT_GIVEN):
+        super().__init__(reason)
+        self.reason = reason
+        self.state = state
+
+    @property
+    def has_state(self) -> bool:
+        return self.state is not _NOT_GIVEN
+
+
 class ParameterError(ValueError):
     """Invalid parameters found by a block's constructor, one entry per problem.
 
@@ -125,7 +151,8 @@ class Block:
         """Next state after a sample hit (inputs are those seen by ``output`` at this hit).
 
         The executor keeps no reference to the previous state, so a block may update
-        the given state in place and return it.
+        the given state in place and return it. A block that wants the run to end raises
+        ``EndRun`` instead of returning.
         """
         return state
 

@@ -29,7 +29,8 @@ class Results:
 
     ``values`` has shape (samples, width); ``info`` holds what run.json records
     (status, diagram, parameters, timing). ``complete`` is False for a failed run,
-    whose signals stop where the failure happened.
+    whose signals stop where the failure happened. A run that a block ended early
+    (``EndRun``) is complete; ``ended_by`` says who ended it and where.
     """
 
     def __init__(self, signals: dict[str, tuple[np.ndarray, np.ndarray]], info: dict):
@@ -66,9 +67,29 @@ class Results:
         return self.status.startswith("interrupted")
 
     @property
+    def ended_by(self) -> dict | None:
+        """How a block ended this complete run before its t_end: ``block``, ``type``,
+        ``time`` (where the run ended), ``tick_time`` (the update that raised ``EndRun``)
+        and ``reason``; None for a run that was not ended that way."""
+        return self.info.get("ended_by")
+
+    @property
+    def end_note(self) -> str | None:
+        """``ended_by`` as one line, 'ended at t=9 s by block 'b' (Type): reason (asked in
+        its update at t=8.8 s)'; None when no block ended the run."""
+        ended = self.ended_by
+        if ended is None:
+            return None
+        return (f"ended at t={ended['time']:.9g} s by block '{ended['block']}' ({ended['type']}): "
+                f"{ended['reason']} (asked in its update at t={ended['tick_time']:.9g} s)")
+
+    @property
     def stop_time(self) -> float | None:
-        """Where a failed or interrupted run stopped: run.json's ``t_stop``, or the time in
-        the status of files written before it was recorded; None for a complete run."""
+        """Where the data end when that is not t_end: where a failed or interrupted run
+        stopped (run.json's ``t_stop``, or the time in the status of files written before
+        it was recorded) or where a block ended a complete run; None for a run to t_end."""
+        if self.ended_by is not None:
+            return float(self.ended_by["time"])
         if self.complete:
             return None
         if self.info.get("t_stop") is not None:
