@@ -178,6 +178,13 @@ class Block:
 
     # -- introspection helpers used by the loader, the scheduler and the CLI --------
 
+    def element_labels(self, port: str) -> list[str] | None:
+        """Names of the elements of output ``port``, one per element (``["1", "2"]`` or
+        ``["1,1", "1,2", ...]``), for the CSV columns ``signal[label]``; None, the
+        default, numbers them from 0. A block whose elements have names of their own (an
+        FMU's ``y[1]``, ``y[2]``) returns them so that files keep them."""
+        return None
+
     def describe(self) -> str:
         """A short note on where this block's configuration comes from, which
         ``hierhand validate`` prints beside the block (e.g. the model a plant simulates);

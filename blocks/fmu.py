@@ -17,10 +17,11 @@ Ports. Every input variable (causality ``input``) and output variable (causality
 ``output``) of type Real (FMI 2) or Float64/Float32 (FMI 3) becomes a float64 port.
 Scalars named ``x[1]``, ``x[2]``, ... (and ``A[1,1]``, ``A[1,2]``, ... row-major) form
 one vector port ``x``; an FMI 3 array variable is one port of its flattened size. The
-indices must start at 1 and have no gaps. Port names are the variable (or vector) names
-with every character other than letters, digits and ``_`` replaced by ``_``
-(``body.v[2]`` -> port ``body_v``). Integer, Boolean and String inputs/outputs are not
-ports; give inputs of those types fixed values with ``start_values``.
+indices must start at 1 and have no gaps; the vector's elements keep them in
+``signals.csv`` (``plant.x[1]``, ``plant.A[1,2]``). Port names are the variable (or
+vector) names with every character other than letters, digits and ``_`` replaced by
+``_`` (``body.v[2]`` -> port ``body_v``). Integer, Boolean and String inputs/outputs are
+not ports; give inputs of those types fixed values with ``start_values``.
 
 Co-simulation semantics. The block has no feedthrough: ``output(t)`` returns the FMU
 outputs at communication point ``t`` (read after the previous ``doStep``), and
@@ -132,6 +133,7 @@ class _Port:
     vrs: list[int]
     width: int
     source: str               # the variable or vector name in the FMU, for messages
+    labels: list[str] | None = None  # a vector's indices in the FMU: "1", "2", ... or "1,1", ...
 
 
 @dataclass
@@ -214,7 +216,7 @@ def _group_variables(variables: list, what: str, fmu: str) -> dict[str, _Port]:
                 raise ValueError(f"{what}s of {fmu}: vector '{base}' mixes the types "
                                  f"{', '.join(sorted(kinds))}")
             port = _Port(_port_name(base), items[0][1].type, [v.valueReference for _, v in items],
-                         len(items), f"{base}[...]")
+                         len(items), f"{base}[...]", [",".join(map(str, index)) for index in indices])
         if port.name in ports:
             raise ValueError(f"{what}s of {fmu}: '{origin[port.name]}' and '{port.source}' both map to "
                              f"the port name '{port.name}'")
@@ -927,6 +929,13 @@ class FMU(Block):
         if spec is None:
             raise KeyError(port)
         return spec.source
+
+    def element_labels(self, port: str) -> list[str] | None:
+        """A vector made of variables ``y[1]``, ``y[2]``, ... (``A[1,1]``, ...) keeps the
+        FMU's indices ("1", "2", ... or "1,1", ...); FMI 3 arrays and scalars are numbered
+        from 0."""
+        spec = self._model.outputs.get(port)
+        return None if spec is None else spec.labels
 
     def bind(self, period: Fraction | None) -> None:
         """The period is the communication step; without one, the FMU's default step

@@ -58,8 +58,9 @@ def figure(results: Results, names: Sequence[str], title: str | None = None):
         if end is not None and len(t) and t[-1] < end:
             t, v = np.append(t, end), np.vstack([v, v[-1:]])
         width = v.shape[1]
+        labels = results.element_labels(name) or [str(j) for j in range(width)]
         for j in range(width):
-            ax.step(t, v[:, j], where="post", label=f"[{j}]" if width > 1 else None, lw=1.2)
+            ax.step(t, v[:, j], where="post", label=f"[{labels[j]}]" if width > 1 else None, lw=1.2)
         if stop is not None:
             ax.axvline(stop, color="tab:red", ls="--", lw=1.0)
         ax.set_ylabel(name, rotation=0, ha="right", va="center")

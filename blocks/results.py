@@ -8,6 +8,8 @@ way with a status saying where it stopped.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import re
 from pathlib import Path
@@ -140,8 +142,21 @@ class Results:
                            for n, (t, v) in self.signals.items()}
         (folder / RUN_JSON).write_text(json.dumps(info, indent=2, default=str) + "\n", encoding="utf-8")
 
+    def element_labels(self, name: str) -> list[str] | None:
+        """The names the block gave the elements of signal ``name`` (run.json's
+        ``element_labels``), or None when they are numbered from 0."""
+        labels = (self.info.get("element_labels") or {}).get(name)
+        width = self[name][1].shape[1]
+        return [str(label) for label in labels] if labels is not None and len(labels) == width else None
+
     def write_csv(self, f) -> None:
-        """Columns ``time`` (every logged sample time) and each signal held at those times."""
+        """Columns ``time`` (every logged sample time) and each signal held at those times.
+
+        A signal of width 1 is the column ``block.port``; the columns of a wider one are
+        ``block.port[i]``, counting from 0, unless its block names its elements
+        (``Block.element_labels``): then ``block.port[label]``, so an FMU's ports keep the
+        FMU's own indices (``plant.y[1]``, ``plant.A[1,2]``).
+        """
         if not self.signals:
             f.write(b"time\n")
             return
@@ -149,9 +164,14 @@ class Results:
         columns, header = [grid[:, None]], ["time"]
         for name, (t, v) in self.signals.items():
             columns.append(self.held(name, grid))
-            header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
-        np.savetxt(f, np.hstack(columns), delimiter=",", header=",".join(header), comments="",
-                   fmt="%.17g")
+            labels = self.element_labels(name)
+            if labels is not None:
+                header += [f"{name}[{label}]" for label in labels]
+            else:
+                header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
+        names = io.StringIO()
+        csv.writer(names, lineterminator="").writerow(header)  # quotes labels such as "A[1,2]"
+        np.savetxt(f, np.hstack(columns), delimiter=",", header=names.getvalue(), comments="", fmt="%.17g")
 
     @classmethod
     def load(cls, directory: str | Path) -> "Results":

@@ -386,10 +386,12 @@ class _Run:
         wall0 = time.perf_counter()
         failure: _StepFailure | None = None
         interrupted: KeyboardInterrupt | None = None
+        labels: dict[str, list[str]] = {}
         k = 0
         stream = self.events()
         initial = self.compile(self.s.initial)
         try:
+            labels = self.element_labels()
             nk, nprog = next(stream, (n, None))
             nk = min(nk, n)
             initial(0, nk)
@@ -432,7 +434,7 @@ class _Run:
             t_stop = t_fail
         else:
             t_stop = None if ended_by is None else ended_by["time"]
-        info = self.info(status, wall, t_stop, ended_by)
+        info = self.info(status, wall, t_stop, ended_by, labels)
         results = Results(self.collect_through_interrupt(), info)
         if failure is not None:
             return results, SimulationError(status, results, failure.block, t_fail,
@@ -457,6 +459,26 @@ class _Run:
         return {"block": name, "type": self.d.blocks[name].type_name, "time": float(end * tick),
                 "tick_time": float(asked * tick), "reason": reason}
 
+    def element_labels(self) -> dict[str, list[str]]:
+        """The element names of the logged signals whose blocks name them
+        (``Block.element_labels``), checked once at the start: one label per element."""
+        found = {}
+        for e in self.d.log:
+            blk = self.d.blocks[e.block].block
+            try:
+                labels = blk.element_labels(e.port)
+                if labels is None:
+                    continue
+                labels = [str(label) for label in labels]
+                width = blk.outputs[e.port]
+                if len(labels) != width:
+                    raise BlockError(f"{len(labels)} labels for the {width} elements of '{e.port}'",
+                                     port=e.port)
+            except Exception as exc:
+                raise _StepFailure(e.block, "element_labels", 0, exc) from exc
+            found[e.signal] = labels
+        return found
+
     def collect_through_interrupt(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """``collect``, once more if an interrupt cuts it short: the signals are all there
         is of the run (a program that defers later interrupts lets the second try finish)."""
@@ -476,9 +498,11 @@ class _Run:
             signals[e.signal] = (ticks * tick.numerator / tick.denominator, lg.buf[:lg.pos].copy())
         return signals
 
-    def info(self, status: str, wall: float, t_stop: float | None, ended_by: dict | None) -> dict:
+    def info(self, status: str, wall: float, t_stop: float | None, ended_by: dict | None,
+             labels: dict[str, list[str]]) -> dict:
+        """run.json's record of the run (``element_labels`` only when a block names elements)."""
         simulated = float(self.t_end) if t_stop is None else t_stop
-        return {
+        info = {
             "diagram": self.d.name,
             "diagram_file": self.d.file,
             "diagram_hash": self.d.source_hash,
@@ -494,6 +518,9 @@ class _Run:
             "parameters": self.d.parameters(),
             "versions": dict(package_versions()),
         }
+        if labels:
+            info["element_labels"] = labels
+        return info
 
 
 @functools.cache

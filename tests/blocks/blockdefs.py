@@ -244,6 +244,21 @@ class EndInOutput(Block):
         return {"y": np.zeros(1)}
 
 
+class Labelled(Block):
+    """y = [1, 2, ..., width] with the elements named by ``labels`` (None: numbered from 0)."""
+
+    def __init__(self, labels=None, width: int = 3):
+        self.labels = labels
+        self.outputs = {"y": width}
+        self.feedthrough = False
+
+    def element_labels(self, port):
+        return self.labels
+
+    def output(self, t, state, inputs):
+        return {"y": np.arange(1.0, self.outputs["y"] + 1)}
+
+
 class EndInAdvance(FastAccumulator):
     """A FastAccumulator whose ``advance`` raises EndRun (which only update may)."""
 
