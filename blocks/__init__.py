@@ -4,7 +4,7 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``simula
 (Diagram -> Results), ``Results.load``, and the ``Block`` base class for new block types.
 """
 
-from .block import Block, BlockError, ParameterError
+from .block import Block, BlockError, EndRun, ParameterError
 from .diagram import Diagram, DiagramError, Issue, load_diagram, loads_diagram
 from .results import Results, ResultsError
 from .schedule import Schedule, build_schedule
@@ -12,7 +12,7 @@ from .simulate import SimulationError, StopRequest, simulate
 from .timebase import parse_duration
 
 __all__ = [
-    "Block", "BlockError", "Diagram", "DiagramError", "Issue", "ParameterError", "Results", "ResultsError",
-    "Schedule", "SimulationError", "StopRequest", "build_schedule", "load_diagram", "loads_diagram",
-    "parse_duration", "simulate",
+    "Block", "BlockError", "Diagram", "DiagramError", "EndRun", "Issue", "ParameterError", "Results",
+    "ResultsError", "Schedule", "SimulationError", "StopRequest", "build_schedule", "load_diagram",
+    "loads_diagram", "parse_duration", "simulate",
 ]

@@ -35,13 +35,30 @@ class BlockError(Exception):
         self.rows = rows
 
 
-class EndRun(Exception):
-    """TEMPORARY stand-in until the executor's version is merged."""
+_NOT_GIVEN: Any = object()
 
-    def __init__(self, reason: str, state=None):
+
+class EndRun(Exception):
+    """Raised by a block's ``update`` to end the run normally (an FMU that requests
+    termination, say): the run is complete, only shorter.
+
+    The run finishes the tick of the request, goes on to the block's next hit (or to its
+    own end time if that comes first) and ends there as at a normal end time: the outputs
+    of the blocks that fire there are computed and logged, nothing is updated. ``reason``
+    is a short text for the status line; ``state``, when given, is the block's new state,
+    as ``update`` would have returned it (otherwise the state keeps what ``update`` did
+    to it in place). Only ``update`` may raise it: from ``output`` or ``advance`` it fails
+    the run.
+    """
+
+    def __init__(self, reason: str, state: Any = _NOT_GIVEN):
         super().__init__(reason)
         self.reason = reason
         self.state = state
+
+    @property
+    def has_state(self) -> bool:
+        return self.state is not _NOT_GIVEN
 
 
 class ParameterError(ValueError):
@@ -145,7 +162,8 @@ class Block:
         """Next state after a sample hit (inputs are those seen by ``output`` at this hit).
 
         The executor keeps no reference to the previous state, so a block may update
-        the given state in place and return it.
+        the given state in place and return it. A block that wants the run to end raises
+        ``EndRun`` instead of returning.
         """
         return state
 
@@ -187,6 +205,12 @@ class Block:
     def port_hint(self, port: str) -> str | None:
         """Why ``port`` is not a port of this block when the name means something to it
         (an FMU's String variable), for the loader's "has no input" message; else None."""
+
+    def element_labels(self, port: str) -> list[str] | None:
+        """Names of the elements of output ``port``, one per element (``["1", "2"]`` or
+        ``["1,1", "1,2", ...]``), for the CSV columns ``signal[label]``; None, the
+        default, numbers them from 0. A block whose elements have names of their own (an
+        FMU's ``y[1]``, ``y[2]``) returns them so that files keep them."""
         return None
 
     def describe(self) -> str:

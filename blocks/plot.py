@@ -20,8 +20,9 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
     """Write PNG(s) of ``signals`` (default all) to ``path``; more than 8 signals make pages.
 
     Discrete signals hold between samples, so they are drawn as steps; a signal's last
-    value is held to the run's end time, or for a failed or interrupted run to where it
-    stopped, which a vertical line marks with the status. Returns the files written.
+    value is held to the run's end time (where a block ended it, if one did, as the title
+    says), or for a failed or interrupted run to where it stopped, which a vertical line
+    marks with the status. Returns the files written.
     """
     import matplotlib
 
@@ -57,8 +58,9 @@ def figure(results: Results, names: Sequence[str], title: str | None = None):
         if end is not None and len(t) and t[-1] < end:
             t, v = np.append(t, end), np.vstack([v, v[-1:]])
         width = v.shape[1]
+        labels = results.element_labels(name) or [str(j) for j in range(width)]
         for j in range(width):
-            ax.step(t, v[:, j], where="post", label=f"[{j}]" if width > 1 else None, lw=1.2)
+            ax.step(t, v[:, j], where="post", label=f"[{labels[j]}]" if width > 1 else None, lw=1.2)
         if stop is not None:
             ax.axvline(stop, color="tab:red", ls="--", lw=1.0)
         ax.set_ylabel(name, rotation=0, ha="right", va="center")
@@ -71,8 +73,9 @@ def figure(results: Results, names: Sequence[str], title: str | None = None):
                             color="tab:red", fontsize="small")
     axes[-1, 0].set_xlabel("time (s)")
     heading = title or results.info.get("diagram", "")
-    if not results.complete:
-        heading += "\n" + textwrap.fill(f"[{results.status}]", TITLE_WIDTH)
+    note = results.end_note if results.complete else results.status
+    if note:
+        heading += "\n" + textwrap.fill(f"[{note}]", TITLE_WIDTH)
     fig.suptitle(heading)
     fig.tight_layout()
     return fig
@@ -81,11 +84,12 @@ def figure(results: Results, names: Sequence[str], title: str | None = None):
 def time_span(results: Results) -> tuple[float | None, float | None]:
     """(the time the plots reach, the time a failed or interrupted run stopped or None).
 
-    A complete run reaches its t_end; an incomplete one where it stopped (its last sample
-    when its run.json does not say), never its t_end: its signals were not held that far."""
-    if results.complete:
-        return results.info.get("t_end"), None
+    A complete run reaches its t_end, or where a block ended it; an incomplete one where it
+    stopped (its last sample when its run.json does not say), never its t_end: its signals
+    were not held that far."""
     stop = results.stop_time
+    if results.complete:
+        return (results.info.get("t_end") if stop is None else stop), None
     if stop is None:
         stop = max((float(t[-1]) for t, _ in results.signals.values() if len(t)), default=None)
     return stop, stop

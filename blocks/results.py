@@ -8,6 +8,8 @@ way with a status saying where it stopped.
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import re
 from pathlib import Path
@@ -29,7 +31,8 @@ class Results:
 
     ``values`` has shape (samples, width); ``info`` holds what run.json records
     (status, diagram, parameters, timing). ``complete`` is False for a failed run,
-    whose signals stop where the failure happened.
+    whose signals stop where the failure happened. A run that a block ended early
+    (``EndRun``) is complete; ``ended_by`` says who ended it and where.
     """
 
     def __init__(self, signals: dict[str, tuple[np.ndarray, np.ndarray]], info: dict):
@@ -66,9 +69,29 @@ class Results:
         return self.status.startswith("interrupted")
 
     @property
+    def ended_by(self) -> dict | None:
+        """How a block ended this complete run before its t_end: ``block``, ``type``,
+        ``time`` (where the run ended), ``tick_time`` (the update that raised ``EndRun``)
+        and ``reason``; None for a run that was not ended that way."""
+        return self.info.get("ended_by")
+
+    @property
+    def end_note(self) -> str | None:
+        """``ended_by`` as one line, 'ended at t=9 s by block 'b' (Type): reason (asked in
+        its update at t=8.8 s)'; None when no block ended the run."""
+        ended = self.ended_by
+        if ended is None:
+            return None
+        return (f"ended at t={ended['time']:.9g} s by block '{ended['block']}' ({ended['type']}): "
+                f"{ended['reason']} (asked in its update at t={ended['tick_time']:.9g} s)")
+
+    @property
     def stop_time(self) -> float | None:
-        """Where a failed or interrupted run stopped: run.json's ``t_stop``, or the time in
-        the status of files written before it was recorded; None for a complete run."""
+        """Where the data end when that is not t_end: where a failed or interrupted run
+        stopped (run.json's ``t_stop``, or the time in the status of files written before
+        it was recorded) or where a block ended a complete run; None for a run to t_end."""
+        if self.ended_by is not None:
+            return float(self.ended_by["time"])
         if self.complete:
             return None
         if self.info.get("t_stop") is not None:
@@ -119,8 +142,21 @@ class Results:
                            for n, (t, v) in self.signals.items()}
         (folder / RUN_JSON).write_text(json.dumps(info, indent=2, default=str) + "\n", encoding="utf-8")
 
+    def element_labels(self, name: str) -> list[str] | None:
+        """The names the block gave the elements of signal ``name`` (run.json's
+        ``element_labels``), or None when they are numbered from 0."""
+        labels = (self.info.get("element_labels") or {}).get(name)
+        width = self[name][1].shape[1]
+        return [str(label) for label in labels] if labels is not None and len(labels) == width else None
+
     def write_csv(self, f) -> None:
-        """Columns ``time`` (every logged sample time) and each signal held at those times."""
+        """Columns ``time`` (every logged sample time) and each signal held at those times.
+
+        A signal of width 1 is the column ``block.port``; the columns of a wider one are
+        ``block.port[i]``, counting from 0, unless its block names its elements
+        (``Block.element_labels``): then ``block.port[label]``, so an FMU's ports keep the
+        FMU's own indices (``plant.y[1]``, ``plant.A[1,2]``).
+        """
         if not self.signals:
             f.write(b"time\n")
             return
@@ -128,9 +164,14 @@ class Results:
         columns, header = [grid[:, None]], ["time"]
         for name, (t, v) in self.signals.items():
             columns.append(self.held(name, grid))
-            header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
-        np.savetxt(f, np.hstack(columns), delimiter=",", header=",".join(header), comments="",
-                   fmt="%.17g")
+            labels = self.element_labels(name)
+            if labels is not None:
+                header += [f"{name}[{label}]" for label in labels]
+            else:
+                header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
+        names = io.StringIO()
+        csv.writer(names, lineterminator="").writerow(header)  # quotes labels such as "A[1,2]"
+        np.savetxt(f, np.hstack(columns), delimiter=",", header=names.getvalue(), comments="", fmt="%.17g")
 
     @classmethod
     def load(cls, directory: str | Path) -> "Results":

@@ -128,6 +128,12 @@ class Schedule:
         count = cycles * int(mask.sum()) + int(mask[:rest + 1].sum())
         return count + (1 if self.fires_at_zero[block] and not mask[0] else 0)
 
+    def next_hit(self, block: str, tick: int) -> int | None:
+        """The first tick after ``tick`` at which ``block`` fires; None if it never fires again."""
+        if not self.masks[block].any():
+            return None
+        return int(self.nth_hits(block, np.array([self.hit_count(block, tick)]))[0])
+
     def rate_text(self, block: str) -> str:
         p = self.period_ticks[block]
         if p is not None:
@@ -149,6 +155,19 @@ def build_schedule(diagram: Diagram, t_end: Fraction | None) -> Schedule:
     if plan is None:
         plan = diagram.plans[t_end] = _Planner(diagram).plan(t_end)
     return plan
+
+
+def final_program(diagram: Diagram, schedule: Schedule, tick: int) -> EventProgram:
+    """The last program of a run that ends at ``tick`` rather than at ``schedule.n_ticks``
+    (a block ended it): the outputs of the blocks that fire there, no updates."""
+    firing = _firing_at(schedule.masks, schedule.lazy, tick)
+    return _Planner(diagram).program(firing, schedule.lazy, schedule.advanced, final=True)
+
+
+def _firing_at(masks: dict[str, np.ndarray], lazy: frozenset[str], tick: int) -> frozenset[str]:
+    """The blocks other than lazy ones whose periodic firing includes ``tick`` (so not the
+    blocks that fire at t = 0 only)."""
+    return frozenset(n for n, mask in masks.items() if n not in lazy and mask[tick % mask.size])
 
 
 class _Planner:
@@ -212,7 +231,7 @@ class _Planner:
         index: dict[frozenset[str], int] = {}
         event_programs = []
         for r in event_ticks:
-            firing = frozenset(n for n in d.blocks if n not in lazy and masks[n][r])
+            firing = _firing_at(masks, lazy, r)
             if firing not in index:
                 index[firing] = len(programs)
                 programs.append(self.program(firing, lazy, advanced, final=False))
@@ -222,8 +241,7 @@ class _Planner:
         initial = self.program(firing0, lazy, advanced, final=n_ticks == 0, initial=True)
         final = None
         if n_ticks:
-            firing_n = frozenset(n for n in d.blocks if n not in lazy and masks[n][n_ticks % hyper])
-            final = self.program(firing_n, lazy, advanced, final=True)
+            final = self.program(_firing_at(masks, lazy, n_ticks), lazy, advanced, final=True)
         return Schedule(base, hyper, n_ticks, period_ticks, offset_ticks, masks, at_zero, lazy,
                         advanced, event_ticks, event_programs, programs, initial,
                         [c for c in d.connections if c.delay], final)

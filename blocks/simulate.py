@@ -6,6 +6,11 @@ the advanced blocks stepped to the next event. Outputs are passed by reference f
 block's return value into the persistent input mappings of the blocks it feeds (no
 per-tick dictionaries or copies); between hits values hold. Time is ``k * base_tick``
 from the integer tick ``k``.
+
+A block ends a run early by raising ``EndRun`` from its ``update`` at tick k: the tick
+is finished, the ticks up to the block's next hit run as usual, and that hit (or t_end,
+if earlier) becomes the end: outputs only, logged, as at a normal end time. The run is
+complete; ``info["ended_by"]`` says which block asked, when, why, and where it ended.
 """
 
 from __future__ import annotations
@@ -19,10 +24,10 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .block import BlockError
+from .block import BlockError, EndRun
 from .diagram import Diagram, DiagramError
 from .results import Results
-from .schedule import EventProgram, Schedule, build_schedule
+from .schedule import EventProgram, Schedule, build_schedule, final_program
 from .timebase import DurationError, format_duration, parse_duration
 
 ADVANCE_CHUNK = 4096
@@ -67,7 +72,9 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
 
     A block failure does not lose the run: the returned Results carry the signals up to
     the failure and ``status`` 'failed at t=...: ...' (or raise ``SimulationError``
-    holding them when ``raise_on_failure``).
+    holding them when ``raise_on_failure``). A block that raises ``EndRun`` ends the run
+    at its next hit; the Results are complete, with ``ended_by`` set when that was
+    before ``t_end``.
     """
     if t_end is None:
         t_end = diagram.t_end
@@ -178,6 +185,10 @@ class _Run:
         self.checked: set[str] = set()
         self.reached: int | None = None
         """The tick an interrupted advance span had logged, when the interrupt came in one."""
+        self.end_tick = self.n_ticks
+        """Where the run ends: t_end's tick, or earlier once a block has raised EndRun."""
+        self.end_request: tuple[str, str, int] | None = None
+        """The first EndRun: (block, reason, tick of the update that raised it)."""
 
     # -- building the per-event programs ------------------------------------------------
 
@@ -238,10 +249,24 @@ class _Run:
         def op(k: int, t: float) -> None:
             try:
                 states[i] = update(t, states[i], inp)
+            except EndRun as end:
+                if end.has_state:
+                    states[i] = end.state
+                self.request_end(name, end.reason, k)
             except Exception as exc:
                 raise _StepFailure(name, "update", k, exc) from exc
 
         return op
+
+    def request_end(self, name: str, reason: str, k: int) -> None:
+        """Record a block's EndRun at tick ``k``: the run ends at the block's next hit, or
+        t_end if that comes first. When several blocks ask, the first one asking is the
+        one reported and the earliest of their ends is the end."""
+        if self.end_request is None:
+            self.end_request = (name, reason, k)
+        nxt = self.s.next_hit(name, k)
+        if nxt is not None and nxt < self.end_tick:
+            self.end_tick = nxt
 
     def sample_op(self, c):
         src, dst, sp, dp = self.held[c.src_block], self.inputs[c.dst_block], c.src_port, c.dst_port
@@ -355,18 +380,22 @@ class _Run:
             cycle += 1
 
     def execute(self, progress: ProgressCallback | None) -> tuple[Results, SimulationError | None]:
-        n = self.n_ticks
+        """Run ticks 0 .. end. Progress is the fraction of t_end reached, so a run that a
+        block ends early stops short of 1."""
+        n = total = self.n_ticks
         wall0 = time.perf_counter()
         failure: _StepFailure | None = None
         interrupted: KeyboardInterrupt | None = None
+        labels: dict[str, list[str]] = {}
         k = 0
         stream = self.events()
         initial = self.compile(self.s.initial)
-        final = self.compile(self.s.final)
         try:
+            labels = self.element_labels()
             nk, nprog = next(stream, (n, None))
             nk = min(nk, n)
             initial(0, nk)
+            n = self.end_tick
             count = 0
             while nk < n:
                 k, prog = nk, nprog
@@ -374,11 +403,13 @@ class _Run:
                 if nk > n:
                     nk = n
                 prog(k, nk)
+                n = self.end_tick
                 count += 1
                 if progress is not None and count & 255 == 0:
-                    progress(k / n, time.perf_counter() - wall0)
+                    progress(k / total, time.perf_counter() - wall0)
             k = n
-            final(n, n)
+            final = self.s.final if n == total else final_program(self.d, self.s, n)
+            self.compile(final)(n, n)
         except _StepFailure as exc:
             failure = exc
         except KeyboardInterrupt as exc:
@@ -387,25 +418,66 @@ class _Run:
                 k = max(k, self.reached)
         wall = time.perf_counter() - wall0
         if progress is not None and failure is None and interrupted is None:
-            progress(1.0, wall)
+            progress(n / total, wall)
         t_fail = float((failure.tick if failure is not None else k) * self.s.base_tick)
+        ended_by = None
         if failure is not None:
-            err = failure.error
-            port = getattr(err, "port", None)
-            spec = self.d.blocks[failure.block]
-            signal = f", signal {failure.block}.{port}" if port else ""
-            status = (f"failed at t={t_fail:.9g} s: block '{failure.block}' ({spec.type_name}){signal} "
-                      f"{failure.phase}: {err}")
+            status = self.failure_status(failure, t_fail)
         elif interrupted is not None:
             by = f" by {interrupted.reason}" if isinstance(interrupted, StopRequest) else ""
             status = f"interrupted at t={t_fail:.9g} s{by}"
         else:
             status = "complete"
-        t_stop = t_fail if status != "complete" else None
-        results = Results(self.collect_through_interrupt(), self.info(status, wall, t_stop))
+            if n < total:
+                ended_by = self.ended_by(n)
+        if status != "complete":
+            t_stop = t_fail
+        else:
+            t_stop = None if ended_by is None else ended_by["time"]
+        info = self.info(status, wall, t_stop, ended_by, labels)
+        results = Results(self.collect_through_interrupt(), info)
         if failure is not None:
-            return results, SimulationError(status, results, failure.block, t_fail, port)
+            return results, SimulationError(status, results, failure.block, t_fail,
+                                            getattr(failure.error, "port", None))
         return results, None
+
+    def failure_status(self, failure: _StepFailure, t_fail: float) -> str:
+        """'failed at t=...: block 'b' (Type), signal b.y phase: message'."""
+        err = failure.error
+        port = getattr(err, "port", None)
+        spec = self.d.blocks[failure.block]
+        signal = f", signal {failure.block}.{port}" if port else ""
+        message = (f"EndRun must be raised from update, not {failure.phase} ({err.reason})"
+                   if isinstance(err, EndRun) else err)
+        return (f"failed at t={t_fail:.9g} s: block '{failure.block}' ({spec.type_name}){signal} "
+                f"{failure.phase}: {message}")
+
+    def ended_by(self, end: int) -> dict[str, Any]:
+        """run.json's record of the EndRun that ended the run at tick ``end``."""
+        name, reason, asked = self.end_request
+        tick = self.s.base_tick
+        return {"block": name, "type": self.d.blocks[name].type_name, "time": float(end * tick),
+                "tick_time": float(asked * tick), "reason": reason}
+
+    def element_labels(self) -> dict[str, list[str]]:
+        """The element names of the logged signals whose blocks name them
+        (``Block.element_labels``), checked once at the start: one label per element."""
+        found = {}
+        for e in self.d.log:
+            blk = self.d.blocks[e.block].block
+            try:
+                labels = blk.element_labels(e.port)
+                if labels is None:
+                    continue
+                labels = [str(label) for label in labels]
+                width = blk.outputs[e.port]
+                if len(labels) != width:
+                    raise BlockError(f"{len(labels)} labels for the {width} elements of '{e.port}'",
+                                     port=e.port)
+            except Exception as exc:
+                raise _StepFailure(e.block, "element_labels", 0, exc) from exc
+            found[e.signal] = labels
+        return found
 
     def collect_through_interrupt(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """``collect``, once more if an interrupt cuts it short: the signals are all there
@@ -426,9 +498,11 @@ class _Run:
             signals[e.signal] = (ticks * tick.numerator / tick.denominator, lg.buf[:lg.pos].copy())
         return signals
 
-    def info(self, status: str, wall: float, t_stop: float | None) -> dict:
+    def info(self, status: str, wall: float, t_stop: float | None, ended_by: dict | None,
+             labels: dict[str, list[str]]) -> dict:
+        """run.json's record of the run (``element_labels`` only when a block names elements)."""
         simulated = float(self.t_end) if t_stop is None else t_stop
-        return {
+        info = {
             "diagram": self.d.name,
             "diagram_file": self.d.file,
             "diagram_hash": self.d.source_hash,
@@ -439,10 +513,14 @@ class _Run:
             "wall_time_s": wall,
             "real_time_factor": simulated / wall if wall > 0 else None,
             "t_stop": t_stop,
+            "ended_by": ended_by,
             "block_types": {name: spec.type_name for name, spec in self.d.blocks.items()},
             "parameters": self.d.parameters(),
             "versions": dict(package_versions()),
         }
+        if labels:
+            info["element_labels"] = labels
+        return info
 
 
 @functools.cache

@@ -261,7 +261,8 @@ class ProgressBar:
 def cmd_run(args: argparse.Namespace) -> int:
     """Simulate and save. The output folder is checked before the run; Ctrl-C or SIGTERM
     stops the run and its results so far are saved, and no signal cuts the saving short
-    (``stop_signals``); after an interrupt the plots are skipped, to stop soon."""
+    (``stop_signals``); after an interrupt the plots are skipped, to stop soon. A run that
+    a block ends early (``EndRun``) is complete: it says where and why, even with -q."""
     from blocks import DiagramError, simulate
     from blocks.results_folder import OutputFolderError
     from blocks.safepath import folder_name
@@ -297,10 +298,13 @@ def cmd_run(args: argparse.Namespace) -> int:
                    if args.plot and results.interrupted else "")
         print(f"hierhand: partial results (marked incomplete) saved in {out}{skipped}", file=sys.stderr)
         return exit_code(stops.received) if results.interrupted else EXIT_FAILED
+    if results.ended_by is not None:
+        print(f"{diagram.name}: {results.end_note}")
     if not args.quiet:
         info = results.info
         rtf = info.get("real_time_factor")
-        print(f"{diagram.name}: {float(t_end):g} s simulated in {info['wall_time_s']:.3g} s"
+        simulated = results.stop_time if results.ended_by is not None else float(t_end)
+        print(f"{diagram.name}: {simulated:g} s simulated in {info['wall_time_s']:.3g} s"
               + (f" ({rtf:.3g}x real time)" if rtf else "") + f"; results in {out}"
               + (f", plots: {', '.join(str(p) for p in saved.plots)}" if saved.plots else ""))
     return EXIT_OK

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from blocks import Block, BlockError, ParameterError
+from blocks import Block, BlockError, EndRun, ParameterError
 
 
 class Accumulator(Block):
@@ -244,3 +244,68 @@ class StartsFromOneInput(Block):
 
     def update(self, t, state, inputs):
         return (True, inputs["u"].copy(), inputs["w"].copy())
+
+
+class Counter(Block):
+    """y = count; each update adds 1 and, once the count reaches ``stop``, raises EndRun
+    with the new count as its state (or, with ``give_state`` false, without a state, so
+    the count stays where it was). ``u`` is only there to inherit a rate from."""
+
+    input_defaults = {"u": np.zeros(1)}
+
+    def __init__(self, stop: int = 3, give_state: bool = True):
+        self.stop, self.give_state = stop, give_state
+        self.inputs = {"u": 1}
+        self.outputs = {"y": 1}
+        self.feedthrough = False
+
+    def initial_state(self):
+        return np.zeros(1)
+
+    def output(self, t, state, inputs):
+        return {"y": state.copy()}
+
+    def update(self, t, state, inputs):
+        new = state + 1.0
+        if new[0] >= self.stop:
+            if self.give_state:
+                raise EndRun(f"the count reached {self.stop}", state=new)
+            raise EndRun(f"the count reached {self.stop}")
+        return new
+
+
+class EndInOutput(Block):
+    """y = 0 until ``t_end``, then its output raises EndRun (which only update may)."""
+
+    outputs = {"y": 1}
+    time_varying = True
+
+    def __init__(self, t_end: float = 0.002):
+        self.t_end = t_end
+
+    def output(self, t, state, inputs):
+        if t >= self.t_end:
+            raise EndRun("done")
+        return {"y": np.zeros(1)}
+
+
+class Labelled(Block):
+    """y = [1, 2, ..., width] with the elements named by ``labels`` (None: numbered from 0)."""
+
+    def __init__(self, labels=None, width: int = 3):
+        self.labels = labels
+        self.outputs = {"y": width}
+        self.feedthrough = False
+
+    def element_labels(self, port):
+        return self.labels
+
+    def output(self, t, state, inputs):
+        return {"y": np.arange(1.0, self.outputs["y"] + 1)}
+
+
+class EndInAdvance(FastAccumulator):
+    """A FastAccumulator whose ``advance`` raises EndRun (which only update may)."""
+
+    def advance(self, t, state, inputs, n):
+        raise EndRun("done")

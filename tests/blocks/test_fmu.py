@@ -130,6 +130,14 @@ def test_fmi2_fmu_matches_the_closed_form(fmus):
     np.testing.assert_allclose(z[:, 1], t, atol=1e-12)         # z[2] = the FMU's own time
 
 
+def test_csv_columns_keep_the_fmus_indices(fmus, tmp_path):
+    """z[1], z[2] of the FMI 2 FMU keep their names; the FMI 3 array z has none, so counts from 0."""
+    simulate(diagram(fmus.fmi2, t_end="0.2 s")).save(tmp_path / "fmi2", csv=True)
+    assert (tmp_path / "fmi2" / "signals.csv").read_text().splitlines()[0] == "time,f.y,f.z[1],f.z[2]"
+    simulate(diagram(fmus.fmi3, t_end="0.2 s")).save(tmp_path / "fmi3", csv=True)
+    assert (tmp_path / "fmi3" / "signals.csv").read_text().splitlines()[0] == "time,f.y,f.z[0],f.z[1]"
+
+
 def test_start_values_of_every_type_change_the_result(fmus):
     sv = "{a: 0.9, b: 0.5, x0: 2.0, scale: 3, frozen: false}"
     results = simulate(diagram(fmus.fmi2, start_values=sv))

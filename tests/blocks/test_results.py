@@ -227,3 +227,41 @@ def test_held_values_are_the_last_sample_at_or_before_each_time():
     held = res.held("a.y", np.array([0.0, 0.1, 0.2, 0.3, 0.9]))
     np.testing.assert_array_equal(held[1:, 0], [1.0, 1.0, 2.0, 2.0])
     assert np.isnan(held[0, 0])  # before the first sample
+
+
+LABELLED = """
+time: {t_end: 2 ms}
+blocks:
+  named: {type: "python:tests.blocks.blockdefs:Labelled", period: 1 ms, params: {labels: LABELS}}
+  plain: {type: "python:tests.blocks.blockdefs:Labelled", period: 1 ms, params: {width: 2}}
+log: [named.y, plain.y]
+"""
+
+
+def labelled_run(labels: str) -> Results:
+    return blocks.simulate(blocks.loads_diagram(LABELLED.replace("LABELS", labels), trust=True))
+
+
+def test_csv_columns_use_the_element_labels_a_block_gives(tmp_path):
+    r = labelled_run('["1,1", "1,2", "2,1"]')
+    assert r.complete, r.status
+    assert r.info["element_labels"] == {"named.y": ["1,1", "1,2", "2,1"]}
+    r.save(tmp_path / "run", csv=True)
+    header, rows = read_csv(tmp_path / "run" / "signals.csv")
+    assert header == ["time", "named.y[1,1]", "named.y[1,2]", "named.y[2,1]", "plain.y[0]", "plain.y[1]"]
+    assert rows[-1] == pytest.approx([0.002, 1.0, 2.0, 3.0, 1.0, 2.0])
+    again = Results.load(tmp_path / "run")
+    again.save(tmp_path / "again", csv=True)
+    assert (tmp_path / "again" / "signals.csv").read_bytes() == (tmp_path / "run" / "signals.csv").read_bytes()
+
+
+def test_without_element_labels_run_json_has_none():
+    r = labelled_run("null")
+    assert "element_labels" not in r.info
+
+
+def test_element_labels_of_the_wrong_length_fail_the_run_at_its_start():
+    r = labelled_run('["1", "2"]')
+    assert r.status == ("failed at t=0 s: block 'named' (Labelled), signal named.y element_labels: "
+                        "2 labels for the 3 elements of 'y'")
+    assert len(r["named.y"][0]) == 0
