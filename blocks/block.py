@@ -205,6 +205,7 @@ class Block:
     def port_hint(self, port: str) -> str | None:
         """Why ``port`` is not a port of this block when the name means something to it
         (an FMU's String variable), for the loader's "has no input" message; else None."""
+        return None
 
     def element_labels(self, port: str) -> list[str] | None:
         """Names of the elements of output ``port``, one per element (``["1", "2"]`` or

@@ -131,11 +131,11 @@ def test_fmi2_fmu_matches_the_closed_form(fmus):
 
 
 def test_csv_columns_keep_the_fmus_indices(fmus, tmp_path):
-    """z[1], z[2] of the FMI 2 FMU keep their names; the FMI 3 array z has none, so counts from 0."""
+    """z[1], z[2] of the FMI 2 FMU keep their names; the FMI 3 array z counts from 1 as FMI does."""
     simulate(diagram(fmus.fmi2, t_end="0.2 s")).save(tmp_path / "fmi2", csv=True)
     assert (tmp_path / "fmi2" / "signals.csv").read_text().splitlines()[0] == "time,f.y,f.z[1],f.z[2]"
     simulate(diagram(fmus.fmi3, t_end="0.2 s")).save(tmp_path / "fmi3", csv=True)
-    assert (tmp_path / "fmi3" / "signals.csv").read_text().splitlines()[0] == "time,f.y,f.z[0],f.z[1]"
+    assert (tmp_path / "fmi3" / "signals.csv").read_text().splitlines()[0] == "time,f.y,f.z[1],f.z[2]"
 
 
 def test_start_values_of_every_type_change_the_result(fmus):
