@@ -82,7 +82,7 @@ def marker_library(build: Path, markers: Path) -> bytes:
     """The FMI 2 first-order FMU's library with ``marker.c``: it leaves
     ``<library file>.loaded`` in ``markers`` when loaded and ``<library file>.instantiated``
     when fmi2Instantiate runs (see ``fmu_sources/marker.c``)."""
-    return compile_library(build / f"marker{EXT}", "first_order_fmi2.c", "marker.c",
+    return compile_library(build / f"marker{EXT}", "first_order_fmi2.c", "fmi2_unsupported.c", "marker.c",
                            defines={"TRACE_RUNS": "1", "MARKER_DIR": f'"{markers}"'})
 
 
@@ -90,7 +90,7 @@ def interrupting_library(build: Path, status: int, at: float = 0.2) -> bytes:
     """The FMI 2 first-order FMU's library whose doStep, from time ``at`` on, sends the
     process SIGINT (as Ctrl-C would), logs a message and returns ``status`` (0 ok, 3 error,
     4 fatal: what an FMU does whose memory callback Ctrl-C broke)."""
-    return compile_library(build / f"interrupting{status}{EXT}", "first_order_fmi2.c",
+    return compile_library(build / f"interrupting{status}{EXT}", "first_order_fmi2.c", "fmi2_unsupported.c",
                            defines={"SIGINT_AT": repr(at), "SIGINT_STATUS": str(status)})
 
 
@@ -98,9 +98,9 @@ def typed_fmu(build: Path, fmi: int, members: dict[str, bytes | str] | None = No
     """The conformance FMU of ``typed_fmi2.c`` / ``typed_fmi3.c`` (a port of every type of
     that FMI version, terminating at its parameter ``stop_at``), with extra ``members``."""
     identifier = f"Typed{fmi}"
-    sources = ("typed_fmi2.c",) if fmi == 2 else ("typed_fmi3.c", "fmi3_unsupported.c")
+    sources = (f"typed_fmi{fmi}.c", f"fmi{fmi}_unsupported.c")
     library = compile_library(build / f"{identifier}{EXT}", *sources,
-                              defines={"TYPED_ACCESSORS": "1"} if fmi == 3 else None)
+                              defines={"STEP_STATUS": "1"} if fmi == 2 else {"TYPED_ACCESSORS": "1"})
     platform = fmpy.platform if fmi == 2 else fmpy.platform_tuple
     files = {"modelDescription.xml": (SOURCES / f"typed_fmi{fmi}.xml").read_text(),
              f"binaries/{platform}/{identifier}{EXT}": library, **(members or {})}

@@ -73,7 +73,8 @@ def fmus(tmp_path_factory) -> Fmus:
         pytest.skip(why)
     build = tmp_path_factory.mktemp("fmu_build")
     markers = tmp_path_factory.mktemp("fmu_markers")
-    lib2 = compile_library(build / ("fo2" + fmpy.sharedLibraryExtension), "first_order_fmi2.c")
+    lib2 = compile_library(build / ("fo2" + fmpy.sharedLibraryExtension), "first_order_fmi2.c",
+                           "fmi2_unsupported.c")
     lib3 = compile_library(build / ("fo3" + fmpy.sharedLibraryExtension), "first_order_fmi3.c",
                            "fmi3_unsupported.c")
     interrupting = {status: interrupting_library(build, status) for status in (0, 4)}

@@ -162,24 +162,3 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
     outputs(m);
     return fmi2OK;
 }
-
-/* Functions this FMU does not provide (fmpy loads every symbol of the API). */
-#define UNSUPPORTED(name, args) fmi2Status name args { return fmi2Error; }
-UNSUPPORTED(fmi2GetFMUstate, (fmi2Component c, fmi2FMUstate *s))
-UNSUPPORTED(fmi2SetFMUstate, (fmi2Component c, fmi2FMUstate s))
-UNSUPPORTED(fmi2FreeFMUstate, (fmi2Component c, fmi2FMUstate *s))
-UNSUPPORTED(fmi2SerializedFMUstateSize, (fmi2Component c, fmi2FMUstate s, size_t *n))
-UNSUPPORTED(fmi2SerializeFMUstate, (fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t n))
-UNSUPPORTED(fmi2DeSerializeFMUstate, (fmi2Component c, const fmi2Byte b[], size_t n, fmi2FMUstate *s))
-UNSUPPORTED(fmi2GetDirectionalDerivative, (fmi2Component c, const fmi2ValueReference u[], size_t nu,
-            const fmi2ValueReference k[], size_t nk, const fmi2Real dk[], fmi2Real du[]))
-UNSUPPORTED(fmi2SetRealInputDerivatives, (fmi2Component c, const fmi2ValueReference vr[], size_t n,
-            const fmi2Integer o[], const fmi2Real v[]))
-UNSUPPORTED(fmi2GetRealOutputDerivatives, (fmi2Component c, const fmi2ValueReference vr[], size_t n,
-            const fmi2Integer o[], fmi2Real v[]))
-UNSUPPORTED(fmi2CancelStep, (fmi2Component c))
-UNSUPPORTED(fmi2GetStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Status *v))
-UNSUPPORTED(fmi2GetRealStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Real *v))
-UNSUPPORTED(fmi2GetIntegerStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Integer *v))
-UNSUPPORTED(fmi2GetBooleanStatus, (fmi2Component c, const fmi2StatusKind k, fmi2Boolean *v))
-UNSUPPORTED(fmi2GetStringStatus, (fmi2Component c, const fmi2StatusKind k, fmi2String *v))
