@@ -472,7 +472,7 @@ def cmd_fmu_export(args: argparse.Namespace) -> int:
 
 
 def cmd_fmu_info(args: argparse.Namespace) -> int:
-    from blocks.fmu_info import FMUInfoError, describe_fmu
+    from blocks.fmu import FMUInfoError, describe_fmu
 
     try:
         print(describe_fmu(args.path))

@@ -24,7 +24,7 @@ import pytest
 
 import blocks
 from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, simulate
-from blocks.fmu_archive import ArchiveError, Limits, extract_archive, read_member
+from blocks.fmu.archive import ArchiveError, Limits, extract_archive, read_member
 
 fmpy = pytest.importorskip("fmpy")
 
@@ -352,7 +352,7 @@ def test_an_interrupt_lost_in_a_callback_is_raised_after_the_call():
     ctypes hands to sys.unraisablehook for it, is raised by the next check()."""
     from types import SimpleNamespace
 
-    from blocks import fmu_interrupt
+    from blocks.fmu import interrupt as fmu_interrupt
 
     @fmu_interrupt.callback
     def log(*args):
@@ -449,7 +449,7 @@ blocks:
 
 
 def test_fmu_info_shows_the_fixed_internal_step(fmus):
-    from blocks.fmu_info import describe_fmu
+    from blocks.fmu import describe_fmu
 
     assert "fixed internal step: 0.04 s" in describe_fmu(_fixed_step(fmus, 3, "0.04", "fixed_info.fmu"))
     assert "fixed internal step" not in describe_fmu(fmus.fmi3)
@@ -536,7 +536,7 @@ def test_unsafe_archive_is_refused_by_the_block(fmus, tmp_path):
 def test_grouping_rules():
     from types import SimpleNamespace as V
 
-    from blocks.fmu import _group_variables
+    from blocks.fmu.ports import group_variables as _group_variables
 
     def var(name, vr, type="Real"):
         return V(name=name, valueReference=vr, type=type, dimensions=[], shape=())
@@ -609,7 +609,7 @@ def test_extractor_limits_size_and_count(tmp_path):
 
 def test_archive_limits_keep_a_zip_bomb_small():
     """At most 256 MiB per member and in all (once 1 GiB and 4 GiB), at most 200-fold inflation."""
-    from blocks import fmu_archive
+    from blocks.fmu import archive as fmu_archive
 
     assert fmu_archive.MAX_MEMBER_BYTES == fmu_archive.MAX_TOTAL_BYTES == 256 * 2**20
     assert fmu_archive.MAX_RATIO == 200 and fmu_archive.RATIO_FLOOR_BYTES == 2**20
@@ -631,7 +631,7 @@ def test_a_member_that_inflates_too_much_is_refused(tmp_path):
 def test_the_bytes_are_counted_as_they_are_decompressed(tmp_path):
     """The running count does not rely on the headers: a member whose header says it is
     huge (so zipfile does not cut it) is stopped once the bytes read pass a limit."""
-    from blocks.fmu_archive import _chunks
+    from blocks.fmu.archive import _chunks
 
     archive = zip_files(tmp_path / "a.zip", {"x.bin": os.urandom(5000)})
     with zipfile.ZipFile(archive) as zf:
@@ -660,7 +660,7 @@ def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
 
 
 def test_fmu_info_lists_interfaces_experiment_and_variables(fmus, tmp_path):
-    from blocks.fmu_info import FMUInfoError, describe_fmu
+    from blocks.fmu import FMUInfoError, describe_fmu
 
     text = describe_fmu(fmus.fmi2)
     assert "FMI 2.0" in text and "co-simulation (model identifier" in text

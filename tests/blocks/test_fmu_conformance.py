@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from blocks import DiagramError, Results, build_schedule, loads_diagram, simulate
-from blocks.fmu_archive import ArchiveError, extract_archive
+from blocks.fmu.archive import ArchiveError, extract_archive
 
 fmpy = pytest.importorskip("fmpy")
 
@@ -317,7 +317,7 @@ def test_only_co_simulation_is_supported_and_the_message_says_what_is(typed, tmp
 
 
 def test_fmu_info_lists_every_variable_type(typed):
-    from blocks.fmu_info import describe_fmu
+    from blocks.fmu import describe_fmu
 
     text = describe_fmu(typed[3])
     for kind in ("UInt64", "Int8", "Boolean", "Enumeration", "Binary", "Clock"):

@@ -1,7 +1,7 @@
 """What an FMU declares, read safely and without running any of its code.
 
 ``read_description`` reads only the archive's member list and its ``modelDescription.xml``
-(into memory, through ``fmu_archive.read_member``, with the archive limits): nothing is
+(into memory, through ``archive.read_member``, with the archive limits): nothing is
 extracted to disk and no binary is loaded. The FMU block reads its FMU this way when a
 diagram is loaded (``hierhand validate`` and ``graph`` never run an FMU's code) and
 extracts and loads the binary only when a run starts; ``hierhand fmu info`` prints
@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree
 
-from .fmu_archive import ArchiveError, read_member
+from .archive import ArchiveError, read_member
 
 MODEL_DESCRIPTION = "modelDescription.xml"
 

@@ -1,0 +1,93 @@
+"""FMU import: an FMI 2.0 or 3.0 co-simulation FMU as a block, through fmpy's low-level API.
+
+In a diagram::
+
+    blocks:
+      plant:
+        type: FMU
+        period: 10 ms                          # the communication step size (required)
+        params:
+          path: fmus/first_order.fmu           # relative to the diagram's folder
+          start_values: {a: 0.9, "z[2]": 1.0, gains: [1, 2, 3]}
+    connections:
+      - ctrl.y -> plant.u
+      - plant.y -> ctrl.u
+
+Ports. Every input variable (causality ``input``) and output variable (causality
+``output``) of a numeric type becomes a float64 port: Real, Integer, Enumeration and
+Boolean (FMI 2); Float64, Float32, Int8 ... UInt64, Enumeration and Boolean (FMI 3). An
+integer reaches the port exactly (a 64-bit one up to 2^53; a larger value stops the run
+with a BlockError rather than change), a Boolean as 0 or 1; an integer input takes whole
+numbers in its type's range and a Boolean input 0 or 1, anything else stops the run
+naming the port, value and time. ``port_types`` records each port's FMI type (in FMI 3
+names: FMI 2's Real is Float64, its Integer Int32), so ``validate`` lists connections
+between different types with their rules. Scalars named ``x[1]``, ``x[2]``, ... (and
+``A[1,1]``, ``A[1,2]``, ... row-major) form one vector port ``x``; an FMI 3 array variable
+is one port of its flattened size; ``element_labels`` keeps the FMU's indices for the CSV
+columns. The indices must start at 1 and have no gaps. Port names are the variable (or
+vector) names with every character other than letters, digits and ``_`` replaced by
+``_`` (``body.v[2]`` -> port ``body_v``). FMI 3 ``<Alias>`` outputs are ports of their own.
+String, Binary and Clock variables are not ports (``port_hint`` says so when a diagram
+names one); give String inputs values with ``start_values``.
+
+Co-simulation semantics. The block has no feedthrough: ``output(t)`` returns the FMU
+outputs at communication point ``t`` (read after the previous ``doStep``), and
+``update(t)`` sets the inputs seen at ``t`` and calls ``doStep(t, period)``. Inputs are
+therefore held over each communication step and an output never depends on the input of
+the same instant, which makes the diagram free of algebraic loops through FMUs and the
+result independent of the evaluation order (the usual Jacobi co-simulation scheme). The
+first output, at the block's first hit ``t0`` (its offset), is the FMU's initial output
+after initialisation with start time ``t0``, with the inputs set before initialisation
+ends, as in FMPy. At t = 0 the blocks feeding the inputs the FMU's initial outputs depend
+on (its InitialUnknowns) are computed first (``initial_feedthrough``), unless that closes a
+loop, in which case the input keeps its start value there.
+
+Termination. An FMU that asks to end the simulation (FMI 2: ``fmi2Discard`` with
+``fmi2Terminated``; FMI 3: ``terminateSimulation``) ends the run with ``EndRun``: the run
+is complete and stops at the end of that communication step, where the FMU's outputs are
+those it reached (at ``lastSuccessfulTime``). A discard without that request, an early
+return or an error status is a failure.
+
+Loading and running. Loading a diagram reads only the archive's member list and its
+modelDescription.xml (``description.read_description``): ``hierhand validate`` and ``graph``
+never run an FMU's code. The archive is extracted and the binary loaded when a run first
+needs an instance, at the block's first ``output`` or ``update``.
+
+State. The FMU instance is external mutable state: ``initial_state()`` hands each run its
+own ``FMUState``, which takes an instance from the block's pool (reset), or instantiates
+one if every pooled one is in use, at the run's first call. When the run's state is
+garbage collected (or ``close()``d) the instance is terminated and returned to the pool;
+instances are freed when the block goes away, at process exit, or by ``FMU.close()``. An
+instance that failed is freed, never reused. The state cannot be copied or checkpointed
+(FMU get/set state is not used).
+
+Errors. Problems with the file, its modelDescription and a period the FMU cannot step
+are raised at load time (ValueError, which the diagram loader reports as
+``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, and a
+failing ``doStep``, raise ``BlockError`` naming the FMU, the time and the status, with the
+FMU's recent log messages; the executor keeps the results up to that point. Ctrl-C inside
+an FMU call is a KeyboardInterrupt, never an FMU failure (see ``interrupt``).
+
+Modules, one concept each:
+
+- ``block``: the FMU block and its run state ``FMUState``;
+- ``model``: what the modelDescription says, checked when the block is made;
+- ``port_types``: the FMI types that become ports and how their values travel as float64;
+- ``ports``: variables grouped into ports, element labels, initial dependencies;
+- ``start_values``: what start values may set, their conversion and checks;
+- ``pool``: the instances of one FMU, reused across runs;
+- ``instance``: one FMU instance with its preallocated per-step calls, FMI 2 and 3;
+- ``log_messages``: the FMUs' log messages and the FMI 2 logger proxy;
+- ``interrupt``: Ctrl-C inside FMU calls;
+- ``description``: reading a modelDescription without running code (``hierhand fmu info``);
+- ``archive``: safe reading and extraction of FMU archives.
+"""
+
+from .archive import ArchiveError, Limits, extract_archive, read_member
+from .block import FMU, FMUState
+from .description import FMUDescription, FMUInfoError, describe_fmu, read_description
+
+__all__ = [
+    "FMU", "ArchiveError", "FMUDescription", "FMUInfoError", "FMUState", "Limits", "describe_fmu",
+    "extract_archive", "read_description", "read_member",
+]

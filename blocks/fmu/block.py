@@ -1,0 +1,294 @@
+"""The FMU block, and its run state: an FMI 2.0 / 3.0 co-simulation FMU as a block.
+
+``FMU`` is what a diagram's ``type: FMU`` makes (the semantics are in the package
+docstring). Making it reads and checks the FMU's modelDescription and the block's
+``start_values`` and runs none of the FMU's code, so loading, ``validate`` and ``graph``
+are safe. ``initial_state()`` gives each run an ``FMUState``: a handle to one instance of
+the block's pool, taken at the run's first ``output`` or ``update``. ``output`` returns the
+outputs at the current communication point; ``update`` sets the inputs, steps and reads
+the outputs of the next point. Failures become BlockErrors naming the FMU, the time and
+the status, with the FMU's recent log; a request to terminate becomes ``EndRun``; Ctrl-C
+inside an FMU call stays a KeyboardInterrupt (``interrupt``).
+"""
+
+from __future__ import annotations
+
+import os
+import weakref
+import zipfile
+from collections.abc import Mapping
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from ..block import Block, BlockError, EndRun, Signal
+from ..timebase import format_duration
+from . import interrupt
+from .instance import Instance
+from .log_messages import status_name
+from .model import float_or_none
+from .pool import PooledModel
+from .start_values import assignments, input_starts, start_of
+
+STEP_TOLERANCE = Fraction(1, 10**6)
+"""How far (in internal steps) a period may miss a whole multiple of an FMU's fixed internal
+step; the exported hand plant accepts the same."""
+
+
+class FMUState:
+    """The run state of an FMU block: a handle to one FMU instance (external and mutable).
+
+    ``instance`` is taken from the block's pool when the run first needs it (its first
+    ``output`` or ``update``), so creating the state runs none of the FMU's code.
+    ``time`` is the FMU's current communication point (None before initialisation) and
+    ``outputs`` the FMU outputs there. ``close()`` gives the instance back to the block
+    early; otherwise that happens when the state is garbage collected.
+    """
+
+    __slots__ = ("instance", "model", "time", "outputs", "ended", "_release", "__weakref__")
+
+    def __init__(self, model: PooledModel):
+        if model.closed:
+            raise BlockError(f"{model.shown}: the FMU block was closed")
+        self.instance: Instance | None = None
+        self.model = model
+        self.time: float | None = None
+        self.outputs: dict[str, Signal] | None = None
+        self.ended: float | None = None
+        self._release: weakref.finalize | None = None
+
+    def acquire(self) -> Instance:
+        """The run's instance, taken from the pool (loading the FMU) on first use."""
+        if self.instance is None:
+            self.instance = self.model.acquire()
+            self._release = weakref.finalize(self, self.model.release, self.instance)
+        return self.instance
+
+    def close(self) -> None:
+        if self._release is not None:
+            self._release()
+
+    def __deepcopy__(self, memo):
+        raise TypeError("the state of an FMU block is a live FMU instance and cannot be copied")
+
+    def __repr__(self) -> str:
+        return f"FMUState({self.model.shown}, t={self.time})"
+
+
+class FMU(Block):
+    """An FMI 2.0 / 3.0 co-simulation FMU; its period is the communication step."""
+
+    param_docs = {
+        "path": "the .fmu file; in a diagram a relative path is resolved against the diagram's "
+                "folder (from Python, against the current directory)",
+        "start_values": "mapping of FMU variable names to start values (parameters, inputs, "
+                        "variables with an exact/approx start); a vector 'x' for x[1], x[2], ... "
+                        "or an FMI 3 array takes a list",
+        "tolerance": "relative tolerance passed to the FMU's solver; default: the FMU's "
+                     "DefaultExperiment tolerance, if any",
+    }
+    time_varying = True
+    path_params = ("path",)
+
+    def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
+                 tolerance: float | None = None):
+        if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
+            raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
+        file = Path(path).expanduser()
+        resolved = (file if file.is_absolute() else Path.cwd() / file).absolute()
+        shown = f"FMU '{path}'"
+        if not resolved.exists():
+            raise ValueError(f"FMU file not found: looked at {resolved} (in a diagram, a relative path "
+                             "is resolved against the diagram's folder; from Python, against the "
+                             "current directory)")
+        if resolved.is_dir():
+            raise ValueError(f"{shown} is a folder; give the path of the .fmu file")
+        if not zipfile.is_zipfile(resolved):
+            raise ValueError(f"{shown} is not an FMU: not a zip archive")
+        if start_values is None:
+            start_values = {}
+        if not isinstance(start_values, Mapping):
+            raise ValueError("parameter 'start_values' must be a mapping of variable names to values, "
+                             f"got {type(start_values).__name__}")
+        if tolerance is not None:
+            tolerance = float_or_none(tolerance)
+            if tolerance is None:
+                raise ValueError("parameter 'tolerance' must be a positive number")
+        self.path = resolved
+        self._model = PooledModel(resolved, shown)
+        model = self._model
+        self._assignments = assignments(model, start_values)
+        self.tolerance = tolerance if tolerance is not None else model.default_tolerance
+        self.inputs = {p.name: p.width for p in model.inputs.values()}
+        self.outputs = {p.name: p.width for p in model.outputs.values()}
+        self.input_defaults = input_starts(model, self._assignments)
+        self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
+        self.feedthrough = False
+        self.initial_feedthrough = model.initial_reads
+        self._step = 0.0
+
+    @property
+    def fmi_version(self) -> str:
+        return self._model.md.fmiVersion
+
+    @property
+    def default_step(self) -> Fraction | None:
+        """The FMU's DefaultExperiment stepSize, if it declares one."""
+        return self._model.default_step
+
+    def describe(self) -> str:
+        given = len(self._assignments)
+        return (f"FMI {self.fmi_version} co-simulation {self._model.shown}"
+                + (f" ({given} start value{'s' if given != 1 else ''} set)" if given else ""))
+
+    def parameter_values(self) -> dict[str, Any]:
+        """Every parameter variable (causality ``parameter``) with the value a run starts
+        it with: the block's ``start_values`` over the modelDescription's start. Real and
+        Float values as float, integers as int, Boolean as bool, String as str, an FMI 3
+        array as a list. A parameter with neither is left out. For tools that model what
+        the FMU simulates (a controller built for an exported plant)."""
+        given = {a.vr: a.values for a in self._assignments}
+        out: dict[str, Any] = {}
+        for v in self._model.md.modelVariables:
+            if v.causality != "parameter":
+                continue
+            values = given.get(v.valueReference)
+            if values is None:
+                values = start_of(v)
+            if values:
+                out[v.name] = values if v.dimensions else values[0]
+        return out
+
+    def element_labels(self, port: str) -> list[str] | None:
+        """A vector port's elements by the FMU's own indices (``y[1]``, ``A[1,2]``), from 1."""
+        spec = self._model.inputs.get(port) or self._model.outputs.get(port)
+        return spec.labels if spec is not None else None
+
+    def input_rule(self, port: str) -> str | None:
+        spec = self._model.inputs.get(port)
+        return None if spec is None or spec.kind.name == "Float64" else spec.kind.input_rule()
+
+    def output_rule(self, port: str) -> str | None:
+        spec = self._model.outputs.get(port)
+        return None if spec is None or spec.kind.name == "Float64" else spec.kind.output_rule()
+
+    def port_hint(self, port: str) -> str | None:
+        """Why ``port`` is not a port of this FMU, when it names one of its variables."""
+        why = self._model.not_ports.get(port)
+        return f"{why} ({self._model.shown})" if why else None
+
+    def variable_of(self, port: str) -> str:
+        """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""
+        spec = self._model.inputs.get(port) or self._model.outputs.get(port)
+        if spec is None:
+            raise KeyError(port)
+        return spec.source
+
+    def bind(self, period: Fraction | None) -> None:
+        """The period is the communication step; without one, the FMU's default step
+        (DefaultExperiment stepSize) is used, and the diagram schedules the block at it.
+        An FMU with a fixed internal step needs a whole multiple of it."""
+        given = period is not None
+        if period is None:
+            period = self._model.default_step
+            if period is None:
+                raise ValueError("an FMU block needs a period, its communication step size (the FMU "
+                                 "declares no default step size: add e.g. 'period: 1 ms')")
+        fixed = self._model.fixed_step
+        if fixed is not None:
+            count = period / fixed
+            if count < 1 or abs(count - round(count)) > STEP_TOLERANCE:
+                which = "period" if given else "default step (DefaultExperiment stepSize)"
+                near = max(1, round(count)) * fixed
+                raise ValueError(f"the {which} {format_duration(period)} is not a whole multiple of the "
+                                 f"fixed internal step {format_duration(fixed)} of {self._model.shown}, "
+                                 f"so the FMU would refuse every step; use a multiple of it, e.g. "
+                                 f"'period: {format_duration(near)}'")
+        super().bind(period)
+        self._step = float(period)
+
+    def is_stateful(self) -> bool:  # without instantiating the FMU, as initial_state() would
+        return True
+
+    def initial_state(self) -> FMUState:
+        return FMUState(self._model)
+
+    def _start(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> None:
+        """The run's first call: take an instance (loading the FMU) and initialise it at
+        ``t`` with the inputs it has now (connected ones are computed first when the FMU's
+        initial outputs depend on them, see ``initial_feedthrough``)."""
+        inst = state.acquire()
+        try:
+            inst.start(t, self._assignments, self.tolerance, inputs)
+            state.time = t
+            state.outputs = inst.read(t)
+        except BlockError:
+            inst.broken = True
+            interrupt.check()
+            raise
+        except Exception as exc:
+            raise self._failure(inst, f"initialising the FMU at t={t:.9g} s failed: {_reason(exc)}") from None
+        interrupt.check()
+
+    def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        if state.time is None:
+            self._start(t, state, inputs)
+        return state.outputs
+
+    def update(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> FMUState:
+        if state.time is None:
+            self._start(t, state, inputs)
+        inst = state.instance
+        h = self._step
+        if inst.broken:
+            raise BlockError(f"{self._model.shown}: the FMU instance failed earlier and cannot step")
+        if state.ended is not None:
+            raise BlockError(f"{self._model.shown}: the FMU ended the simulation at t={state.ended:.9g} s "
+                             "and cannot step further")
+        if abs(t - state.time) > 1e-9 * max(h, abs(t)):
+            raise BlockError(f"{self._model.shown}: asked to step from t={t:.9g} s, but the FMU is at "
+                             f"t={state.time:.9g} s (the block must fire every period)")
+        try:
+            inst.arm()
+            inst.write(inputs, t)
+            terminate, early, last = inst.do_step(t, h)
+            interrupt.check()
+            if terminate:
+                state.time = state.ended = last
+                state.outputs = inst.read(last)
+                short = f" (its step to t={t + h:.9g} s stopped at t={last:.9g} s)" if last < t + h - 1e-9 * h else ""
+                raise EndRun(f"{self._model.shown} requested to terminate the simulation{short}", state)
+            if early:
+                inst.broken = True
+                raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) returned early "
+                                 f"at t={last:.9g} s, which co-simulation here does not allow{inst.log_text()}")
+            state.time = t + h
+            state.outputs = inst.read(state.time)
+        except (BlockError, EndRun):
+            raise
+        except Exception as exc:
+            raise self._failure(inst, _reason(exc, t, h)) from None
+        return state
+
+    def _failure(self, inst: Instance, what: str) -> BlockError:
+        """The error of a failed call into the FMU, which breaks the instance: ``what`` with
+        the FMU's name and recent log. A failure that comes with Ctrl-C is the interrupt,
+        raised here instead."""
+        inst.broken = True
+        interrupt.check()
+        return BlockError(f"{self._model.shown}: {what}{inst.log_text()}")
+
+    def close(self) -> None:
+        """Free the pooled FMU instances and, once no run holds one, the extracted files."""
+        self._model.close()
+
+
+def _reason(exc: BaseException, t: float | None = None, h: float | None = None) -> str:
+    function = getattr(exc, "function", None)
+    status = getattr(exc, "status", None)
+    if function is None:
+        return f"{type(exc).__name__}: {exc}" if not isinstance(exc, BlockError) else str(exc)
+    label = status_name(status)
+    if function.endswith("DoStep") and t is not None:
+        return f"{function} at t={t:.9g} s (step {h:.9g} s) returned status '{label}'"
+    return f"{function} returned status '{label}'"

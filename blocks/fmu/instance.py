@@ -1,0 +1,366 @@
+"""One FMU instance: an fmpy slave made ready for the per-step calls of a run.
+
+An instance loads the FMU's binary from the extracted archive, instantiates it with our
+callbacks (the C library's calloc and free, with no Python in between that Ctrl-C could
+break, and the log callback of ``log_messages``) and preallocates its value transfers:
+for each group of ports of one FMI type, the value references, the C buffer and a numpy
+view of it, bound with the instance into one call (``Transfer``). The per-step calls,
+``write``, ``do_step`` and ``read``, then only move values: they call the FMU's C
+functions directly and check the status here, because fmpy's Python wrappers (and, for
+FMI 3's doStep, its fresh output arguments) cost more than the call; a failing call
+raises fmpy's own ``FMICallException``, as the wrappers would.
+
+Values are checked on their way: an integer or Boolean input takes only values its type
+holds, and a 64-bit integer output that a float64 port cannot hold exactly (beyond 2^53)
+stops the run, each as a BlockError naming port, value and time.
+
+``FMI2Instance`` and ``FMI3Instance`` hold what differs between the FMI versions: the
+slave class, instantiation with its callbacks, initialisation and doStep (with the FMI 2
+status queries after a discard). Instances are pooled and reused by ``pool.PooledModel``.
+"""
+
+from __future__ import annotations
+
+import collections
+import functools
+import itertools
+import math
+import os
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..block import BlockError, Signal
+from . import interrupt
+from .log_messages import ERROR_LOG_LINES, LOG_LINES, fmi2_buffers, fmi2_logger, log, record
+from .model import import_fmpy
+from .port_types import EXACT_INTEGERS, KINDS, PortKind
+from .ports import Group
+from .start_values import Assignment
+
+_serials = itertools.count(1)
+
+
+@dataclass
+class Binary:
+    """What an instance needs to know about its FMU (kept apart from the pool, so that
+    pooled instances do not keep the pool's owner alive)."""
+
+    shown: str
+    major: int
+    identifier: str
+    guid: str
+    dir: Path
+    library: Path
+    in_groups: list[Group]
+    out_groups: list[Group]
+
+
+@dataclass
+class Transfer:
+    """One preallocated get or set call of an instance: ``call()`` moves a group's values
+    between the FMU and the C buffer that ``view`` shows (in the variables' own type) and
+    returns the FMI status of ``function``; ``slices`` says where each port's values lie,
+    ``check`` whether values need checking on their way (an input type narrower than
+    float64, an output type with integers beyond 2^53)."""
+
+    function: str
+    call: Callable[[], int]
+    view: np.ndarray
+    slices: list[tuple[str, int, int]]
+    kind: PortKind
+    check: bool
+
+
+def new_instance(model: Binary) -> Instance:
+    """An instance of the FMU ``model`` (BlockError if its binary does not load or instantiate)."""
+    return (FMI2Instance if model.major == 2 else FMI3Instance)(model)
+
+
+def call_failed(function: str, status: int) -> Exception:
+    """The exception for an FMI call that returned ``status`` (worse than warning): fmpy's,
+    as its own wrappers raise it."""
+    from fmpy.fmi1 import FMICallException
+
+    return FMICallException(function=function, status=status)
+
+
+class Instance:
+    """One fmpy slave with its preallocated value transfers and its recent log messages."""
+
+    value_counts = False
+    """Whether the get and set functions also take the number of values (FMI 3)."""
+
+    def __init__(self, model: Binary):
+        fmpy = import_fmpy()
+        self.model = model
+        self.serial = next(_serials)
+        self.messages: collections.deque[str] = collections.deque(maxlen=LOG_LINES)
+        self.started = False
+        self.used = False
+        self.broken = False
+        self.freed = False
+        self.slave = None
+        name = f"{model.identifier}#{self.serial}"
+        kwargs = {"guid": model.guid, "modelIdentifier": model.identifier,
+                  "unzipDirectory": str(model.dir), "instanceName": name}
+        cwd = os.getcwd()
+        try:  # fmpy changes into the binary's folder to load it, and not back if that fails
+            slave = self._load(fmpy, kwargs)
+        except Exception as exc:
+            raise BlockError(f"cannot load the binary of {model.shown} "
+                             f"(binaries/{model.library.parent.name}/{model.library.name}): {exc}") from None
+        finally:
+            if os.getcwd() != cwd:
+                os.chdir(cwd)
+        self.slave = slave
+        interrupt.arm()
+        try:
+            self._instantiate(f"{model.shown} ({name})")
+        except Exception as exc:
+            fmi2_buffers.pop(self.serial, None)
+            slave.freeLibrary()
+            interrupt.check()
+            raise BlockError(f"{model.shown}: instantiating the FMU failed: {exc}{self.log_text()}") from None
+        self.component = slave.component
+        self.reads = self._transfers(model.out_groups, "Get")
+        self.writes = self._transfers(model.in_groups, "Set")
+
+    # -- what differs between FMI 2 and FMI 3 ----------------------------------------------
+
+    def _load(self, fmpy: Any, kwargs: dict[str, str]) -> Any:
+        """The fmpy slave, its binary loaded."""
+        raise NotImplementedError
+
+    def _instantiate(self, who: str) -> None:
+        """Instantiate the slave, its log messages going to ``self.messages`` as ``who``'s."""
+        raise NotImplementedError
+
+    def _initialise(self, t: float, tolerance: float | None) -> None:
+        """Enter initialisation mode with start time ``t``."""
+        raise NotImplementedError
+
+    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
+        """One doStep; (terminate requested, returned early, last successful time).
+        Raises fmpy's FMICallException for an error status, or for a discard that is not a
+        request to terminate, as fmpy's own call does."""
+        raise NotImplementedError
+
+    def arm(self) -> None:
+        """Before a call into the FMU: the interrupt hook in place."""
+        interrupt.arm()
+
+    # -- setting up -------------------------------------------------------------------------
+
+    def _transfers(self, groups: list[Group], verb: str) -> list[Transfer]:
+        import ctypes
+
+        out = []
+        for g in groups:
+            function = f"fmi{self.model.major}{verb}{g.kind.function}"
+            vrs = (ctypes.c_uint * len(g.vrs))(*g.vrs)
+            buf = (getattr(ctypes, g.kind.ctype) * g.count)()
+            args = (self.component, vrs, len(g.vrs), buf) + ((g.count,) if self.value_counts else ())
+            call = functools.partial(self.slave._functions[function], *args)
+            check = not g.kind.is_float if verb == "Set" else g.kind.exceeds_float64
+            out.append(Transfer(function, call, np.frombuffer(buf, dtype=g.kind.dtype), g.slices, g.kind, check))
+        return out
+
+    def log_text(self) -> str:
+        if not self.messages:
+            return " (the FMU logged no messages)"
+        lines = list(self.messages)[-ERROR_LOG_LINES:]
+        return "; FMU log: " + " | ".join(lines)
+
+    # -- the life cycle -------------------------------------------------------------------
+
+    def start(self, t: float, assignments: list[Assignment], tolerance: float | None,
+              inputs: Mapping[str, Signal]) -> None:
+        """Reset if used before, set the start values, initialise at start time ``t`` with
+        ``inputs`` set before initialisation ends (as FMI and fmpy do)."""
+        s = self.slave
+        if self.used:
+            s.reset()
+        self.used = True
+        self.messages.clear()
+        self.arm()
+        setters = {name: getattr(s, "set" + kind.function) for name, kind in KINDS[self.model.major].items()}
+        setters["String"] = s.setString
+        for a in assignments:
+            setters[a.kind]([a.vr], a.values)
+        self._initialise(t, tolerance)
+        self.write(inputs, t)
+        s.exitInitializationMode()
+        self.started = True
+
+    def read(self, t: float) -> dict[str, Signal]:
+        """Fresh float64 outputs at time ``t``: one copy per group, each port a view of it."""
+        out: dict[str, Signal] = {}
+        for x in self.reads:
+            status = x.call()
+            if status > 1:
+                raise call_failed(x.function, status)
+            values = x.view.astype(np.float64)
+            if x.check:
+                self._check_exact(x, values, t)
+            for name, a, b in x.slices:
+                out[name] = values[a:b]
+        return out
+
+    def _check_exact(self, x: Transfer, values: np.ndarray, t: float) -> None:
+        """BlockError if a 64-bit integer output does not survive the trip to float64."""
+        big = np.flatnonzero(np.abs(values) >= EXACT_INTEGERS)
+        for i in big:
+            exact = int(x.view[i])
+            if int(values[i]) != exact:
+                name, a, b = next(sl for sl in x.slices if sl[1] <= i < sl[2])
+                element = f" element {i - a}" if b - a > 1 else ""
+                raise BlockError(f"{self.model.shown}: output '{name}'{element} ({x.kind.name}) is {exact} at "
+                                 f"t={t:.9g} s, which a float64 port cannot hold exactly (integers are "
+                                 f"exact up to 2^53)", port=name)
+
+    def write(self, inputs: Mapping[str, Signal], t: float) -> None:
+        """Set the inputs to the values of ``inputs`` at time ``t``."""
+        for x in self.writes:
+            if x.check:
+                for name, a, b in x.slices:
+                    x.view[a:b] = self._checked(x.kind, name, inputs[name], t)
+            else:
+                for name, a, b in x.slices:
+                    x.view[a:b] = inputs[name]
+            status = x.call()
+            if status > 1:
+                raise call_failed(x.function, status)
+
+    def _checked(self, kind: PortKind, name: str, value: np.ndarray, t: float) -> np.ndarray:
+        """``value`` if every element is one the input's type holds, else BlockError."""
+        if kind.name == "Boolean":
+            bad = (value != 0) & (value != 1)
+        else:
+            bad = ~((value >= kind.low) & (value < kind.high + 1) & (np.floor(value) == value))
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            element = f" element {i}" if value.size > 1 else ""
+            raise BlockError(f"{self.model.shown}: input '{name}'{element} ({kind.name}) got {float(value[i]):.17g} at "
+                             f"t={t:.9g} s; it takes {kind.input_rule()}", port=name)
+        return value
+
+    def stop(self) -> None:
+        """End a started run's simulation (terminate); an instance that fails to is broken."""
+        if self.started and not self.broken:
+            self.started = False
+            try:
+                self.arm()
+                self.slave.terminate()
+            except Exception:
+                self.broken = True
+            interrupt.deliver()
+
+    def free(self) -> None:
+        if self.freed or self.slave is None:
+            return
+        self.freed = True
+        try:
+            self.arm()
+            self.slave.freeInstance()
+        except Exception as exc:  # freeing must not raise from a finalizer
+            log.debug("%s: freeing the FMU instance failed: %s", self.model.shown, exc)
+        finally:
+            fmi2_buffers.pop(self.serial, None)
+        interrupt.deliver()
+
+
+class FMI2Instance(Instance):
+    """An FMI 2.0 co-simulation instance."""
+
+    def _load(self, fmpy: Any, kwargs: dict[str, str]) -> Any:
+        return fmpy.fmi2.FMU2Slave(**kwargs)
+
+    def _instantiate(self, who: str) -> None:
+        import ctypes
+
+        from fmpy import calloc, free
+        from fmpy.fmi2 import fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions
+        from fmpy.logging import addLoggerProxy
+
+        callbacks = fmi2CallbackFunctions()
+        callbacks.logger = fmi2_logger()
+        # the C library's own functions: no Python (which Ctrl-C could break) in between
+        callbacks.allocateMemory = ctypes.cast(calloc, fmi2CallbackAllocateMemoryTYPE)
+        callbacks.freeMemory = ctypes.cast(free, fmi2CallbackFreeMemoryTYPE)
+        callbacks.componentEnvironment = self.serial
+        addLoggerProxy(ctypes.byref(callbacks))
+        fmi2_buffers[self.serial] = (self.messages, who)
+        self.slave.instantiate(callbacks=callbacks)
+        self._do_step = self.slave._functions["fmi2DoStep"]
+
+    def arm(self) -> None:
+        """Before a call into the FMU: the interrupt hook and our logger in place."""
+        interrupt.arm()
+        fmi2_logger()
+
+    def _initialise(self, t: float, tolerance: float | None) -> None:
+        self.slave.setupExperiment(tolerance=tolerance, startTime=t)
+        self.slave.enterInitializationMode()
+
+    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
+        status = self._do_step(self.component, t, h, 1)
+        if status == 2 and self._terminated():
+            return True, False, self._last_time(t + h)
+        if status > 1:
+            raise call_failed("fmi2DoStep", status)
+        return False, False, t + h
+
+    def _terminated(self) -> bool:
+        """After a discard: whether the FMU asks to end the simulation (fmi2Terminated)."""
+        import ctypes
+
+        flag = ctypes.c_int(0)
+        fn = self.slave._functions.get("fmi2GetBooleanStatus")
+        return fn is not None and fn(self.component, 3, ctypes.byref(flag)) <= 1 and bool(flag.value)
+
+    def _last_time(self, default: float) -> float:
+        """After a discard: how far the step got (fmi2LastSuccessfulTime), else ``default``."""
+        import ctypes
+
+        value = ctypes.c_double(default)
+        fn = self.slave._functions.get("fmi2GetRealStatus")
+        if fn is None or fn(self.component, 2, ctypes.byref(value)) > 1 or not math.isfinite(value.value):
+            return default
+        return value.value
+
+
+class FMI3Instance(Instance):
+    """An FMI 3.0 co-simulation instance."""
+
+    value_counts = True
+
+    def _load(self, fmpy: Any, kwargs: dict[str, str]) -> Any:
+        return fmpy.fmi3.FMU3Slave(**kwargs)
+
+    def _instantiate(self, who: str) -> None:
+        import ctypes
+
+        messages = self.messages
+
+        def log3(env, status, category, message):
+            record(messages, status, category, message, who)
+
+        self.slave.instantiate(logMessage=interrupt.callback(log3))
+        self._do_step = self.slave._functions["fmi3DoStep"]
+        flags = [ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(), ctypes.c_double()]
+        self._step_flags = flags
+        self._step_refs = [ctypes.byref(f) for f in flags]
+
+    def _initialise(self, t: float, tolerance: float | None) -> None:
+        self.slave.enterInitializationMode(tolerance=tolerance, startTime=t)
+
+    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
+        status = self._do_step(self.component, t, h, True, *self._step_refs)
+        if status > 1:
+            raise call_failed("fmi3DoStep", status)
+        _, terminate, early, last = self._step_flags
+        return terminate.value, early.value, last.value

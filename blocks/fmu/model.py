@@ -1,0 +1,134 @@
+"""What an FMU's modelDescription says, checked once, when a block is made.
+
+``Model`` reads the archive's member list and modelDescription.xml (through
+``description.read_description``; nothing is extracted, no code runs) and checks what the
+FMU block needs before a diagram is accepted: FMI 2.0 or 3.0, a co-simulation interface,
+no execution tool, a binary for this platform. It keeps what the block and its instances
+use: the ports and their FMI-type groups, the variables that start values may set, the
+default experiment and the fixed internal step. Problems are ValueErrors, which the
+diagram loader reports as ``file:line: block 'x' (FMU): ...``.
+"""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+from .description import read_description
+from .port_types import KINDS, NOT_PORTS
+from .ports import group_variables, groups, initial_reads, port_name, vectors
+from .start_values import settable
+
+
+def import_fmpy():
+    """fmpy, imported on first use (it takes a fifth of a second) with a clear error if missing."""
+    try:
+        import fmpy
+        import fmpy.fmi2
+        import fmpy.fmi3
+        import fmpy.model_description
+    except ImportError as exc:  # pragma: no cover - fmpy is a dependency
+        raise ValueError(f"FMU blocks need fmpy ({exc}); install it with 'pip install fmpy'") from None
+    return fmpy
+
+
+class Model:
+    """What the modelDescription of the FMU at ``path`` says (``shown`` names it in messages)."""
+
+    def __init__(self, path: Path, shown: str):
+        self.path = path
+        self.shown = shown
+        fmpy = import_fmpy()
+        description = read_description(path, shown)
+        self.description = description
+        md = self.md = description.md
+        major = md.fmiMajorVersion if md.fmiVersion else 0
+        if major not in (2, 3):
+            raise ValueError(f"{shown} is an FMI {md.fmiVersion} FMU; the FMU block supports FMI 2.0 "
+                             "and 3.0")
+        self.major = major
+        if md.coSimulation is None:
+            others = [k for k, v in (("model exchange", md.modelExchange),
+                                     ("scheduled execution", md.scheduledExecution)) if v is not None]
+            raise ValueError(f"{shown} has no co-simulation interface (it provides only "
+                             f"{' and '.join(others) or 'no interface'}); the FMU block runs FMI 2.0 "
+                             "and 3.0 co-simulation FMUs (not model exchange, not scheduled execution "
+                             "or clocks), so export the model for co-simulation")
+        cs = md.coSimulation
+        self.identifier = cs.modelIdentifier
+        self.once_per_process = bool(cs.canBeInstantiatedOnlyOncePerProcess)
+        if cs.needsExecutionTool:
+            raise ValueError(f"{shown} needs its execution tool (a tool-coupling FMU), which cannot "
+                             "run here")
+        platform = fmpy.platform if major == 2 else fmpy.platform_tuple
+        library = f"binaries/{platform}/{self.identifier}{fmpy.sharedLibraryExtension}"
+        if library not in description.files:
+            found = description.platforms()
+            has_sources = any(f.startswith("sources/") for f in description.files)
+            detail = f"it has binaries for {', '.join(found)}" if found else "it has no binaries"
+            if has_sources:
+                detail += " and C sources (compile them first, e.g. with fmpy's compile_platform_binary)"
+            raise ValueError(f"{shown} has no binary for this platform ({platform}/"
+                             f"{library.rsplit('/', 1)[1]}); {detail}")
+        self.library = library
+        self.fixed_step = description.fixed_step()
+        self.guid = md.guid or ""
+        de = md.defaultExperiment
+        self.default_step = fraction_or_none(de.stepSize if de else None)
+        self.default_tolerance = float_or_none(de.tolerance if de else None)
+        self.variables = {v.name: v for v in md.modelVariables}
+        kinds = KINDS[major]
+        ports = [v for v in md.modelVariables if v.type in kinds]
+        ins = [v for v in ports if v.causality == "input" and v.alias is None]
+        outs = [v for v in ports if v.causality == "output"]
+        self.inputs = group_variables(ins, "input", shown, major)
+        self.outputs = group_variables(outs, "output", shown, major)
+        self.not_ports = self._not_ports(md.modelVariables)
+        self.initial_reads = initial_reads(md, self.inputs, self.outputs)
+        self.in_groups = groups(self.inputs)
+        self.out_groups = groups(self.outputs)
+        self.vectors = vectors(md.modelVariables, self.variables)
+
+    def _not_ports(self, variables: list) -> dict[str, str]:
+        """Why each variable that is not a port is not one, by the port name it would have."""
+        why: dict[str, str] = {}
+        for v in variables:
+            name = port_name(v.name)
+            if name in self.inputs or name in self.outputs:
+                continue
+            if v.type in NOT_PORTS:
+                reason = f"'{v.name}' is {NOT_PORTS[v.type]}"
+                if v.causality == "input" and v.type != "Clock":
+                    reason += "; give it a value with start_values"
+            elif v.alias is not None and v.causality == "input":
+                reason = f"'{v.name}' is an alias of the input '{v.alias.name}'; connect that one"
+            elif v.causality in ("parameter", "calculatedParameter", "structuralParameter"):
+                reason = f"'{v.name}' is a {v.causality} of the FMU, not a port"
+                if settable(v) is None:
+                    reason += "; set it with start_values"
+            elif v.causality in ("local", "independent"):
+                reason = f"'{v.name}' is a {v.causality} variable of the FMU; only inputs and outputs are ports"
+            else:
+                continue
+            why.setdefault(name, reason)
+        return why
+
+
+def fraction_or_none(text: Any) -> Fraction | None:
+    """A positive Fraction read from ``text``, or None."""
+    try:
+        value = Fraction(str(text).strip())
+    except (TypeError, ValueError, ZeroDivisionError):
+        return None
+    return value if value > 0 else None
+
+
+def float_or_none(text: Any) -> float | None:
+    """A positive finite float read from ``text``, or None."""
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        return None
+    return value if math.isfinite(value) and value > 0 else None

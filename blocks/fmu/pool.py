@@ -1,0 +1,114 @@
+"""The instances of one FMU, pooled across the runs of the block that loaded it.
+
+Instantiating an FMU (loading its binary, allocating its memory) costs far more than
+resetting one, and an FMU may allow only one instance per process, so a block keeps the
+instances its runs gave back and hands them to the next runs. ``PooledModel`` is the
+block's ``Model`` with that pool: a run takes an idle instance (reset when it starts) or a
+new one, extracting the archive the first time a run needs one; giving it back terminates
+the FMU's simulation and pools the instance, or frees it if it failed. Closing the block,
+or its going away, frees the idle instances and, once no run holds one, the extracted
+files.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import threading
+import weakref
+import zipfile
+from pathlib import Path
+
+from ..block import BlockError
+from .archive import ArchiveError, extract_archive
+from .description import MODEL_DESCRIPTION
+from .instance import Binary, Instance, new_instance
+from .model import Model
+
+
+class PooledModel(Model):
+    """What an FMU's modelDescription says (``Model``), and the pool of its instances.
+
+    Reading the model touches only the archive's member list and modelDescription.xml;
+    the archive is extracted (and the binary loaded, by ``Instance``) when the first
+    instance is acquired, that is when a run starts.
+    """
+
+    def __init__(self, path: Path, shown: str):
+        self.lock = threading.Lock()
+        self.extract_lock = threading.Lock()
+        self.idle: list[Instance] = []
+        self.live = 0
+        self.closed = False
+        self.dir: Path | None = None
+        self.binary: Binary | None = None
+        self._dirs: list[str] = []
+        self._cleanup = weakref.finalize(self, _remove_model, self.idle, self._dirs)
+        super().__init__(path, shown)
+
+    def acquire(self) -> Instance:
+        with self.lock:
+            if self.closed:
+                raise BlockError(f"{self.shown}: the FMU block was closed")
+            inst = self.idle.pop() if self.idle else None
+            if inst is None and self.once_per_process and self.live:
+                raise BlockError(f"{self.shown} can be instantiated only once per process, and its "
+                                 "instance is in use by another run")
+            self.live += 1
+        if inst is None:
+            try:
+                inst = new_instance(self._extracted())
+            except BaseException:
+                with self.lock:
+                    self.live -= 1
+                raise
+        return inst
+
+    def _extracted(self) -> Binary:
+        """What an instance needs, extracting the archive the first time (a run starts)."""
+        with self.extract_lock:
+            if self.binary is None:
+                folder = Path(tempfile.mkdtemp(prefix="blocks-fmu-"))
+                self._dirs.append(str(folder))
+                try:
+                    extract_archive(self.path, folder)
+                    xml = (folder / MODEL_DESCRIPTION).read_bytes()
+                except (ArchiveError, OSError, zipfile.BadZipFile, EOFError) as exc:
+                    shutil.rmtree(folder, ignore_errors=True)
+                    raise BlockError(f"{self.shown}: extracting the FMU failed: {exc}") from None
+                if xml != self.description.xml:
+                    shutil.rmtree(folder, ignore_errors=True)
+                    raise BlockError(f"{self.shown} has changed since the diagram was loaded; load it again")
+                self.dir = folder
+                self.binary = Binary(self.shown, self.major, self.identifier, self.guid, folder,
+                                     folder / self.library, self.in_groups, self.out_groups)
+        return self.binary
+
+    def release(self, inst: Instance) -> None:
+        """Take an instance back from a run: terminate and pool it, or free it if it failed."""
+        inst.stop()
+        with self.lock:
+            self.live -= 1
+            keep = not inst.broken and not self.closed
+            if keep:
+                self.idle.append(inst)
+        if not keep:
+            inst.free()
+
+    def close(self) -> None:
+        with self.lock:
+            self.closed = True
+            idle, self.idle[:] = list(self.idle), []
+            live = self.live
+        for inst in idle:
+            inst.free()
+        if not live:
+            self._cleanup()
+
+
+def _remove_model(idle: list, directories: list[str]) -> None:
+    for inst in list(idle):
+        inst.free()
+    idle.clear()
+    for directory in directories:
+        shutil.rmtree(directory, ignore_errors=True)
