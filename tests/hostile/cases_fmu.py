@@ -4,7 +4,7 @@ has started, and Ctrl-C inside an FMU.
 
 Most cases need no compiler: loading a diagram never loads an FMU's binary, so their
 FMUs carry a few bytes in its place. The cases that run an FMU use the test FMUs of
-``tests/blocks/fmu_sources``, compiled once per session (``_libraries``); without a C
+``tests/blocks/fmu/sources``, compiled once per session (``_libraries``); without a C
 compiler those cases are left out.
 """
 
@@ -18,7 +18,7 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from tests.blocks import fmu_build
+from tests.blocks.fmu import build as fmu_build
 
 from .corpus import Case
 

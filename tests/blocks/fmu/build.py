@@ -1,4 +1,4 @@
-"""Builds the test FMUs of ``fmu_sources/`` at test time, for the FMU block tests and the
+"""Builds the test FMUs of ``sources/`` at test time, for the FMU block tests and the
 hostile-input corpus.
 
 The shared libraries are compiled with the system C compiler against fmpy's FMI headers;
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import fmpy
 
-SOURCES = Path(__file__).parent / "fmu_sources"
+SOURCES = Path(__file__).parent / "sources"
 HEADERS = Path(fmpy.__file__).parent / "c-code"
 EXT = fmpy.sharedLibraryExtension
 
@@ -43,7 +43,7 @@ def build_error() -> str | None:
 
 
 def compile_library(target: Path, *sources: str, defines: dict[str, str] | None = None) -> bytes:
-    """Compile ``sources`` (names in ``fmu_sources/``) into the shared library ``target``;
+    """Compile ``sources`` (names in ``sources/``) into the shared library ``target``;
     ``defines`` become ``-D`` options. Returns the library's bytes."""
     flags = [f"-D{k}={v}" for k, v in (defines or {}).items()]
     cmd = [compiler(), "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *flags,

@@ -1,6 +1,6 @@
 """The FMU import block, with small FMI 2.0 and 3.0 co-simulation FMUs compiled at test time.
 
-The C sources and model descriptions are in ``fmu_sources/``: a discrete first-order
+The C sources and model descriptions are in ``sources/``: a discrete first-order
 system x[k+1] = a x[k] + b u[k], y = x, with a vector output z = [scale * x, time]
 (``z[2]``/``z[1]`` scalars in FMI 2, an array in FMI 3) and a doStep that fails when u
 exceeds a threshold. They are built with the system C compiler and fmpy's FMI headers;
@@ -12,11 +12,7 @@ from __future__ import annotations
 from fractions import Fraction
 
 import gc
-import os
 import shutil
-import stat
-import sys
-import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -24,62 +20,10 @@ import pytest
 
 import blocks
 from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, simulate
-from blocks.fmu.archive import ArchiveError, Limits, extract_archive, read_member
 
 fmpy = pytest.importorskip("fmpy")
 
-from .fmu_build import (  # noqa: E402
-    SOURCES,
-    build_error,
-    compile_library,
-    fmi2_files,
-    interrupting_library,
-    marker_library,
-    zip_files,
-)
-
-
-class Fmus:
-    """Builds FMU files in a folder from the compiled binaries and (edited) model descriptions."""
-
-    def __init__(self, folder: Path, lib2: bytes, lib3: bytes, marker: bytes, markers: Path,
-                 interrupting: dict[int, bytes]):
-        self.folder = folder
-        self.lib2, self.lib3 = lib2, lib3
-        self.marker, self.markers = marker, markers
-        self.interrupting = interrupting
-        self.xml2 = (SOURCES / "first_order_fmi2.xml").read_text()
-        self.xml3 = (SOURCES / "first_order_fmi3.xml").read_text()
-        self.fmi2 = self.make("first_order.fmu")
-        self.fmi3 = self.make("first_order3.fmu", version=3)
-
-    def make(self, name: str, xml: str | None = None, version: int = 2, binary: bool = True) -> Path:
-        ext = fmpy.sharedLibraryExtension
-        if version == 2:
-            files = {"modelDescription.xml": self.xml2 if xml is None else xml}
-            if binary:
-                files[f"binaries/{fmpy.platform}/FirstOrder{ext}"] = self.lib2
-        else:
-            files = {"modelDescription.xml": self.xml3 if xml is None else xml}
-            if binary:
-                files[f"binaries/{fmpy.platform_tuple}/FirstOrder3{ext}"] = self.lib3
-        return zip_files(self.folder / name, files)
-
-
-@pytest.fixture(scope="module")
-def fmus(tmp_path_factory) -> Fmus:
-    why = build_error()
-    if why:
-        pytest.skip(why)
-    build = tmp_path_factory.mktemp("fmu_build")
-    markers = tmp_path_factory.mktemp("fmu_markers")
-    lib2 = compile_library(build / ("fo2" + fmpy.sharedLibraryExtension), "first_order_fmi2.c",
-                           "fmi2_unsupported.c")
-    lib3 = compile_library(build / ("fo3" + fmpy.sharedLibraryExtension), "first_order_fmi3.c",
-                           "fmi3_unsupported.c")
-    interrupting = {status: interrupting_library(build, status) for status in (0, 4)}
-    return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3, marker_library(build, markers), markers,
-                interrupting)
+from .build import fmi2_files, zip_files  # noqa: E402
 
 
 def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
@@ -347,38 +291,6 @@ def test_ctrl_c_during_a_step_is_an_interrupt_not_an_fmu_failure(fmus, tmp_path,
     assert "fmi2DoStep" not in results.status
 
 
-def test_an_interrupt_lost_in_a_callback_is_raised_after_the_call():
-    """The pieces on their own: a KeyboardInterrupt inside a wrapped callback, or one that
-    ctypes hands to sys.unraisablehook for it, is raised by the next check()."""
-    from types import SimpleNamespace
-
-    from blocks.fmu import interrupt as fmu_interrupt
-
-    @fmu_interrupt.callback
-    def log(*args):
-        raise KeyboardInterrupt
-
-    log(1, 2)
-    with pytest.raises(KeyboardInterrupt):
-        fmu_interrupt.check()
-    fmu_interrupt.check()                                   # noted once, raised once
-    fmu_interrupt.arm()
-    lost = KeyboardInterrupt()
-    sys.unraisablehook(SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=lost, object=log))
-    with pytest.raises(KeyboardInterrupt) as raised:
-        fmu_interrupt.check()
-    assert raised.value is lost                             # the interrupt itself, e.g. a StopRequest
-    seen = []
-    before = sys.unraisablehook
-    sys.unraisablehook = seen.append                        # others' hooks keep their messages
-    fmu_interrupt.arm()
-    other = SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=KeyboardInterrupt(), object=print)
-    sys.unraisablehook(other)
-    assert seen == [other]
-    fmu_interrupt.check()
-    sys.unraisablehook = before
-
-
 # -- load-time errors ---------------------------------------------------------------------
 
 
@@ -417,22 +329,10 @@ log: [f.y]
     np.testing.assert_allclose(t, [0.0, 0.1, 0.2, 0.3, 0.4, 0.5])
 
 
-def _fixed_step(fmus, version: int, step: str, name: str) -> Path:
-    """The first-order FMU declaring a fixed internal step: FMI 3's fixedInternalStepSize,
-    for FMI 2 the same attribute in a vendor annotation."""
-    if version == 3:
-        xml = fmus.xml3.replace("<CoSimulation ", f'<CoSimulation fixedInternalStepSize="{step}" ')
-    else:
-        annotation = (f'<VendorAnnotations><Tool name="some tool"><CoSimulation fixedInternalStepSize="{step}"/>'
-                      "</Tool></VendorAnnotations>\n  <ModelVariables>")
-        xml = fmus.xml2.replace("<ModelVariables>", annotation)
-    return fmus.make(name, xml, version=version)
-
-
 @pytest.mark.parametrize("version", [2, 3])
 def test_a_period_off_the_fixed_internal_step_is_a_load_error(fmus, version):
     """Such an FMU refuses every step; that must show at load time, not once a run has started."""
-    path = _fixed_step(fmus, version, "0.04", f"fixed{version}.fmu")
+    path = fmus.with_fixed_step(version, "0.04", f"fixed{version}.fmu")
     msg = load_error(lambda: diagram(path, period="0.1 s"))
     assert msg.startswith("fmu.yaml:5: block 'f' (FMU): the period 100 ms is not a whole multiple of the "
                           "fixed internal step 40 ms"), msg
@@ -446,13 +346,6 @@ blocks:
 """
     assert "the default step (DefaultExperiment stepSize) 100 ms is not a whole multiple" in load_error(
         lambda: loads_diagram(text))
-
-
-def test_fmu_info_shows_the_fixed_internal_step(fmus):
-    from blocks.fmu import describe_fmu
-
-    assert "fixed internal step: 0.04 s" in describe_fmu(_fixed_step(fmus, 3, "0.04", "fixed_info.fmu"))
-    assert "fixed internal step" not in describe_fmu(fmus.fmi3)
 
 
 def test_a_relative_path_is_resolved_against_the_diagrams_folder(fmus, tmp_path, monkeypatch):
@@ -531,144 +424,3 @@ def test_unsafe_archive_is_refused_by_the_block(fmus, tmp_path):
     msg = load_error(lambda: diagram(evil))
     assert "unsafe FMU archive" in msg and "'../evil.txt'" in msg
     assert not (tmp_path.parent / "evil.txt").exists()
-
-
-def test_grouping_rules():
-    from types import SimpleNamespace as V
-
-    from blocks.fmu.ports import group_variables as _group_variables
-
-    def var(name, vr, type="Real"):
-        return V(name=name, valueReference=vr, type=type, dimensions=[], shape=())
-
-    ports = _group_variables([var("A[2,1]", 3), var("A[1,1]", 1), var("A[1,2]", 2), var("A[2,2]", 4),
-                              var("body.v", 5), var("q[1]", 7), var("q[2]", 6)], "output", "F", 2)
-    assert {n: (p.width, p.vrs) for n, p in ports.items()} == {
-        "A": (4, [1, 2, 3, 4]), "body_v": (1, [5]), "q": (2, [7, 6])}
-    assert ports["A"].labels == ["1,1", "1,2", "2,1", "2,2"] and ports["q"].labels == ["1", "2"]
-    assert ports["body_v"].labels is None
-    with pytest.raises(ValueError, match="'x' is both a variable and the vector"):
-        _group_variables([var("x", 1), var("x[1]", 2)], "input", "F", 2)
-    with pytest.raises(ValueError, match=r"'a.b' and 'a_b' both map to the port name 'a_b'"):
-        _group_variables([var("a.b", 1), var("a_b", 2)], "input", "F", 2)
-    with pytest.raises(ValueError, match="indices must start at 1"):
-        _group_variables([var("x[0]", 1), var("x[1]", 2)], "input", "F", 2)
-
-
-# -- safe extraction ----------------------------------------------------------------------
-
-
-def _zip_with(path: Path, name: str, data: bytes = b"x", mode: int | None = None) -> Path:
-    info = zipfile.ZipInfo(name)
-    if mode is not None:
-        info.create_system = 3
-        info.external_attr = mode << 16
-    with zipfile.ZipFile(path, "w") as zf:
-        zf.writestr("ok.txt", "fine")
-        zf.writestr(info, data)
-    return path
-
-
-@pytest.mark.filterwarnings("ignore:Duplicate name")
-@pytest.mark.parametrize("name, mode, expected", [
-    ("../evil.txt", None, "has a '..' component"),
-    ("a/../../evil.txt", None, "has a '..' component"),
-    ("..\\evil.txt", None, "has a '..' component"),
-    ("/abs/evil.txt", None, "has an absolute path"),
-    ("C:/evil.txt", None, "drive letter"),
-    ("link", stat.S_IFLNK | 0o777, "is a symbolic link"),
-    ("fifo", stat.S_IFIFO | 0o644, "is a special file"),
-    ("ok.txt", None, "occurs twice"),
-])
-def test_extractor_rejects_unsafe_members(tmp_path, name, mode, expected):
-    archive = _zip_with(tmp_path / "a.zip", name, b"/etc/passwd" if mode else b"x", mode)
-    dest = tmp_path / "out"
-    dest.mkdir()
-    with pytest.raises(ArchiveError, match=expected) as info:
-        extract_archive(archive, dest)
-    assert repr(name) in str(info.value)
-    assert list(dest.iterdir()) == []               # nothing written
-    assert not (tmp_path / "evil.txt").exists()
-
-
-def test_extractor_limits_size_and_count(tmp_path):
-    big = _zip_with(tmp_path / "big.zip", "big.bin", b"\0" * 5000)
-    (tmp_path / "o1").mkdir()
-    with pytest.raises(ArchiveError, match="'big.bin' is 5000 bytes uncompressed, more than the limit of 1000"):
-        extract_archive(big, tmp_path / "o1", Limits(member_bytes=1000))
-    with pytest.raises(ArchiveError, match="more than the limit of 3000 bytes"):
-        extract_archive(big, tmp_path / "o1", Limits(total_bytes=3000))
-    many = zip_files(tmp_path / "many.zip", {f"f{i}.txt": "x" for i in range(20)})
-    with pytest.raises(ArchiveError, match="has 20 members, more than the limit of 10"):
-        extract_archive(many, tmp_path / "o1", Limits(members=10))
-    with pytest.raises(ArchiveError, match="its member list takes .* bytes, more than 1 members can need"):
-        read_member(many, "f1.txt", Limits(members=1))
-    extract_archive(many, tmp_path / "o1")
-    assert len(list((tmp_path / "o1").iterdir())) == 20
-
-
-def test_archive_limits_keep_a_zip_bomb_small():
-    """At most 256 MiB per member and in all (once 1 GiB and 4 GiB), at most 200-fold inflation."""
-    from blocks.fmu import archive as fmu_archive
-
-    assert fmu_archive.MAX_MEMBER_BYTES == fmu_archive.MAX_TOTAL_BYTES == 256 * 2**20
-    assert fmu_archive.MAX_RATIO == 200 and fmu_archive.RATIO_FLOOR_BYTES == 2**20
-    assert fmu_archive.MAX_MEMBERS == 10_000
-
-
-def test_a_member_that_inflates_too_much_is_refused(tmp_path):
-    bomb = zip_files(tmp_path / "bomb.fmu", {"modelDescription.xml": "<x/>", "resources/zeros.bin": b"\0" * (4 << 20)})
-    (tmp_path / "out").mkdir()
-    with pytest.raises(ArchiveError, match=r"'resources/zeros.bin' inflates from \d+ to 4194304 bytes or more, "
-                                           "more than 200 times"):
-        extract_archive(bomb, tmp_path / "out")
-    with pytest.raises(ArchiveError, match="more than 200 times"):
-        read_member(bomb, "modelDescription.xml")     # every member is checked, even when reading one
-    small = zip_files(tmp_path / "small.fmu", {"notes.txt": b"\0" * 100_000})  # below the floor: fine
-    assert read_member(small, "notes.txt") == (b"\0" * 100_000, ["notes.txt"])
-
-
-def test_the_bytes_are_counted_as_they_are_decompressed(tmp_path):
-    """The running count does not rely on the headers: a member whose header says it is
-    huge (so zipfile does not cut it) is stopped once the bytes read pass a limit."""
-    from blocks.fmu.archive import _chunks
-
-    archive = zip_files(tmp_path / "a.zip", {"x.bin": os.urandom(5000)})
-    with zipfile.ZipFile(archive) as zf:
-        info = zf.getinfo("x.bin")
-        info.file_size = 10**9
-        with pytest.raises(ArchiveError, match="is 5000 bytes uncompressed, more than the limit of 1000"):
-            list(_chunks(zf, info, 0, "a.zip", Limits(member_bytes=1000)))
-        with pytest.raises(ArchiveError, match="add up to more than the limit of 6000"):
-            list(_chunks(zf, info, 2000, "a.zip", Limits(total_bytes=6000)))
-
-
-def test_extractor_catches_members_that_inflate_beyond_their_header(tmp_path):
-    """A forged header declaring a small size does not let more data through."""
-    archive = tmp_path / "forged.zip"
-    with zipfile.ZipFile(archive, "w", zipfile.ZIP_STORED) as zf:
-        zf.writestr("x.bin", b"A" * 4096)
-    data = bytearray(archive.read_bytes())
-    # Patch the uncompressed size in the central directory (offset 24 of its entry) to 16.
-    cd = data.rfind(b"PK\x01\x02")
-    data[cd + 24:cd + 28] = (16).to_bytes(4, "little")
-    archive.write_bytes(bytes(data))
-    (tmp_path / "out").mkdir()
-    with pytest.raises((ArchiveError, zipfile.BadZipFile)):
-        extract_archive(archive, tmp_path / "out", Limits(member_bytes=100))
-    assert not (tmp_path / "out" / "x.bin").exists()
-
-
-def test_fmu_info_lists_interfaces_experiment_and_variables(fmus, tmp_path):
-    from blocks.fmu import FMUInfoError, describe_fmu
-
-    text = describe_fmu(fmus.fmi2)
-    assert "FMI 2.0" in text and "co-simulation (model identifier" in text
-    assert "step 0.1" in text
-    for name in ("u", "y", "z[1]", "z[2]", "a"):
-        assert f"\n    {name} " in text
-    assert "input" in text and "output" in text and "parameter" in text
-    bogus = tmp_path / "bogus.fmu"
-    bogus.write_text("not a zip")
-    with pytest.raises(FMUInfoError, match="not a readable zip"):
-        describe_fmu(bogus)

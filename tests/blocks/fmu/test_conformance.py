@@ -24,7 +24,7 @@ from blocks.fmu.archive import ArchiveError, extract_archive
 
 fmpy = pytest.importorskip("fmpy")
 
-from .fmu_build import build_error, typed_fmu  # noqa: E402
+from .build import build_error, typed_fmu  # noqa: E402
 
 INT_TYPES = {"i8": (-2**7, 2**7 - 1), "u8": (0, 2**8 - 1), "i16": (-2**15, 2**15 - 1),
              "u16": (0, 2**16 - 1), "i32": (-2**31, 2**31 - 1), "u32": (0, 2**32 - 1)}
