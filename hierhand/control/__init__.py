@@ -1,12 +1,18 @@
-"""Controller mathematics of the hierarchical hand controller, as pure numpy functions.
+"""Controller mathematics of the hierarchical hand controller, on its compiled laws.
+
+The laws are C (``hierhand/csrc/reflex.c``, ``manipulation.c``, ``suppresser.c``); the
+blocks call them once per hit and these functions call the same C, so each law has one
+implementation (its readable numpy form lives in the tests, as the oracle it is checked
+against).
 
 - ``internal_forces``: grasp matrix, internal (squeeze) force directions, the projection
   onto internal forces, and the friction-cone scaling used by the grasping reflex.
 - ``inverse_kinematics``: exact three-joint finger IK/FK and whole-hand IK.
 - ``trajectory``: timed fingertip waypoints with linear or minimum-jerk segments.
-- ``suppression``: the suppresser's sigmoid gain on the grasping torque.
+- ``suppresser_kernel``: the suppresser's sigmoid gain on the grasping torque.
 
-The blocks that use them (reflex, manipulation, suppresser) live beside these modules.
+The blocks that use them (reflex, manipulation, suppresser) live beside these modules,
+with the kernels that pack their parameters (``reflex_kernel``, ``manipulation_kernel``).
 """
 
 from .internal_forces import (
@@ -17,7 +23,7 @@ from .internal_forces import (
     required_scale_from_sensors,
 )
 from .inverse_kinematics import UnreachableError, finger_fk, finger_ik, finger_ik_near, hand_ik, wrap_angle
-from .suppression import sigmoid, suppress
+from .suppresser_kernel import finger_shares, sigmoid, suppress
 from .trajectory import Trajectory
 
 __all__ = [
@@ -26,6 +32,7 @@ __all__ = [
     "finger_fk",
     "finger_ik",
     "finger_ik_near",
+    "finger_shares",
     "friction_scale",
     "grasp_matrix",
     "hand_ik",

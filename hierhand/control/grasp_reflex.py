@@ -40,9 +40,9 @@ the safety ratio would leave ``|f_t| / f_n`` just above it for ever; aiming at
 
 How: ``output`` and ``update`` each make one native call through ``reflex_kernel`` (the
 law in C, ``hierhand/csrc/reflex.c``: the grasp matrix solve written out by hand, the tip
-Jacobians from the plant's own kinematics); ``internal_forces`` is the numpy reference
-they are tested against. The parameters are packed for the native calls when the block
-is made and bound.
+Jacobians from the plant's own kinematics); ``internal_forces.project_internal`` and
+``internal_directions`` call the same C. The parameters are packed for the native calls
+when the block is made and bound.
 """
 
 from __future__ import annotations
@@ -145,12 +145,6 @@ class GraspReflex(ModelsTheHand, Block):
         it last touched, 0 while the reflex holds it (3)]."""
         return np.concatenate(([self.approach_force], np.zeros(3)))
 
-    def members(self, state: np.ndarray, fn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(fingers in the grasp, fingers in contact)."""
-        touching = fn > self.threshold
-        approaching = self.initial & (state[1:] == 0.0) & ~touching
-        return touching | approaching, touching
-
     def directions(self, state: np.ndarray, tip: np.ndarray, normal: np.ndarray,
                    fn: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(3, 2) internal force per finger at unit scale (largest row length 1), the
@@ -163,7 +157,7 @@ class GraspReflex(ModelsTheHand, Block):
         approaching pushes towards the others' centroid. Should the projection leave a
         finger not pushing (``g_i . push_i <= 0``), the grasp falls back to the centroid
         squeeze ``internal_directions``. Computed by ``reflex_kernel.reflex_directions``
-        (``G^+ = G^T (G G^T)^-1`` solved by hand; ``project_internal`` is the reference).
+        (``G^+ = G^T (G G^T)^-1`` solved by hand, as ``project_internal`` does).
         """
         return reflex_directions(self._params, state, tip, normal, fn)
 

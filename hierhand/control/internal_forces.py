@@ -8,6 +8,13 @@ scales them until every contact is inside its friction cone with a safety margin
 
 Conventions: points are ``(k, 2)`` arrays, stacked force vectors are ``(2k,)`` in the
 order ``f1x, f1y, f2x, f2y, ...``.
+
+``project_internal`` and ``internal_directions`` (the centroid squeeze) are the reflex's
+own law: they call its C (``hierhand/csrc/reflex.c``). The rest is Python because no
+block runs it: ``grasp_matrix`` states the convention, ``internal_directions`` with an
+explicit ``focus`` is the focus-point form the reflex does not use, and
+``friction_scale`` / ``required_scale_from_sensors`` are the static friction-cone
+analysis whose fixed point the reflex's integral loop seeks.
 """
 
 from __future__ import annotations
@@ -15,6 +22,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from .. import _native
+from .arrays import flat_float64
 
 __all__ = [
     "grasp_matrix",
@@ -38,14 +48,18 @@ def _points(points: np.ndarray, name: str = "points") -> np.ndarray:
     return p
 
 
+def _center(center: np.ndarray) -> np.ndarray:
+    """The moment point as a (2,) array (``ValueError`` for another shape)."""
+    return np.asarray(center, dtype=float).reshape(2)
+
+
 def grasp_matrix(points: np.ndarray, center: np.ndarray) -> np.ndarray:
     """(3, 2k) grasp matrix: contact ``i`` contributes columns ``[I2; (-r_iy, r_ix)]``.
 
     ``r_i = p_i - center``; the third row is the z moment ``r_i x f_i`` about ``center``.
     """
     p = _points(points)
-    c = np.asarray(center, dtype=float).reshape(2)
-    r = p - c
+    r = p - _center(center)
     k = p.shape[0]
     g = np.zeros((3, 2 * k))
     g[0, 0::2] = 1.0
@@ -69,7 +83,8 @@ def internal_directions(points: np.ndarray, focus: np.ndarray | None = None) -> 
 
     With the default focus, the centroid, the null-space magnitudes reduce to
     ``a_i ~ |c - p_i|``, i.e. ``f_i ~ c - p_i`` (because ``sum_i (c - p_i) = 0``), and
-    that closed form is what is evaluated. It covers every ``k >= 2`` (for ``k = 2`` it
+    that closed form is what is evaluated, by the grasping reflex's C (it is the reflex's
+    fallback squeeze). It covers every ``k >= 2`` (for ``k = 2`` it
     is exactly ``+-e``) and it stays a valid internal set when three contacts are
     collinear, where the null space is two-dimensional and the focus construction has no
     unique answer: it is the limit of the focus form as the triangle flattens (the middle
@@ -85,11 +100,9 @@ def internal_directions(points: np.ndarray, focus: np.ndarray | None = None) -> 
     if k < 2:
         raise ValueError(f"internal forces need at least two contacts, got {k}")
     if focus is None:
-        f = p.mean(axis=0) - p
-        spread = float(np.max(np.hypot(f[:, 0], f[:, 1])))
-        if spread <= _COINCIDENT_RTOL * max(float(np.max(np.abs(p))), np.finfo(float).tiny):
-            raise ValueError("internal forces are undefined: all contact points coincide")
-        return f / spread
+        g = np.empty((k, 2))
+        _native.centroid_squeeze(flat_float64(p), _COINCIDENT_RTOL, g)
+        return g
     if k != 3:
         raise ValueError(f"an explicit focus point needs exactly three contacts, got {k}")
     return _focus_form(p, np.asarray(focus, dtype=float).reshape(2))
@@ -123,15 +136,21 @@ def _focus_form(p: np.ndarray, c: np.ndarray) -> np.ndarray:
 def project_internal(points: np.ndarray, center: np.ndarray, f: np.ndarray) -> np.ndarray:
     """(2k,) internal part ``(I - G^+ G) f`` of the stacked contact forces ``f``.
 
-    This is the general projection onto the null space of the grasp matrix (computed
-    with ``numpy.linalg.pinv``); it removes the part of ``f`` that would accelerate the
-    object. The result does not depend on ``center``.
+    This is the general projection onto the null space of the grasp matrix; it removes
+    the part of ``f`` that would accelerate the object. ``G G^T`` is solved in closed form
+    about the points' centroid (the reflex's solve, ``hierhand/csrc/reflex.c``); when all
+    points coincide the moment equation is dropped, as ``numpy.linalg.pinv`` drops it.
+    The result does not depend on ``center`` (checked for shape only).
     """
-    g = grasp_matrix(points, center)
+    p = _points(points)
+    _center(center)  # its shape only: the projection does not depend on it
     f = np.asarray(f, dtype=float).reshape(-1)
-    if f.shape[0] != g.shape[1]:
-        raise ValueError(f"f must have shape ({g.shape[1]},), got {f.shape}")
-    return f - np.linalg.pinv(g) @ (g @ f)
+    if f.shape[0] != 2 * p.shape[0]:
+        raise ValueError(f"f must have shape ({2 * p.shape[0]},), got {f.shape}")
+    out = np.empty(f.shape[0])
+    if out.size:
+        _native.project_internal(flat_float64(p), flat_float64(f), out)
+    return out
 
 
 def friction_scale(

@@ -5,16 +5,22 @@ Joint angles are relative: link ``i`` points at ``base_angle + q1 + ... + qi``
 target is ``(x, y, phi)`` with ``phi`` the absolute angle of link 3; fixing ``phi`` makes
 the problem exact: the wrist (joint 3) sits at ``tip - l3 (cos phi, sin phi)`` and joints
 1-2 solve the two-link problem for it, which has two branches (elbows).
+
+The manipulation controller's law, compiled (``hierhand/csrc/manipulation.c``): every
+function here calls the C the ``ManipulationPD`` block runs (``finger_fk`` the plant's
+own kinematics), checking and shaping the arguments and naming what is out of reach.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
-__all__ = ["UnreachableError", "finger_ik", "finger_fk", "hand_ik", "wrap_angle"]
+from .. import _native
+from .arrays import flat_float64
+
+__all__ = ["UnreachableError", "finger_ik", "finger_ik_near", "finger_fk", "hand_ik", "wrap_angle"]
 
 # Wrist distances this close (relative to l1 + l2) outside the reachable annulus are
 # treated as on its boundary, so that targets computed by forward kinematics at a fully
@@ -39,27 +45,25 @@ class UnreachableError(ValueError):
 
 def wrap_angle(a: Any) -> Any:
     """Angle(s) wrapped to (-pi, pi]: a float for a scalar, else an array."""
-    w = math.pi - np.mod(math.pi - np.asarray(a, dtype=float), 2 * math.pi)
-    # np.mod(-tiny, 2 pi) rounds to exactly 2 pi, which would give -pi.
-    w = np.where(w <= -math.pi, w + 2 * math.pi, w)
-    return float(w) if w.ndim == 0 else w
+    values = flat_float64(a)
+    out = np.empty_like(values)
+    _native.wrap_angles(values, out)
+    return float(out[0]) if np.ndim(a) == 0 else out.reshape(np.shape(a))
 
 
-def _lengths(lengths: Any) -> np.ndarray:
+def _geometry(base: Any, base_angle: float, lengths: Any) -> np.ndarray:
+    """The C's finger geometry: base x, base y, base angle, the three link lengths."""
     ls = np.asarray(lengths, dtype=float).reshape(-1)
     if ls.shape != (3,) or not np.all(ls > 0):
         raise ValueError(f"lengths must be three positive link lengths, got {lengths!r}")
-    return ls
+    return np.array([base[0], base[1], base_angle, *ls], dtype=float)
 
 
 def finger_fk(base: Any, base_angle: float, lengths: Any, q: Any) -> tuple[float, float, float]:
     """Fingertip-circle centre ``(x, y)`` and link-3 absolute angle ``phi`` (not wrapped)."""
-    ls = _lengths(lengths)
-    q = np.asarray(q, dtype=float).reshape(3)
-    th = base_angle + np.cumsum(q)
-    x = float(base[0] + np.sum(ls * np.cos(th)))
-    y = float(base[1] + np.sum(ls * np.sin(th)))
-    return x, y, float(th[2])
+    pose = np.empty(3)
+    _native.finger_fk(_geometry(base, base_angle, lengths), flat_float64(q), pose)
+    return float(pose[0]), float(pose[1]), float(pose[2])
 
 
 def finger_ik(
@@ -75,28 +79,10 @@ def finger_ik(
     """
     if elbow not in (1, -1):
         raise ValueError(f"elbow must be +1 or -1, got {elbow!r}")
-    l1, l2, l3 = _lengths(lengths)
-    wx = x - l3 * math.cos(phi) - base[0]
-    wy = y - l3 * math.sin(phi) - base[1]
-    r = math.hypot(wx, wy)
-    r_min, r_max = abs(l1 - l2), l1 + l2
-    tol = _REACH_RTOL * r_max
-    if not (r_min - tol <= r <= r_max + tol):
-        raise UnreachableError(r, r_min, r_max)
-    c2 = (r * r - l1 * l1 - l2 * l2) / (2 * l1 * l2)
-    q2 = elbow * math.acos(min(1.0, max(-1.0, c2)))
-    th1 = math.atan2(wy, wx) - math.atan2(l2 * math.sin(q2), l1 + l2 * math.cos(q2))
-    q1 = th1 - base_angle
-    q3 = phi - th1 - q2
-    return wrap_angle(np.array([q1, q2, q3]))
-
-
-def _finger_geometry(hand: Any) -> list[tuple[str, tuple[float, float], float, tuple[float, float, float]]]:
-    """(name, base, base_angle, link lengths) per finger, from ``hand.params``."""
-    return [
-        (f.name, f.base, f.base_angle, tuple(link.length for link in f.links))
-        for f in hand.params.fingers
-    ]
+    q, reach = np.empty(3), np.empty(3)
+    if not _native.finger_ik(_geometry(base, base_angle, lengths), _REACH_RTOL, x, y, phi, int(elbow), q, reach):
+        raise UnreachableError(*map(float, reach))
+    return q
 
 
 def hand_ik(hand: Any, targets: Any, q_ref: Any) -> np.ndarray:
@@ -107,8 +93,8 @@ def hand_ik(hand: Any, targets: Any, q_ref: Any) -> np.ndarray:
     differences, summed squares) is taken, and each angle is returned as its
     representative nearest ``q_ref`` (``q_ref + wrap(q - q_ref)``, the same
     configuration), so a joint-space controller tracking it never turns the long way
-    round. Geometry comes from ``hand.params.fingers`` (a ``hierhand.model.Hand``).
-    Raises ``UnreachableError`` naming the finger.
+    round. Geometry comes from ``hand`` (a ``hierhand.model.Hand``). Raises
+    ``UnreachableError`` naming the finger.
     """
     targets = np.asarray(targets, dtype=float)
     if targets.shape != (3, 3):
@@ -124,12 +110,10 @@ def hand_ik(hand: Any, targets: Any, q_ref: Any) -> np.ndarray:
 
 def finger_ik_near(hand: Any, finger: int, target: Any, q_ref: Any) -> np.ndarray:
     """Joint angles (3,) of one finger of ``hand`` for a tip target ``(x, y, phi)``: the
-    elbow branch nearer ``q_ref``, each angle as its representative nearest ``q_ref``."""
-    name, base, base_angle, lengths = _finger_geometry(hand)[finger]
-    ref = np.asarray(q_ref, dtype=float)
-    try:
-        branches = [finger_ik(base, base_angle, lengths, *target, elbow=e) for e in (1, -1)]
-    except UnreachableError as err:
-        raise UnreachableError(err.distance, err.r_min, err.r_max, name) from None
-    steps = [wrap_angle(b - ref) for b in branches]
-    return ref + min(steps, key=lambda d: float(np.dot(d, d)))
+    elbow branch nearer ``q_ref``, each angle as its representative nearest ``q_ref``
+    (elbow +1 on a tie). Raises ``UnreachableError`` naming the finger."""
+    x, y, phi = (float(v) for v in target)
+    q, reach = np.empty(3), np.empty(3)
+    if not _native.ik_near(hand.native, finger, _REACH_RTOL, x, y, phi, flat_float64(q_ref), q, reach):
+        raise UnreachableError(*map(float, reach), hand.names[finger])
+    return q

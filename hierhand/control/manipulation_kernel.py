@@ -1,14 +1,12 @@
 """The manipulation controller's compiled output: trajectories, IK, PD and feedforward.
 
-``manipulation_output`` does in one native call what ``ManipulationPD.output_reference``
-does in numpy: sample the fingertip trajectories, turn the samples into joint targets by
-the exact three-joint inverse kinematics (the elbow branch nearest ``q0``, each angle as
-its representative nearest ``q0``), differentiate those centrally in time for the
-velocity target, track both with the joint PD, and add the gravity and load feedforward.
-The law lives in C (``hierhand/csrc/manipulation.c``); its arithmetic follows
-``inverse_kinematics.finger_ik`` / ``finger_ik_near``, ``trajectory.Trajectory.sample`` /
-``velocity`` and ``Hand.bias`` / ``tip_jacobians`` operation by operation, with the
-plant's own kinematics and dynamics, so the two agree to round-off.
+``manipulation_output`` is ``ManipulationPD.output`` in one native call: sample the
+fingertip trajectories, turn the samples into joint targets by the exact three-joint
+inverse kinematics (the elbow branch nearest ``q0``, each angle as its representative
+nearest ``q0``), differentiate those centrally in time for the velocity target, track
+both with the joint PD, and add the gravity and load feedforward. The law lives in C
+(``hierhand/csrc/manipulation.c``); ``inverse_kinematics`` and ``trajectory`` call the
+same C for their functions, and the gravity and Jacobians are the plant's.
 
 Everything comes in flat float64 arrays whose layouts are defined once, in
 ``hierhand/csrc/control.h`` (``hierhand._native.LAYOUT``); ``pack_params`` and
@@ -23,6 +21,7 @@ import numpy as np
 
 from .. import _native
 from .inverse_kinematics import _REACH_RTOL
+from .trajectory import INTERPOLATIONS
 
 _L = _native.LAYOUT
 
@@ -43,9 +42,7 @@ N_PARAMS: int = _L["MANIP_N_PARAMS"]
 
 # -- trajectories: waypoints (3, n_max, 4) rows (t, x, y, phi); meta (3, 2) float64 ------
 M_COUNT: int = _L["MANIP_M_COUNT"]  # waypoints of the finger's trajectory (0: none, the finger holds q0)
-M_INTERP: int = _L["MANIP_M_INTERP"]  # INTERP_LINEAR or INTERP_MINJERK
-INTERP_LINEAR: int = _L["MANIP_INTERP_LINEAR"]
-INTERP_MINJERK: int = _L["MANIP_INTERP_MINJERK"]
+M_INTERP: int = _L["MANIP_M_INTERP"]  # trajectory.INTERPOLATIONS' code
 
 # -- output: rows tau_m, tau_ff, q_ref -------------------------------------------------
 N_OUT: int = _L["MANIP_N_OUT"]
@@ -58,13 +55,6 @@ manipulation_output = _native.manipulation_output
 """``manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, out) -> status``: fill
 ``out`` (3, 9) with the rows tau_m, tau_ff, q_ref (``out`` incomplete unless ``OK``).
 Takes C-contiguous float64 arrays only (``TypeError`` otherwise)."""
-
-sample = _native.trajectory_sample
-"""``sample(waypoints, meta, f, t) -> (x, y, phi)``: ``Trajectory.sample(t)`` of finger f."""
-
-moving = _native.trajectory_moving
-"""``moving(waypoints, meta, f, t) -> bool``: whether ``Trajectory.velocity(t)`` of finger f
-has a non-zero component."""
 
 
 def pack_params(q0, kp, kd, gravity, weight, threshold: float, gravity_compensation: bool,
@@ -96,14 +86,6 @@ def pack_trajectories(trajectories: Sequence) -> tuple[np.ndarray, np.ndarray]:
         waypoints[f, :n, 0] = traj.times
         waypoints[f, :n, 1:] = traj.points
         meta[f, M_COUNT] = n
-        meta[f, M_INTERP] = INTERP_MINJERK if traj.interpolation == "minjerk" else INTERP_LINEAR
+        meta[f, M_INTERP] = INTERPOLATIONS[traj.interpolation]
     return waypoints, meta
 
-
-def ik_near(model, f: int, x: float, y: float, phi: float, r0: float, r1: float,
-            r2: float) -> tuple[bool, float, float, float]:
-    """Joint angles of finger f of ``model`` (``Hand.native``) for the tip target
-    (x, y, phi), as ``finger_ik_near``: of the two elbow branches the one nearer
-    (r0, r1, r2), each angle as its representative nearest the reference.
-    Returns (reachable, q1, q2, q3)."""
-    return _native.ik_near(model, f, _REACH_RTOL, x, y, phi, r0, r1, r2)

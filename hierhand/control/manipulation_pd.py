@@ -6,9 +6,9 @@ exact three-joint inverse kinematics and tracks them with a joint PD. Fingers wi
 trajectory hold their initial joint angles.
 
 All of that runs in one native call per hit (``manipulation_kernel.manipulation_output``,
-the law in C over flat arrays packed once at load time); ``output_reference`` is the same
-computation in numpy, kept as the reference the C law is tested against and as the path
-that raises a descriptive error when a target turns out unreachable during the run.
+the law in C over flat arrays packed once at load time). When a target turns out
+unreachable during the run, the Python API on the same C (``finger_ik_near``) names the
+finger and the distance.
 
 Outputs: ``tau_m``, the PD torque of the voluntary motion (what the suppresser weighs
 against the grasping torque), and ``tau_ff``, a feedforward that keeps the 10 ms loop's
@@ -31,8 +31,9 @@ import numpy as np
 from blocks import Block
 
 from ..model.hand_source import HAND_DOC, ModelsTheHand, hand_of
+from .arrays import flat_float64
 from .inverse_kinematics import UnreachableError, finger_ik_near
-from .manipulation_kernel import OK, manipulation_output, pack_params, pack_trajectories
+from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
 
 DERIVATIVE_STEP = 1e-3
@@ -112,48 +113,31 @@ class ManipulationPD(ModelsTheHand, Block):
         """Joint angles (3,) of one finger for a tip target, on the branch nearest q0."""
         return finger_ik_near(self.hand, finger, point, self.hand.q0[3 * finger:3 * finger + 3])
 
-    def reference(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Joint position and velocity targets (9,) at time t (numpy; ``output`` computes
-        the same in its native call)."""
-        q_ref = self.hand.q0.copy()
-        qd_ref = np.zeros(9)
-        for f, traj in enumerate(self.trajectories):
-            if traj is None:
-                continue
-            s = slice(3 * f, 3 * f + 3)
-            q_ref[s] = self.joint_targets_for(f, traj.sample(t))
-            if np.any(traj.velocity(t)):
-                ahead = self.joint_targets_for(f, traj.sample(t + DERIVATIVE_STEP))
-                behind = self.joint_targets_for(f, traj.sample(t - DERIVATIVE_STEP))
-                qd_ref[s] = (ahead - behind) / (2 * DERIVATIVE_STEP)
-        return q_ref, qd_ref
-
     def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """One native call on the arrays packed in ``__init__`` (so parameters changed on
-        the object afterwards are not seen). Inputs the native call refuses (anything but
-        C-contiguous float64 arrays of the port widths), and a target found unreachable,
-        go through ``output_reference``."""
+        the object afterwards are not seen). Inputs the native call refuses for their type
+        (lists, other dtypes, strided views) are converted to float64 first; inputs of the
+        wrong width raise ``ValueError`` naming the port, a target out of reach
+        ``UnreachableError`` naming the finger."""
         out = np.empty((3, 9))
+        q, qd, fn, support = inputs["q"], inputs["qd"], inputs["fn"], inputs.get("support", self.input_defaults["support"])
         try:
-            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, inputs["q"],
-                                         inputs["qd"], inputs["fn"], inputs.get("support", self.input_defaults["support"]), out)
-        except (TypeError, ValueError):
-            return self.output_reference(t, state, inputs)
+            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, q, qd, fn, support, out)
+        except TypeError:
+            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, flat_float64(q),
+                                         flat_float64(qd), flat_float64(fn), flat_float64(support), out)
         if status != OK:
-            return self.output_reference(t, state, inputs)  # raises the UnreachableError naming the finger
+            raise self.unreachable(status - UNREACHABLE, t)
         return {"tau_m": out[0], "tau_ff": out[1], "q_ref": out[2]}
 
-    def output_reference(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """``output`` in numpy (the native call follows it operation by operation)."""
-        q, qd = inputs["q"], inputs["qd"]
-        q_ref, qd_ref = self.reference(t)
-        tau_m = self.kp * (q_ref - q) + self.kd * (qd_ref - qd)
-        tau_ff = self.hand.bias(q, np.zeros(9)) if self.gravity_compensation else np.zeros(9)
-        carrying = inputs["fn"] > self.threshold
-        if self.load_compensation and carrying.any():
-            support = np.asarray(inputs.get("support", self.input_defaults["support"]), dtype=float)
-            share = -(self.weight + support[:2]) / carrying.sum()
-            jac = self.hand.tip_jacobians(q)
-            for f in np.flatnonzero(carrying):
-                tau_ff[3 * f:3 * f + 3] += jac[f].T @ share
-        return {"tau_m": tau_m, "tau_ff": tau_ff, "q_ref": q_ref}
+    def unreachable(self, finger: int, t: float) -> UnreachableError:
+        """The error of the first target of ``finger`` out of reach at time t: its pose at
+        t, or a derivative step ahead or behind (the targets ``output`` needs)."""
+        trajectory = self.trajectories[finger]
+        for when in (t, t + DERIVATIVE_STEP, t - DERIVATIVE_STEP):
+            try:
+                self.joint_targets_for(finger, trajectory.sample(when))
+            except UnreachableError as err:
+                return err
+        raise RuntimeError(f"ManipulationPD: finger '{self.hand.names[finger]}' was found out of reach at "
+                           f"t = {t:g} s, but none of its targets is")

@@ -3,7 +3,8 @@
 The reflex runs every 1 ms, so a hit must cost about a microsecond. The law lives in C
 (``hierhand/csrc/reflex.c``, reached through ``hierhand._native``): the grasp matrix
 solve written out by hand, the tip Jacobians from the plant's own kinematics, no
-allocation. ``internal_forces.py`` stays the numpy reference; the tests compare the two.
+allocation. ``internal_forces`` calls the same C for its ``project_internal`` and
+``internal_directions``.
 
 Parameters travel packed in one array (slots ``P_*``, built by ``pack_params``) so that a
 call costs little to dispatch. The slots are defined once, in ``hierhand/csrc/control.h``
@@ -19,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _native
+from .arrays import flat_float64
 from .internal_forces import _COINCIDENT_RTOL
 
 _L = _native.LAYOUT
@@ -86,7 +88,7 @@ def reflex_directions(params, state, tip, normal, fn) -> tuple[np.ndarray, np.nd
     try:
         _directions(params, state, tip, normal, fn, g, flags)
     except TypeError:
-        _directions(params, _f64(state), _f64(tip), _f64(normal), _f64(fn), g, flags)
+        _directions(params, *map(flat_float64, (state, tip, normal, fn)), g, flags)
     return g, flags[:3] != 0.0, flags[3:] != 0.0
 
 
@@ -98,7 +100,7 @@ def reflex_forces(params, state, tip, normal, fn) -> tuple[np.ndarray, np.ndarra
     try:
         _forces(params, state, tip, normal, fn, f, grasp)
     except TypeError:
-        _forces(params, _f64(state), _f64(tip), _f64(normal), _f64(fn), f, grasp)
+        _forces(params, *map(flat_float64, (state, tip, normal, fn)), f, grasp)
     return f, grasp != 0.0
 
 
@@ -112,7 +114,7 @@ def reflex_output(model, params, state, q, tip, normal, fn) -> np.ndarray:
     try:
         _output(model, params, state, tip, normal, fn, q, out)
     except TypeError:
-        _output(model, params, _f64(state), _f64(tip), _f64(normal), _f64(fn), _f64(q), out)
+        _output(model, params, *map(flat_float64, (state, tip, normal, fn, q)), out)
     return out
 
 
@@ -132,10 +134,6 @@ def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.n
     try:
         _update(params, state, tip, normal, fn, ft, share, new)
     except TypeError:
-        _update(params, _f64(state), _f64(tip), _f64(normal), _f64(fn), _f64(ft), _f64(share), new)
+        _update(params, *map(flat_float64, (state, tip, normal, fn, ft, share)), new)
     return new
 
-
-def _f64(x) -> np.ndarray:
-    """A 1-D C-contiguous float64 array of ``x`` (a list, another dtype, a strided view)."""
-    return np.ascontiguousarray(x, dtype=np.float64).reshape(-1)

@@ -2,9 +2,14 @@
 
 The manipulation controller is given these beforehand (one per finger), samples them,
 turns the samples into joint targets by exact inverse kinematics and tracks them with a
-joint PD. Minimum-jerk segments start and end at rest, so a finger passes every
-waypoint with zero velocity and acceleration; linear segments have constant velocity.
-``phi`` is interpolated as given (not wrapped): write 3.1 -> 3.3 rather than 3.1 -> -2.98.
+joint PD. Minimum-jerk segments (``s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5``) start and
+end at rest, so a finger passes every waypoint with zero velocity and acceleration;
+linear segments have constant velocity. ``phi`` is interpolated as given (not wrapped):
+write 3.1 -> 3.3 rather than 3.1 -> -2.98.
+
+Sampling is the manipulation controller's law, compiled (``hierhand/csrc/manipulation.c``):
+``sample`` and ``velocity`` call the C the ``ManipulationPD`` block runs; this class
+checks and holds the waypoints.
 """
 
 from __future__ import annotations
@@ -13,19 +18,12 @@ from typing import Any, Sequence
 
 import numpy as np
 
-__all__ = ["Trajectory", "minjerk", "minjerk_rate"]
+from .. import _native
 
-INTERPOLATIONS = ("linear", "minjerk")
+__all__ = ["Trajectory"]
 
-
-def minjerk(tau: float) -> float:
-    """Minimum-jerk blend ``s(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5`` on [0, 1]."""
-    return tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau))
-
-
-def minjerk_rate(tau: float) -> float:
-    """``ds/dtau = 30 tau^2 (1 - tau)^2``."""
-    return 30.0 * tau * tau * (1.0 - tau) ** 2
+INTERPOLATIONS = {"linear": _native.LAYOUT["MANIP_INTERP_LINEAR"], "minjerk": _native.LAYOUT["MANIP_INTERP_MINJERK"]}
+"""The interpolations by name, with their codes in the C's trajectory arrays."""
 
 
 class Trajectory:
@@ -50,41 +48,29 @@ class Trajectory:
                     "(times must be strictly increasing)"
                 )
         self.interpolation = interpolation
-        self._t = w[:, 0].copy()
-        self._p = w[:, 1:].copy()
+        self._code = INTERPOLATIONS[interpolation]
+        self._w = np.array(w, order="C")  # rows (t, x, y, phi), the C's layout; a copy
 
     @property
     def times(self) -> np.ndarray:
         """(n,) waypoint times."""
-        return self._t.copy()
+        return self._w[:, 0].copy()
 
     @property
     def points(self) -> np.ndarray:
         """(n, 3) waypoint poses ``(x, y, phi)``."""
-        return self._p.copy()
+        return self._w[:, 1:].copy()
 
     @property
     def duration(self) -> float:
         """Time from the first to the last waypoint."""
-        return float(self._t[-1] - self._t[0])
-
-    def _segment(self, t: float) -> tuple[int, float, float]:
-        """Segment index, its normalised time tau in [0, 1] and its length."""
-        i = int(np.searchsorted(self._t, t, side="right")) - 1
-        i = min(max(i, 0), self._t.size - 2)
-        span = self._t[i + 1] - self._t[i]
-        return i, (t - self._t[i]) / span, span
+        return float(self._w[-1, 0] - self._w[0, 0])
 
     def sample(self, t: float) -> np.ndarray:
         """(3,) pose ``(x, y, phi)`` at time ``t``."""
-        t = float(t)
-        if t <= self._t[0]:
-            return self._p[0].copy()
-        if t >= self._t[-1]:
-            return self._p[-1].copy()
-        i, tau, _ = self._segment(t)
-        s = minjerk(tau) if self.interpolation == "minjerk" else tau
-        return self._p[i] + s * (self._p[i + 1] - self._p[i])
+        pose = np.empty(3)
+        _native.trajectory_sample(self._w, self._code, float(t), pose)
+        return pose
 
     def velocity(self, t: float) -> np.ndarray:
         """(3,) analytic time derivative of ``sample``.
@@ -93,15 +79,13 @@ class Trajectory:
         there; zero before the first waypoint and from the last one on (held). Linear
         interpolation jumps at waypoints; minimum jerk is continuous (zero there).
         """
-        t = float(t)
-        if t < self._t[0] or t >= self._t[-1]:
-            return np.zeros(3)
-        i, tau, span = self._segment(t)
-        rate = minjerk_rate(tau) if self.interpolation == "minjerk" else 1.0
-        return (rate / span) * (self._p[i + 1] - self._p[i])
+        velocity = np.empty(3)
+        _native.trajectory_velocity(self._w, self._code, float(t), velocity)
+        return velocity
 
     def __repr__(self) -> str:
-        return f"Trajectory({self._t.size} waypoints, {self.interpolation}, t in [{self._t[0]:g}, {self._t[-1]:g}])"
+        t = self._w[:, 0]
+        return f"Trajectory({t.size} waypoints, {self.interpolation}, t in [{t[0]:g}, {t[-1]:g}])"
 
     @classmethod
     def from_config(cls, config: Any) -> "Trajectory":

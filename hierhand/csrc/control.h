@@ -8,12 +8,13 @@
  * finger geometry comes from an hh_model through the inline kinematics and dynamics the
  * plant's step uses (kinematics.h, dynamics.h).
  *
- * Every law follows its numpy reference operation by operation (the same formulas, the
- * same order of additions, Python's max/min/% as float_ops.h gives them), so the two
- * agree to the last bit wherever libm does: the references are internal_forces.py
- * (reflex), inverse_kinematics.py and trajectory.py (manipulation) and suppression.py.
- * Numbers that Python defines (tolerances, the derivative step) arrive in the parameter
- * vectors, so each has one definition.
+ * These functions are the laws: the blocks and the Python API of hierhand.control
+ * (internal_directions, project_internal, finger_ik, finger_fk, wrap_angle, Trajectory,
+ * suppress, ...) call them, and nothing in the package computes them a second time.
+ * Readable numpy formulations live in the tests (tests/hierhand/control/oracles.py),
+ * which compare them with these to round-off. Numbers that Python defines (tolerances,
+ * the derivative step) arrive as arguments or in the parameter vectors, so each has one
+ * definition.
  *
  * Failures are status codes (HH_REFLEX_*, HH_MANIP_*), never aborts.
  */
@@ -68,6 +69,19 @@ typedef struct hh_reflex_inputs {
                             (the suppresser's output 'share'; 1 when nothing overrides the reflex);
                             read by hh_reflex_update only */
 } hh_reflex_inputs;
+
+/* The internal part (I - G^+ G) f of the stacked forces f (k x 2) at the points (k x 2,
+ * k >= 1) into out (k x 2): what is left of f once the part that would move the object
+ * is removed. G G^T is solved in closed form about the points' centroid; when the moment
+ * row is numerically dependent (all points coincide) it is dropped, as numpy.linalg.pinv
+ * drops it. The result does not depend on the point the moments are taken about. */
+void hh_project_internal(int k, const double *points, const double *f, double *out);
+
+/* The centroid squeeze g_i = c - p_i of k points (k x 2), c their centroid, divided by its
+ * longest row, into g (k x 2): an internal force set for any k >= 2, pushing every point
+ * toward the centroid. HH_REFLEX_COINCIDENT when its longest row is at most
+ * coincident_rtol times the largest coordinate (g then incomplete). */
+int hh_centroid_squeeze(int k, const double *points, double coincident_rtol, double *g);
 
 /* The internal force per finger at unit scale, g (3 x 2: largest row length 1, zero
  * outside the grasp or with fewer than two fingers in it), and the flags grasp and
@@ -139,6 +153,16 @@ typedef struct hh_trajectories {
     long capacity; /* waypoint rows per finger */
 } hh_trajectories;
 
+/* One trajectory: count >= 1 rows (t, x, y, phi) with strictly increasing t. */
+typedef struct hh_trajectory {
+    const double *waypoints; /* count x HH_MANIP_W_COLS */
+    long count;
+    int minimum_jerk; /* 1: minimum-jerk segments, 0: linear */
+} hh_trajectory;
+
+/* Finger f's trajectory of tr (count 0: the finger has none). */
+hh_trajectory hh_finger_trajectory(const hh_trajectories *tr, int f);
+
 /* -- output of hh_manipulation_output: rows tau_m, tau_ff, q_ref (9 each) --------------- */
 enum { HH_MANIP_O_TAU_M = 0, HH_MANIP_O_TAU_FF = 9, HH_MANIP_O_Q_REF = 18, HH_MANIP_N_OUT = 27 };
 
@@ -146,21 +170,36 @@ enum { HH_MANIP_O_TAU_M = 0, HH_MANIP_O_TAU_FF = 9, HH_MANIP_O_Q_REF = 18, HH_MA
  * its reach ---------------------------------------------------------------------------- */
 enum { HH_MANIP_OK = 0, HH_MANIP_UNREACHABLE = 1 };
 
-/* Joint angles q (3) of the finger with parameter row ``finger`` (hh_model.fingers[f])
- * placing its tip centre at (x, y) with link 3 at absolute angle phi: of the two elbow
- * branches the one nearer ref (wrapped differences, summed squares; elbow +1 on a tie),
- * each angle as its representative nearest ref. Returns 1, or 0 when the wrist point is
- * out of reach (q untouched). */
+/* An angle wrapped to (-pi, pi]. */
+double hh_wrap_angle(double a);
+
+/* Tip centre x, y and link-3 angle phi (not wrapped) of the finger with parameter row
+ * ``finger`` at joint angles q (3): the plant's kinematics (kinematics.h). */
+void hh_finger_fk(const double *finger, const double q[3], double pose[3]);
+
+/* Joint angles q (3, wrapped to (-pi, pi]) of the finger with parameter row ``finger``
+ * (hh_model.fingers[f]) placing its tip centre at (x, y) with link 3 at absolute angle
+ * phi, on the elbow branch ``elbow``: +1 gives q2 >= 0, -1 q2 <= 0. reach (3) receives
+ * the wrist point's distance from the base and the reachable range [|l1 - l2|, l1 + l2].
+ * Returns 1, or 0 when the distance is outside the range by more than reach_rtol (l1 +
+ * l2) (q untouched). */
+int hh_finger_ik(const double *finger, double reach_rtol, double x, double y, double phi, int elbow, double q[3],
+                 double reach[3]);
+
+/* As hh_finger_ik, but of the two elbow branches the one nearer ref (wrapped
+ * differences, summed squares; elbow +1 on a tie), each angle as its representative
+ * nearest ref. */
 int hh_ik_near(const double *finger, double reach_rtol, double x, double y, double phi, const double ref[3],
-               double q[3]);
+               double q[3], double reach[3]);
 
-/* Pose (x, y, phi) of finger f's trajectory at time t: the first waypoint before it, the
- * last after it, linear or minimum-jerk in between. The finger must have waypoints. */
-void hh_trajectory_sample(const hh_trajectories *tr, int f, double t, double pose[3]);
+/* Pose (x, y, phi) of a trajectory at time t: the first waypoint before it, the last
+ * after it, linear or minimum-jerk in between; NaN at a NaN time. */
+void hh_trajectory_sample(const hh_trajectory *tr, double t, double pose[3]);
 
-/* 1 when the trajectory's analytic velocity at t (right-continuous; zero before the first
- * and from the last waypoint on) has a non-zero component, else 0. */
-int hh_trajectory_moving(const hh_trajectories *tr, int f, double t);
+/* Analytic time derivative of hh_trajectory_sample, right-continuous: at a waypoint the
+ * velocity of the segment starting there, zero before the first waypoint and from the
+ * last one on; NaN at a NaN time. */
+void hh_trajectory_velocity(const hh_trajectory *tr, double t, double velocity[3]);
 
 /* out (HH_MANIP_N_OUT) at time t, joint angles q (9), rates qd (9), normal forces fn (3)
  * and the force a support applies to the object (support: fx, fy, torque): tau_m = kp
@@ -187,5 +226,16 @@ enum { HH_SUPPRESS_O_TAU = 0, HH_SUPPRESS_O_TAU_G_EFF = 9, HH_SUPPRESS_O_SHARE =
 
 /* out (HH_SUPPRESS_N_OUT) from the torques tau_g, tau_m, tau_ff (9 each). */
 void hh_suppress(const double *params, const double *tau_g, const double *tau_m, const double *tau_ff, double *out);
+
+/* The logistic function 1 / (1 + exp(-x)), without overflow for large |x|. */
+double hh_sigmoid(double x);
+
+/* One joint's suppressed grasping torque tau_g * sigmoid(S_a (S_b - g(tau_m))) in mode
+ * HH_SUPPRESS_MAGNITUDE or HH_SUPPRESS_SIGNED, tau_g in HH_SUPPRESS_PASS. */
+double hh_suppressed(double tau_g, double tau_m, double s_a, double s_b, double mode);
+
+/* share (3) of the torques tau_g, tau_g_eff, tau_m (9 each), as the suppresser's output
+ * of that name when it does suppress. */
+void hh_finger_shares(const double *tau_g, const double *tau_g_eff, const double *tau_m, double share[3]);
 
 #endif

@@ -1,7 +1,8 @@
 /* Python's float max, min and modulo in C.
  *
- * The controllers' C laws follow numpy reference code operation by operation, so that
- * they give the same numbers bit for bit. Where that code uses Python's builtins, these
+ * The controllers' C laws were written to follow numpy formulations operation by
+ * operation (the tests' oracles, tests/hierhand/control/oracles.py), so that they give
+ * the same numbers bit for bit where libm does. Where those use Python's builtins, these
  * functions do what the builtins do, NaN and signed zeros included: max(a, b) keeps a
  * unless b > a, min(a, b) keeps a unless b < a, and x % y has the sign of y
  * (CPython's float_rem, which numba and numpy.mod copy).

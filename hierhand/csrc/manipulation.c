@@ -1,12 +1,11 @@
 /* The manipulation controller's law (ManipulationPD): trajectories, IK, PD, feedforward.
  *
- * hh_manipulation_output does in one call what ManipulationPD.output_reference does in
- * numpy: sample the fingertip trajectories, turn the samples into joint targets by exact
- * three-joint inverse kinematics, differentiate those centrally in time for the velocity
- * target, track both with the joint PD, and add the gravity and load feedforward. The
- * arithmetic follows inverse_kinematics.finger_ik / finger_ik_near,
- * trajectory.Trajectory.sample / velocity and Hand.bias / tip_jacobians operation by
- * operation.
+ * hh_manipulation_output does in one call what the block's output is: sample the
+ * fingertip trajectories, turn the samples into joint targets by exact three-joint
+ * inverse kinematics, differentiate those centrally in time for the velocity target,
+ * track both with the joint PD, and add the gravity and load feedforward. The pieces
+ * (hh_wrap_angle, hh_finger_ik, hh_ik_near, hh_trajectory_sample / _velocity) are the
+ * Python API's too: inverse_kinematics.py and trajectory.py call them.
  */
 #include <math.h>
 
@@ -18,8 +17,7 @@
 static const double PI = 3.14159265358979323846;
 static const double TWO_PI = 2 * 3.14159265358979323846;
 
-/* inverse_kinematics.wrap_angle of one angle: to (-pi, pi]. */
-static double wrap_angle(double a)
+double hh_wrap_angle(double a)
 {
     double w = PI - hh_floored_mod(PI - a, TWO_PI);
     if (w <= -PI) /* the modulo of a tiny negative number rounds to 2 pi */
@@ -27,13 +25,24 @@ static double wrap_angle(double a)
     return w;
 }
 
+void hh_finger_fk(const double *finger, const double q[3], double pose[3])
+{
+    double u[3][2], pts[4][2];
+    pose[2] = hh_finger_frames(finger, q, u, pts);
+    pose[0] = pts[3][0];
+    pose[1] = pts[3][1];
+}
+
 static double link_length(const double *finger, int i)
 {
     return finger[HH_F_LINK0 + HH_F_LINK_STRIDE * i + HH_L_LENGTH];
 }
 
-int hh_ik_near(const double *finger, double reach_rtol, double x, double y, double phi, const double ref[3],
-               double q[3])
+/* The wrist point (joint 3) of a tip target, seen from the finger base: its direction
+ * ``toward`` and the size ``bend`` of the elbow angle q2 that reaches it. reach as
+ * hh_finger_ik; 0 when out of reach. */
+static int wrist(const double *finger, double reach_rtol, double x, double y, double phi, double reach[3],
+                 double *toward, double *bend)
 {
     double l1 = link_length(finger, 0);
     double l2 = link_length(finger, 1);
@@ -44,23 +53,54 @@ int hh_ik_near(const double *finger, double reach_rtol, double x, double y, doub
     double r_min = fabs(l1 - l2);
     double r_max = l1 + l2;
     double tol = reach_rtol * r_max;
+    reach[0] = r;
+    reach[1] = r_min;
+    reach[2] = r_max;
     if (!(r_min - tol <= r && r <= r_max + tol))
         return 0;
     double c2 = (r * r - l1 * l1 - l2 * l2) / (2 * l1 * l2);
-    double a2 = acos(hh_min(1.0, hh_max(-1.0, c2)));
-    double toward = atan2(wy, wx);
+    *bend = acos(hh_min(1.0, hh_max(-1.0, c2)));
+    *toward = atan2(wy, wx);
+    return 1;
+}
+
+/* Joint angles (wrapped) of the branch with elbow angle q2 for the wrist direction toward. */
+static void branch(const double *finger, double phi, double toward, double q2, double q[3])
+{
+    double l1 = link_length(finger, 0);
+    double l2 = link_length(finger, 1);
+    double th1 = toward - atan2(l2 * sin(q2), l1 + l2 * cos(q2));
+    q[0] = hh_wrap_angle(th1 - finger[HH_F_BASE_ANGLE]);
+    q[1] = hh_wrap_angle(q2);
+    q[2] = hh_wrap_angle(phi - th1 - q2);
+}
+
+int hh_finger_ik(const double *finger, double reach_rtol, double x, double y, double phi, int elbow, double q[3],
+                 double reach[3])
+{
+    double toward, bend;
+    if (!wrist(finger, reach_rtol, x, y, phi, reach, &toward, &bend))
+        return 0;
+    branch(finger, phi, toward, elbow > 0 ? bend : -bend, q);
+    return 1;
+}
+
+int hh_ik_near(const double *finger, double reach_rtol, double x, double y, double phi, const double ref[3],
+               double q[3], double reach[3])
+{
+    double toward, bend;
+    if (!wrist(finger, reach_rtol, x, y, phi, reach, &toward, &bend))
+        return 0;
     double best = 0.0;
     double best_step[3] = {0.0, 0.0, 0.0};
-    for (int branch = 0; branch < 2; branch++) {
-        double q2 = branch == 0 ? a2 : -a2; /* elbow +1 first: it wins ties */
-        double th1 = toward - atan2(l2 * sin(q2), l1 + l2 * cos(q2));
-        double q1 = th1 - finger[HH_F_BASE_ANGLE];
-        double q3 = phi - th1 - q2;
-        double d0 = wrap_angle(wrap_angle(q1) - ref[0]);
-        double d1 = wrap_angle(wrap_angle(q2) - ref[1]);
-        double d2 = wrap_angle(wrap_angle(q3) - ref[2]);
+    for (int elbow = 0; elbow < 2; elbow++) {
+        double angles[3];
+        branch(finger, phi, toward, elbow == 0 ? bend : -bend, angles); /* elbow +1 first: it wins ties */
+        double d0 = hh_wrap_angle(angles[0] - ref[0]);
+        double d1 = hh_wrap_angle(angles[1] - ref[1]);
+        double d2 = hh_wrap_angle(angles[2] - ref[2]);
         double dd = d0 * d0 + d1 * d1 + d2 * d2;
-        if (branch == 0 || dd < best) {
+        if (elbow == 0 || dd < best) {
             best = dd;
             best_step[0] = d0;
             best_step[1] = d1;
@@ -72,89 +112,112 @@ int hh_ik_near(const double *finger, double reach_rtol, double x, double y, doub
     return 1;
 }
 
-/* Waypoint k of finger f. */
-static const double *waypoint(const hh_trajectories *tr, int f, long k)
+hh_trajectory hh_finger_trajectory(const hh_trajectories *tr, int f)
 {
-    return tr->waypoints + ((long)f * tr->capacity + k) * HH_MANIP_W_COLS;
+    const double *meta = tr->meta + f * HH_MANIP_N_META;
+    hh_trajectory one = {
+        .waypoints = tr->waypoints + (long)f * tr->capacity * HH_MANIP_W_COLS,
+        .count = (long)meta[HH_MANIP_M_COUNT],
+        .minimum_jerk = meta[HH_MANIP_M_INTERP] == HH_MANIP_INTERP_MINJERK,
+    };
+    return one;
 }
 
-static long waypoint_count(const hh_trajectories *tr, int f)
+/* Waypoint k of a trajectory. */
+static const double *waypoint(const hh_trajectory *tr, long k)
 {
-    return (long)tr->meta[f * HH_MANIP_N_META + HH_MANIP_M_COUNT];
-}
-
-static int minimum_jerk(const hh_trajectories *tr, int f)
-{
-    return tr->meta[f * HH_MANIP_N_META + HH_MANIP_M_INTERP] == HH_MANIP_INTERP_MINJERK;
+    return tr->waypoints + k * HH_MANIP_W_COLS;
 }
 
 /* The segment of t (times[i] <= t < times[i+1], clamped to the first and last): its index,
- * normalised time tau in [0, 1] and span, as Trajectory._segment (numpy.searchsorted on
- * the right). */
-static long segment(const hh_trajectories *tr, int f, long n, double t, double *tau, double *span)
+ * normalised time tau in [0, 1] and span (searchsorted on the right). Needs two
+ * waypoints or more. */
+static long segment(const hh_trajectory *tr, double t, double *tau, double *span)
 {
+    long n = tr->count;
     long count = 0;
-    while (count < n && waypoint(tr, f, count)[HH_MANIP_W_T] <= t)
+    while (count < n && waypoint(tr, count)[HH_MANIP_W_T] <= t)
         count += 1;
     long i = count - 1 > 0 ? count - 1 : 0;
     if (i > n - 2)
         i = n - 2;
-    double t0 = waypoint(tr, f, i)[HH_MANIP_W_T];
-    *span = waypoint(tr, f, i + 1)[HH_MANIP_W_T] - t0;
+    double t0 = waypoint(tr, i)[HH_MANIP_W_T];
+    *span = waypoint(tr, i + 1)[HH_MANIP_W_T] - t0;
     *tau = (t - t0) / *span;
     return i;
 }
 
-void hh_trajectory_sample(const hh_trajectories *tr, int f, double t, double pose[3])
+/* NaN into the three values of v: the pose or velocity at a NaN time. */
+static void not_a_time(double v[3])
 {
-    long n = waypoint_count(tr, f);
-    const double *first = waypoint(tr, f, 0);
-    const double *last = waypoint(tr, f, n - 1);
+    for (int c = 0; c < 3; c++)
+        v[c] = NAN;
+}
+
+void hh_trajectory_sample(const hh_trajectory *tr, double t, double pose[3])
+{
+    const double *first = waypoint(tr, 0);
+    const double *last = waypoint(tr, tr->count - 1);
     if (t <= first[HH_MANIP_W_T] || t >= last[HH_MANIP_W_T]) {
         const double *held = t <= first[HH_MANIP_W_T] ? first : last;
         for (int c = 0; c < 3; c++)
             pose[c] = held[HH_MANIP_W_X + c];
         return;
     }
+    if (isnan(t)) {
+        not_a_time(pose);
+        return;
+    }
     double tau, span;
-    long i = segment(tr, f, n, t, &tau, &span);
-    double s = minimum_jerk(tr, f) ? tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau)) : tau;
-    const double *a = waypoint(tr, f, i);
-    const double *b = waypoint(tr, f, i + 1);
+    long i = segment(tr, t, &tau, &span);
+    double s = tr->minimum_jerk ? tau * tau * tau * (10.0 + tau * (-15.0 + 6.0 * tau)) : tau;
+    const double *a = waypoint(tr, i);
+    const double *b = waypoint(tr, i + 1);
     for (int c = HH_MANIP_W_X; c <= HH_MANIP_W_PHI; c++)
         pose[c - HH_MANIP_W_X] = a[c] + s * (b[c] - a[c]);
 }
 
-int hh_trajectory_moving(const hh_trajectories *tr, int f, double t)
+void hh_trajectory_velocity(const hh_trajectory *tr, double t, double velocity[3])
 {
-    long n = waypoint_count(tr, f);
-    if (t < waypoint(tr, f, 0)[HH_MANIP_W_T] || t >= waypoint(tr, f, n - 1)[HH_MANIP_W_T])
-        return 0;
+    if (t < waypoint(tr, 0)[HH_MANIP_W_T] || t >= waypoint(tr, tr->count - 1)[HH_MANIP_W_T]) {
+        for (int c = 0; c < 3; c++)
+            velocity[c] = 0.0;
+        return;
+    }
+    if (isnan(t)) {
+        not_a_time(velocity);
+        return;
+    }
     double tau, span;
-    long i = segment(tr, f, n, t, &tau, &span);
-    double rate = minimum_jerk(tr, f) ? 30.0 * tau * tau * ((1.0 - tau) * (1.0 - tau)) : 1.0;
+    long i = segment(tr, t, &tau, &span);
+    double rate = tr->minimum_jerk ? 30.0 * tau * tau * ((1.0 - tau) * (1.0 - tau)) : 1.0;
     double k = rate / span;
-    const double *a = waypoint(tr, f, i);
-    const double *b = waypoint(tr, f, i + 1);
+    const double *a = waypoint(tr, i);
+    const double *b = waypoint(tr, i + 1);
     for (int c = HH_MANIP_W_X; c <= HH_MANIP_W_PHI; c++)
-        if (k * (b[c] - a[c]) != 0.0)
-            return 1;
-    return 0;
+        velocity[c - HH_MANIP_W_X] = k * (b[c] - a[c]);
+}
+
+/* 1 when the trajectory's velocity at t has a non-zero component, else 0. */
+static int moving(const hh_trajectory *tr, double t)
+{
+    double velocity[3];
+    hh_trajectory_velocity(tr, t, velocity);
+    return velocity[0] != 0.0 || velocity[1] != 0.0 || velocity[2] != 0.0;
 }
 
 /* Joint targets q (3) of finger f for its trajectory's pose at time t; 0 if unreachable. */
-static int target_at(const hh_model *m, const double *params, const hh_trajectories *tr, int f, double t,
-                     double q[3])
+static int target_at(const hh_model *m, const double *params, const hh_trajectory *tr, int f, double t, double q[3])
 {
-    double pose[3];
-    hh_trajectory_sample(tr, f, t, pose);
+    double pose[3], reach[3];
+    hh_trajectory_sample(tr, t, pose);
     return hh_ik_near(m->fingers[f], params[HH_MANIP_P_REACH_RTOL], pose[0], pose[1], pose[2],
-                      params + HH_MANIP_P_Q0 + 3 * f, q);
+                      params + HH_MANIP_P_Q0 + 3 * f, q, reach);
 }
 
 /* Joint position and velocity targets (9 each); HH_MANIP_OK or HH_MANIP_UNREACHABLE + f. */
-static int reference(const hh_model *m, const double *params, const hh_trajectories *tr, double t, double *q_ref,
-                     double *qd_ref)
+static int reference(const hh_model *m, const double *params, const hh_trajectories *trajectories, double t,
+                     double *q_ref, double *qd_ref)
 {
     for (int j = 0; j < HH_JOINTS; j++) {
         q_ref[j] = params[HH_MANIP_P_Q0 + j];
@@ -162,13 +225,14 @@ static int reference(const hh_model *m, const double *params, const hh_trajector
     }
     double h = params[HH_MANIP_P_STEP];
     for (int f = 0; f < HH_FINGERS; f++) {
-        if (waypoint_count(tr, f) == 0)
+        hh_trajectory tr = hh_finger_trajectory(trajectories, f);
+        if (tr.count == 0)
             continue;
-        if (!target_at(m, params, tr, f, t, q_ref + 3 * f))
+        if (!target_at(m, params, &tr, f, t, q_ref + 3 * f))
             return HH_MANIP_UNREACHABLE + f;
-        if (hh_trajectory_moving(tr, f, t)) {
+        if (moving(&tr, t)) {
             double ahead[3], behind[3];
-            if (!target_at(m, params, tr, f, t + h, ahead) || !target_at(m, params, tr, f, t - h, behind))
+            if (!target_at(m, params, &tr, f, t + h, ahead) || !target_at(m, params, &tr, f, t - h, behind))
                 return HH_MANIP_UNREACHABLE + f;
             for (int j = 0; j < 3; j++)
                 qd_ref[3 * f + j] = (ahead[j] - behind[j]) / (2 * h);

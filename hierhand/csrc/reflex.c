@@ -10,8 +10,9 @@
  * When the moment row is numerically dependent (Schur complement at or below
  * numpy.linalg.pinv's cut-off) the moment equation is dropped, as pinv does.
  *
- * internal_forces.py is the numpy reference (project_internal, internal_directions);
- * the tip Jacobians are the plant's (kinematics.h).
+ * The projection and the centroid squeeze work on any k points (hh_project_internal,
+ * hh_centroid_squeeze); internal_forces.py calls them for its project_internal and
+ * internal_directions. The tip Jacobians are the plant's (kinematics.h).
  */
 #include <float.h>
 #include <math.h>
@@ -49,27 +50,68 @@ static void approach_push(const double *tip, const int grasp[3], int i, double p
     push[1] = ty / d;
 }
 
-/* g_i = c - p_i over the grasp, divided by its longest row; HH_REFLEX_COINCIDENT when
- * that is round-off of the points' size. */
-static int centroid_squeeze(const double *params, const double *tip, const int grasp[3], double cx, double cy,
-                            double g[3][2])
+/* The centroid (cx, cy) of k points (k x 2). */
+static void centroid(int k, const double *points, double *cx, double *cy)
 {
+    *cx = 0.0;
+    *cy = 0.0;
+    for (int i = 0; i < k; i++) {
+        *cx += points[2 * i];
+        *cy += points[2 * i + 1];
+    }
+    *cx /= k;
+    *cy /= k;
+}
+
+int hh_centroid_squeeze(int k, const double *points, double coincident_rtol, double *g)
+{
+    double cx, cy;
+    centroid(k, points, &cx, &cy);
     double spread = 0.0;
     double size = 0.0;
-    for (int i = 0; i < 3; i++)
-        if (grasp[i]) {
-            g[i][0] = cx - tip[3 * i];
-            g[i][1] = cy - tip[3 * i + 1];
-            spread = hh_max(spread, hypot(g[i][0], g[i][1]));
-            size = hh_max(hh_max(size, fabs(tip[3 * i])), fabs(tip[3 * i + 1]));
-        }
-    if (spread <= params[HH_REFLEX_P_COINCIDENT_RTOL] * hh_max(size, DBL_MIN))
-        return HH_REFLEX_COINCIDENT;
-    for (int i = 0; i < 3; i++) {
-        g[i][0] /= spread;
-        g[i][1] /= spread;
+    for (int i = 0; i < k; i++) {
+        g[2 * i] = cx - points[2 * i];
+        g[2 * i + 1] = cy - points[2 * i + 1];
+        spread = hh_max(spread, hypot(g[2 * i], g[2 * i + 1]));
+        size = hh_max(hh_max(size, fabs(points[2 * i])), fabs(points[2 * i + 1]));
     }
+    if (spread <= coincident_rtol * hh_max(size, DBL_MIN))
+        return HH_REFLEX_COINCIDENT;
+    for (int i = 0; i < 2 * k; i++)
+        g[i] /= spread;
     return HH_REFLEX_OK;
+}
+
+void hh_project_internal(int k, const double *points, const double *f, double *out)
+{
+    double cx, cy;
+    centroid(k, points, &cx, &cy);
+    /* w = G f, and G G^T = [[k, 0, a], [0, k, b], [a, b, s]] */
+    double w0 = 0.0, w1 = 0.0, w2 = 0.0;
+    double a = 0.0, b = 0.0, s = 0.0;
+    for (int i = 0; i < k; i++) {
+        double rx = points[2 * i] - cx;
+        double ry = points[2 * i + 1] - cy;
+        w0 += f[2 * i];
+        w1 += f[2 * i + 1];
+        w2 += rx * f[2 * i + 1] - ry * f[2 * i];
+        a -= ry;
+        b += rx;
+        s += rx * rx + ry * ry;
+    }
+    double fk = (double)k;
+    double schur = s - (a * a + b * b) / fk;
+    /* all points coinciding leave the moment row empty: pinv drops it */
+    double x2 = schur > PINV_RCOND_SQUARED * hh_max(fk, s) ? (w2 - (a * w0 + b * w1) / fk) / schur : 0.0;
+    double x0 = (w0 - a * x2) / fk;
+    double x1 = (w1 - b * x2) / fk;
+    /* internal = f - G^T x */
+    for (int i = 0; i < k; i++) {
+        double rx = points[2 * i] - cx;
+        double ry = points[2 * i + 1] - cy;
+        out[2 * i] = f[2 * i] - (x0 - ry * x2);
+        out[2 * i + 1] = f[2 * i + 1] - (x1 + rx * x2);
+    }
 }
 
 int hh_reflex_directions(const double *params, const double *state, const hh_reflex_inputs *in, double g[3][2],
@@ -90,61 +132,38 @@ int hh_reflex_directions(const double *params, const double *state, const hh_ref
     }
     if (k < 2)
         return HH_REFLEX_OK;
-    /* push directions: the contact normal, or toward the others' centroid while approaching */
-    double push[3][2];
+    /* the grasp's points and pushes, in finger order: the contact normal, or toward the
+     * others' centroid while approaching */
+    double points[3][2], push[3][2], internal[3][2];
+    int finger[3];
+    int m = 0;
     for (int i = 0; i < 3; i++) {
         if (!grasp[i])
             continue;
+        finger[m] = i;
+        points[m][0] = tip[3 * i];
+        points[m][1] = tip[3 * i + 1];
         if (touching[i]) {
-            push[i][0] = in->normal[2 * i];
-            push[i][1] = in->normal[2 * i + 1];
+            push[m][0] = in->normal[2 * i];
+            push[m][1] = in->normal[2 * i + 1];
         } else {
-            approach_push(tip, grasp, i, push[i]);
+            approach_push(tip, grasp, i, push[m]);
         }
+        m += 1;
     }
-    /* centroid of the grasp points */
-    double cx = 0.0;
-    double cy = 0.0;
-    for (int i = 0; i < 3; i++)
-        if (grasp[i]) {
-            cx += tip[3 * i];
-            cy += tip[3 * i + 1];
-        }
-    cx /= k;
-    cy /= k;
-    /* w = G push, and G G^T = [[k, 0, a], [0, k, b], [a, b, s]] */
-    double w0 = 0.0, w1 = 0.0, w2 = 0.0;
-    double a = 0.0, b = 0.0, s = 0.0;
-    for (int i = 0; i < 3; i++)
-        if (grasp[i]) {
-            double rx = tip[3 * i] - cx;
-            double ry = tip[3 * i + 1] - cy;
-            w0 += push[i][0];
-            w1 += push[i][1];
-            w2 += rx * push[i][1] - ry * push[i][0];
-            a -= ry;
-            b += rx;
-            s += rx * rx + ry * ry;
-        }
-    double fk = (double)k;
-    double schur = s - (a * a + b * b) / fk;
-    /* all points coinciding leave the moment row empty: pinv drops it */
-    double x2 = schur > PINV_RCOND_SQUARED * hh_max(fk, s) ? (w2 - (a * w0 + b * w1) / fk) / schur : 0.0;
-    double x0 = (w0 - a * x2) / fk;
-    double x1 = (w1 - b * x2) / fk;
-    /* internal = push - G^T x; the centroid squeeze instead if a finger would not push */
+    hh_project_internal(k, points[0], push[0], internal[0]);
+    /* the centroid squeeze instead if a finger would not push */
     int pushing = 1;
-    for (int i = 0; i < 3; i++)
-        if (grasp[i]) {
-            double rx = tip[3 * i] - cx;
-            double ry = tip[3 * i + 1] - cy;
-            g[i][0] = push[i][0] - (x0 - ry * x2);
-            g[i][1] = push[i][1] - (x1 + rx * x2);
-            if (g[i][0] * push[i][0] + g[i][1] * push[i][1] <= 0.0)
-                pushing = 0;
-        }
-    if (!pushing && centroid_squeeze(params, tip, grasp, cx, cy, g) != HH_REFLEX_OK)
+    for (int j = 0; j < k; j++)
+        if (internal[j][0] * push[j][0] + internal[j][1] * push[j][1] <= 0.0)
+            pushing = 0;
+    if (!pushing &&
+        hh_centroid_squeeze(k, points[0], params[HH_REFLEX_P_COINCIDENT_RTOL], internal[0]) != HH_REFLEX_OK)
         return HH_REFLEX_COINCIDENT;
+    for (int j = 0; j < k; j++) {
+        g[finger[j]][0] = internal[j][0];
+        g[finger[j]][1] = internal[j][1];
+    }
     double longest = 0.0;
     for (int i = 0; i < 3; i++)
         longest = hh_max(longest, sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]));

@@ -1,14 +1,17 @@
-/* The controllers' laws (control.h) for Python: one native call per output or update.
+/* The controllers' laws (control.h) for Python: the blocks' calls (one per output or
+ * update) and the pieces the Python API of hierhand.control is made of.
  *
- * Arguments are the block's packed parameters, its inputs and an output array, all
- * float64 buffers the caller allocates; a Model (Hand.native) gives the finger geometry.
+ * Arguments are packed parameters, inputs and output arrays, all float64 buffers the
+ * caller allocates; a Model (Hand.native) or a finger geometry gives the finger geometry.
  * A buffer that is not C-contiguous float64 is a TypeError (the Python side then
- * converts it), one of the wrong length a ValueError. The laws' status codes become
- * ValueErrors with the messages the blocks have always raised, except the manipulation
- * output's, which it returns (the block then names the finger and the target).
+ * converts it), one of the wrong length a ValueError naming the argument. The laws'
+ * status codes become ValueErrors with the messages the blocks have always raised,
+ * except reachability, which is returned (the Python side then raises UnreachableError
+ * naming the finger and the distance).
  */
 #include "py_common.h"
 
+#include <limits.h>
 #include <math.h>
 
 #include "../control.h"
@@ -157,6 +160,58 @@ static PyObject *py_reflex_update(PyObject *module, PyObject *const *args, Py_ss
     return result;
 }
 
+/* points (k x 2, k >= 1) and a second buffer of as many values. */
+static int points_and(held_buffers *h, PyObject *points, PyObject *other, int writable, const char *what,
+                      const double **p, double **o, int *k)
+{
+    if ((*p = hh_py_hold(h, points, -1, 0, "points")) == NULL)
+        return -1;
+    Py_ssize_t n = hh_py_last_count(h);
+    if (n == 0 || n % 2 != 0 || n / 2 > INT_MAX) {
+        PyErr_Format(PyExc_ValueError, "points must hold k x 2 values (k >= 1), got %zd values", n);
+        return -1;
+    }
+    *k = (int)(n / 2);
+    return (*o = hh_py_hold(h, other, n, writable, what)) == NULL ? -1 : 0;
+}
+
+static PyObject *py_project_internal(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    held_buffers h = {.held = 0};
+    const double *points;
+    double *f, *out;
+    int k;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 3, "project_internal") != 0)
+        return NULL;
+    if (points_and(&h, args[0], args[1], 0, "f", &points, &f, &k) == 0 &&
+        (out = hh_py_hold(&h, args[2], 2 * (Py_ssize_t)k, 1, "out")) != NULL) {
+        hh_project_internal(k, points, f, out);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
+static PyObject *py_centroid_squeeze(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    held_buffers h = {.held = 0};
+    const double *points;
+    double *g, rtol;
+    int k;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 3, "centroid_squeeze") != 0 || hh_py_double(args[1], &rtol, "coincident_rtol") != 0)
+        return NULL;
+    if (points_and(&h, args[0], args[2], 1, "g", &points, &g, &k) == 0) {
+        int code = hh_centroid_squeeze(k, points, rtol, g);
+        result = code == HH_REFLEX_OK ? Py_NewRef(Py_None) : reflex_error(code);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
 /* -- manipulation PD ------------------------------------------------------------------------ */
 
 /* waypoints (3 x capacity x 4) and meta (3 x 2), checked: counts whole numbers within the
@@ -191,50 +246,123 @@ static int manip_trajectories(held_buffers *h, PyObject *waypoints, PyObject *me
     return 0;
 }
 
-/* waypoints, meta, finger, t of the trajectory queries; the finger must have waypoints. */
-static int trajectory_query(held_buffers *h, PyObject *const *args, hh_trajectories *tr, int *finger, double *t)
+/* One trajectory: waypoints (n x 4, n >= 1) and its interpolation (MANIP_INTERP_*). */
+static int one_trajectory(held_buffers *h, PyObject *waypoints, PyObject *interpolation, hh_trajectory *tr)
 {
-    if (hh_py_finger(args[2], finger) != 0 || hh_py_double(args[3], t, "t") != 0 ||
-        manip_trajectories(h, args[0], args[1], tr) != 0)
+    if ((tr->waypoints = hh_py_hold(h, waypoints, -1, 0, "waypoints")) == NULL)
         return -1;
-    if (tr->meta[*finger * HH_MANIP_N_META + HH_MANIP_M_COUNT] == 0.0) {
-        PyErr_Format(PyExc_ValueError, "finger %d has no trajectory", *finger);
+    Py_ssize_t values = hh_py_last_count(h);
+    if (values == 0 || values % HH_MANIP_W_COLS != 0) {
+        PyErr_Format(PyExc_ValueError, "waypoints must hold n x 4 values (n >= 1), got %zd values", values);
         return -1;
     }
+    long interp = PyLong_AsLong(interpolation);
+    if (interp == -1 && PyErr_Occurred())
+        return -1;
+    if (interp != HH_MANIP_INTERP_LINEAR && interp != HH_MANIP_INTERP_MINJERK) {
+        PyErr_Format(PyExc_ValueError, "interpolation must be %d (linear) or %d (minjerk), got %ld",
+                     HH_MANIP_INTERP_LINEAR, HH_MANIP_INTERP_MINJERK, interp);
+        return -1;
+    }
+    tr->count = (long)(values / HH_MANIP_W_COLS);
+    tr->minimum_jerk = interp == HH_MANIP_INTERP_MINJERK;
     return 0;
 }
 
-static PyObject *py_trajectory_sample(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+/* waypoints, interpolation, t, out (3) of trajectory_sample and trajectory_velocity. */
+static PyObject *trajectory_query(PyObject *const *args, Py_ssize_t nargs, const char *name,
+                                  void (*query)(const hh_trajectory *, double, double[3]))
 {
-    (void)module;
     held_buffers h = {.held = 0};
-    hh_trajectories tr;
-    int f;
-    double t;
+    hh_trajectory tr;
+    double t, *out;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 4, "trajectory_sample") != 0)
+    if (hh_py_nargs(nargs, 4, name) != 0 || hh_py_double(args[2], &t, "t") != 0)
         return NULL;
-    if (trajectory_query(&h, args, &tr, &f, &t) == 0) {
-        double pose[3];
-        hh_trajectory_sample(&tr, f, t, pose);
-        result = Py_BuildValue("(ddd)", pose[0], pose[1], pose[2]);
+    if (one_trajectory(&h, args[0], args[1], &tr) == 0 && (out = hh_py_hold(&h, args[3], 3, 1, "out")) != NULL) {
+        query(&tr, t, out);
+        result = Py_NewRef(Py_None);
     }
     hh_py_release_all(&h);
     return result;
 }
 
-static PyObject *py_trajectory_moving(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+static PyObject *py_trajectory_sample(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    return trajectory_query(args, nargs, "trajectory_sample", hh_trajectory_sample);
+}
+
+static PyObject *py_trajectory_velocity(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    return trajectory_query(args, nargs, "trajectory_velocity", hh_trajectory_velocity);
+}
+
+/* A finger parameter row (hh_model.fingers[f]'s layout) from ``geometry``: 6 values,
+ * base x, base y, base angle and the three link lengths; what the kinematics do not read
+ * is zero. */
+static int finger_row(held_buffers *h, PyObject *geometry, double row[HH_N_FINGER_PARAMS])
+{
+    const double *g = hh_py_hold(h, geometry, 6, 0, "geometry");
+    if (g == NULL)
+        return -1;
+    for (int i = 0; i < HH_N_FINGER_PARAMS; i++)
+        row[i] = 0.0;
+    row[HH_F_BASE_X] = g[0];
+    row[HH_F_BASE_Y] = g[1];
+    row[HH_F_BASE_ANGLE] = g[2];
+    for (int i = 0; i < 3; i++)
+        row[HH_F_LINK0 + HH_F_LINK_STRIDE * i + HH_L_LENGTH] = g[3 + i];
+    return 0;
+}
+
+static PyObject *py_finger_fk(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
     held_buffers h = {.held = 0};
-    hh_trajectories tr;
-    int f;
-    double t;
+    double row[HH_N_FINGER_PARAMS], *pose;
+    const double *q;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 4, "trajectory_moving") != 0)
+    if (hh_py_nargs(nargs, 3, "finger_fk") != 0)
         return NULL;
-    if (trajectory_query(&h, args, &tr, &f, &t) == 0)
-        result = PyBool_FromLong(hh_trajectory_moving(&tr, f, t));
+    if (finger_row(&h, args[0], row) == 0 && (q = hh_py_hold(&h, args[1], 3, 0, "q")) != NULL &&
+        (pose = hh_py_hold(&h, args[2], 3, 1, "pose")) != NULL) {
+        hh_finger_fk(row, q, pose);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
+/* x, y, phi at args[0..2] of the inverse kinematics. */
+static int tip_target(PyObject *const *args, double *x, double *y, double *phi)
+{
+    return hh_py_double(args[0], x, "x") != 0 || hh_py_double(args[1], y, "y") != 0 ||
+                   hh_py_double(args[2], phi, "phi") != 0
+               ? -1
+               : 0;
+}
+
+static PyObject *py_finger_ik(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    held_buffers h = {.held = 0};
+    double row[HH_N_FINGER_PARAMS], reach_rtol, x, y, phi, *q, *reach;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 8, "finger_ik") != 0 || hh_py_double(args[1], &reach_rtol, "reach_rtol") != 0 ||
+        tip_target(args + 2, &x, &y, &phi) != 0)
+        return NULL;
+    long elbow = PyLong_AsLong(args[5]);
+    if (elbow == -1 && PyErr_Occurred())
+        return NULL;
+    if (elbow != 1 && elbow != -1) {
+        PyErr_Format(PyExc_ValueError, "elbow must be +1 or -1, got %ld", elbow);
+        return NULL;
+    }
+    if (finger_row(&h, args[0], row) == 0 && (q = hh_py_hold(&h, args[6], 3, 1, "q")) != NULL &&
+        (reach = hh_py_hold(&h, args[7], 3, 1, "reach")) != NULL)
+        result = PyBool_FromLong(hh_finger_ik(row, reach_rtol, x, y, phi, (int)elbow, q, reach));
     hh_py_release_all(&h);
     return result;
 }
@@ -242,18 +370,57 @@ static PyObject *py_trajectory_moving(PyObject *module, PyObject *const *args, P
 static PyObject *py_ik_near(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
 {
     (void)module;
+    held_buffers h = {.held = 0};
     ModelObject *model;
     int f;
-    double reach_rtol, x, y, phi, ref[3], q[3];
+    double reach_rtol, x, y, phi, *q, *reach;
+    const double *ref;
+    PyObject *result = NULL;
     if (hh_py_nargs(nargs, 9, "ik_near") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
         hh_py_finger(args[1], &f) != 0 || hh_py_double(args[2], &reach_rtol, "reach_rtol") != 0 ||
-        hh_py_double(args[3], &x, "x") != 0 || hh_py_double(args[4], &y, "y") != 0 ||
-        hh_py_double(args[5], &phi, "phi") != 0 || hh_py_double(args[6], &ref[0], "r0") != 0 ||
-        hh_py_double(args[7], &ref[1], "r1") != 0 || hh_py_double(args[8], &ref[2], "r2") != 0)
+        tip_target(args + 3, &x, &y, &phi) != 0)
         return NULL;
-    if (!hh_ik_near(model->model.fingers[f], reach_rtol, x, y, phi, ref, q))
-        return Py_BuildValue("(Oddd)", Py_False, 0.0, 0.0, 0.0);
-    return Py_BuildValue("(Oddd)", Py_True, q[0], q[1], q[2]);
+    if ((ref = hh_py_hold(&h, args[6], 3, 0, "ref")) != NULL && (q = hh_py_hold(&h, args[7], 3, 1, "q")) != NULL &&
+        (reach = hh_py_hold(&h, args[8], 3, 1, "reach")) != NULL)
+        result = PyBool_FromLong(hh_ik_near(model->model.fingers[f], reach_rtol, x, y, phi, ref, q, reach));
+    hh_py_release_all(&h);
+    return result;
+}
+
+/* a (n values) and out (as many): the elementwise functions. */
+static int elementwise(held_buffers *h, PyObject *a, const char *a_name, PyObject *out, const double **values,
+                       double **result, Py_ssize_t *n)
+{
+    if ((*values = hh_py_hold(h, a, -1, 0, a_name)) == NULL)
+        return -1;
+    *n = hh_py_last_count(h);
+    return (*result = hh_py_hold(h, out, *n, 1, "out")) == NULL ? -1 : 0;
+}
+
+/* fn of every value of args[0] (named what) into args[1]: the elementwise functions. */
+static PyObject *map_values(PyObject *const *args, Py_ssize_t nargs, const char *name, const char *what,
+                            double (*fn)(double))
+{
+    held_buffers h = {.held = 0};
+    const double *values;
+    double *out;
+    Py_ssize_t n;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 2, name) != 0)
+        return NULL;
+    if (elementwise(&h, args[0], what, args[1], &values, &out, &n) == 0) {
+        for (Py_ssize_t i = 0; i < n; i++)
+            out[i] = fn(values[i]);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
+static PyObject *py_wrap_angles(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    return map_values(args, nargs, "wrap_angles", "a", hh_wrap_angle);
 }
 
 static PyObject *py_manipulation_output(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
@@ -304,6 +471,61 @@ static PyObject *py_suppress(PyObject *module, PyObject *const *args, Py_ssize_t
     return result;
 }
 
+static PyObject *py_sigmoid(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    return map_values(args, nargs, "sigmoid", "x", hh_sigmoid);
+}
+
+static PyObject *py_suppress_joints(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    held_buffers h = {.held = 0};
+    const double *tau_g, *tau_m, *s_a, *s_b;
+    double *out;
+    Py_ssize_t n;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 6, "suppress_joints") != 0)
+        return NULL;
+    long mode = PyLong_AsLong(args[4]);
+    if (mode == -1 && PyErr_Occurred())
+        return NULL;
+    if (mode != HH_SUPPRESS_PASS && mode != HH_SUPPRESS_MAGNITUDE && mode != HH_SUPPRESS_SIGNED) {
+        PyErr_Format(PyExc_ValueError, "mode must be %d (pass), %d (magnitude) or %d (signed), got %ld",
+                     HH_SUPPRESS_PASS, HH_SUPPRESS_MAGNITUDE, HH_SUPPRESS_SIGNED, mode);
+        return NULL;
+    }
+    if (elementwise(&h, args[0], "tau_g", args[5], &tau_g, &out, &n) == 0 &&
+        (tau_m = hh_py_hold(&h, args[1], n, 0, "tau_m")) != NULL && (s_a = hh_py_hold(&h, args[2], n, 0, "S_a")) != NULL &&
+        (s_b = hh_py_hold(&h, args[3], n, 0, "S_b")) != NULL) {
+        for (Py_ssize_t i = 0; i < n; i++)
+            out[i] = hh_suppressed(tau_g[i], tau_m[i], s_a[i], s_b[i], (double)mode);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
+static PyObject *py_finger_shares(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    held_buffers h = {.held = 0};
+    const double *tau_g, *tau_g_eff, *tau_m;
+    double *share;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 4, "finger_shares") != 0)
+        return NULL;
+    if ((tau_g = hh_py_hold(&h, args[0], HH_JOINTS, 0, "tau_g")) != NULL &&
+        (tau_g_eff = hh_py_hold(&h, args[1], HH_JOINTS, 0, "tau_g_eff")) != NULL &&
+        (tau_m = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau_m")) != NULL &&
+        (share = hh_py_hold(&h, args[3], HH_FINGERS, 1, "share")) != NULL) {
+        hh_finger_shares(tau_g, tau_g_eff, tau_m, share);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
 /* -- the module's table and layout ------------------------------------------------------------ */
 
 #define FASTCALL(function) (PyCFunction)(void (*)(void))(function), METH_FASTCALL
@@ -320,18 +542,39 @@ PyMethodDef hh_py_control_methods[] = {
      "into out (REFLEX_N_OUT)."},
     {"reflex_update", FASTCALL(py_reflex_update),
      "reflex_update(params, state, tip, normal, fn, ft, share, next): the next state (4) into next."},
+    {"project_internal", FASTCALL(py_project_internal),
+     "project_internal(points, f, out): the internal part (I - G^+ G) f of the forces f (k x 2) at the points "
+     "(k x 2) into out (k x 2)."},
+    {"centroid_squeeze", FASTCALL(py_centroid_squeeze),
+     "centroid_squeeze(points, coincident_rtol, g): the squeeze toward the centroid of the points (k x 2), "
+     "longest row 1, into g (k x 2); ValueError when the points coincide."},
+    {"wrap_angles", FASTCALL(py_wrap_angles), "wrap_angles(a, out): every angle of a wrapped to (-pi, pi] into out."},
+    {"finger_fk", FASTCALL(py_finger_fk),
+     "finger_fk(geometry, q, pose): tip centre x, y and link-3 angle (pose, 3) of a finger (geometry: base x, "
+     "base y, base angle, link lengths 1-3) at joint angles q (3)."},
+    {"finger_ik", FASTCALL(py_finger_ik),
+     "finger_ik(geometry, reach_rtol, x, y, phi, elbow, q, reach) -> reachable: joint angles (q, 3) of the elbow "
+     "branch (+1 or -1) for a tip target; reach (3) gets the wrist distance and the reachable range."},
     {"ik_near", FASTCALL(py_ik_near),
-     "ik_near(model, finger, reach_rtol, x, y, phi, r0, r1, r2) -> (reachable, q1, q2, q3): the finger's joint "
-     "angles for a tip target, on the elbow branch nearest the reference, each angle nearest it."},
+     "ik_near(model, finger, reach_rtol, x, y, phi, ref, q, reach) -> reachable: the finger's joint angles (q, 3) "
+     "for a tip target, on the elbow branch nearest ref (3), each angle nearest it; reach as finger_ik."},
     {"trajectory_sample", FASTCALL(py_trajectory_sample),
-     "trajectory_sample(waypoints, meta, finger, t) -> (x, y, phi): the finger's trajectory at time t."},
-    {"trajectory_moving", FASTCALL(py_trajectory_moving),
-     "trajectory_moving(waypoints, meta, finger, t) -> bool: whether its velocity at t is non-zero."},
+     "trajectory_sample(waypoints, interpolation, t, pose): the pose (x, y, phi) at time t of the trajectory "
+     "through waypoints (n x 4: t, x, y, phi)."},
+    {"trajectory_velocity", FASTCALL(py_trajectory_velocity),
+     "trajectory_velocity(waypoints, interpolation, t, velocity): its time derivative at t."},
     {"manipulation_output", FASTCALL(py_manipulation_output),
      "manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, out) -> status: rows tau_m, tau_ff, "
      "q_ref into out (3x9); MANIP_OK, or MANIP_UNREACHABLE + f when a target of finger f is out of reach."},
     {"suppress", FASTCALL(py_suppress),
-     "suppress(params, tau_g, tau_m, tau_ff, out): tau (9) and tau_g_eff (9) into out (SUPPRESS_N_OUT)."},
+     "suppress(params, tau_g, tau_m, tau_ff, out): tau (9), tau_g_eff (9) and share (3) into out (SUPPRESS_N_OUT)."},
+    {"sigmoid", FASTCALL(py_sigmoid), "sigmoid(x, out): the logistic function of every value of x into out."},
+    {"suppress_joints", FASTCALL(py_suppress_joints),
+     "suppress_joints(tau_g, tau_m, S_a, S_b, mode, out): the suppressed grasping torque of n joints (n values "
+     "each) into out, mode SUPPRESS_PASS, _MAGNITUDE or _SIGNED."},
+    {"finger_shares", FASTCALL(py_finger_shares),
+     "finger_shares(tau_g, tau_g_eff, tau_m, share): per finger (3) the share of its grasping torque its command "
+     "keeps."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -17,6 +17,8 @@ from hierhand.control import (
     required_scale_from_sensors,
 )
 
+from . import oracles
+
 coord = st.floats(-0.1, 0.1, allow_nan=False)
 point = st.tuples(coord, coord)
 angle = st.floats(-math.pi, math.pi, allow_nan=False)
@@ -183,6 +185,28 @@ def test_projection_removes_the_wrench_and_is_idempotent(k, data, center):
     if k == 2:
         e = internal_directions(p).ravel()
         np.testing.assert_allclose(pf, (pf @ e) / (e @ e) * e, atol=1e-9)
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 5])
+def test_projection_and_squeeze_match_the_oracle(k):
+    """The closed-form solve against numpy.linalg.pinv, and the centroid squeeze, on random
+    grasps, collinear ones and points a nanometre apart included."""
+    rng = np.random.default_rng(100 + k)
+    for trial in range(500):
+        p = rng.uniform(-0.1, 0.1, (k, 2))
+        if trial % 5 == 1:  # collinear
+            p = p[0] + np.outer(rng.uniform(-0.05, 0.05, k), unit(rng.uniform(-math.pi, math.pi)))
+        elif trial % 5 == 2:  # within a nanometre of each other
+            p = p[0] + rng.normal(0.0, 1e-9, (k, 2))
+        f = rng.normal(0.0, 5.0, 2 * k)
+        # both are round-off of the forces times the conditioning, size over spread of the points
+        spread = float(np.max(np.abs(p - p.mean(axis=0)))) if k > 1 else math.inf  # one contact: no moment arm
+        atol = 1e-13 * np.max(np.abs(f)) * max(1.0, float(np.max(np.abs(p))) / spread)
+        np.testing.assert_allclose(project_internal(p, rng.uniform(-0.1, 0.1, 2), f), oracles.project_internal(p, f),
+                                   rtol=0, atol=atol)
+        if k >= 2 and trial % 5 != 2:
+            np.testing.assert_allclose(internal_directions(p), oracles.internal_directions(p), rtol=0, atol=1e-14)
+    assert project_internal(np.zeros((0, 2)), [0.0, 0.0], np.zeros(0)).shape == (0,)
 
 
 def test_projection_rejects_a_wrong_force_length():

@@ -9,8 +9,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from hierhand.control import UnreachableError, finger_fk, finger_ik, hand_ik, wrap_angle
+from hierhand.control import UnreachableError, finger_fk, finger_ik, finger_ik_near, hand_ik, wrap_angle
 from hierhand.model import Hand
+
+from . import oracles
 
 angle = st.floats(-math.pi, math.pi, allow_nan=False)
 length = st.floats(0.005, 0.06)
@@ -206,3 +208,43 @@ def test_hand_ik_names_the_finger_that_cannot_reach(hand):
 def test_hand_ik_checks_shapes(hand, targets, q_ref, message):
     with pytest.raises(ValueError, match=message):
         hand_ik(hand, targets, q_ref)
+
+
+# -- against the oracle ------------------------------------------------------------------
+
+
+def test_wrap_angle_matches_the_oracle_to_the_bit():
+    a = np.concatenate([np.random.default_rng(1).uniform(-50, 50, 10000), [math.pi, -math.pi, -1e-300, 0.0, -0.0]])
+    np.testing.assert_array_equal(wrap_angle(a), oracles.wrap_angle(a))
+
+
+def test_finger_kinematics_match_the_oracle():
+    """Round-off apart: the oracle sums the links with numpy, walks the wrist distance with
+    math.hypot (not libm's) and the angles with numpy's cumulative sum."""
+    rng = np.random.default_rng(2)
+    for _ in range(3000):
+        base, base_angle = rng.uniform(-0.1, 0.1, 2), rng.uniform(-math.pi, math.pi)
+        lengths, q = rng.uniform(0.005, 0.06, 3), rng.uniform(-math.pi, math.pi, 3)
+        target = finger_fk(base, base_angle, lengths, q)
+        np.testing.assert_allclose(target, oracles.finger_fk(base, base_angle, lengths, q), rtol=0, atol=1e-14)
+        for elbow in (1, -1):
+            np.testing.assert_allclose(finger_ik(base, base_angle, lengths, *target, elbow=elbow),
+                                       oracles.finger_ik(base, base_angle, lengths, *target, elbow=elbow),
+                                       rtol=0, atol=1e-9)
+
+
+def test_finger_ik_near_matches_the_oracle(hand):
+    rng = np.random.default_rng(3)
+    for _ in range(3000):
+        f = int(rng.integers(3))
+        q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 0.8, 3)
+        ref_q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 1.5, 3)
+        target = hand.tip_poses(np.tile(q, 3))[f]
+        np.testing.assert_allclose(finger_ik_near(hand, f, target, ref_q), oracles.finger_ik_near(hand, f, target, ref_q),
+                                   rtol=0, atol=1e-9)
+
+
+def test_finger_ik_near_names_the_finger_and_the_distance(hand):
+    with pytest.raises(UnreachableError, match="^middle: ") as info:
+        finger_ik_near(hand, 2, (1.0, 1.0, 0.0), hand.q0[6:])
+    assert info.value.distance > info.value.r_max

@@ -1,4 +1,5 @@
-"""The native (C) fast paths of ManipulationPD and Suppresser against their numpy references."""
+"""The compiled output of ManipulationPD against its numpy oracle, and how the blocks'
+native calls take their arguments."""
 
 from __future__ import annotations
 
@@ -7,31 +8,24 @@ import math
 import numpy as np
 import pytest
 
-from hierhand.control.inverse_kinematics import (
-    UnreachableError,
-    finger_fk,
-    finger_ik_near,
-)
-from hierhand.control import reflex_kernel
+from hierhand import _native
+from hierhand.control import UnreachableError, manipulation_pd, reflex_kernel, suppresser
 from hierhand.control.grasp_reflex import GraspReflex
 from hierhand.control.manipulation_kernel import (
-    INTERP_LINEAR,
     M_COUNT,
     M_INTERP,
     N_OUT,
     OK,
     UNREACHABLE,
-    ik_near,
     manipulation_output,
-    moving,
     pack_trajectories,
-    sample,
 )
 from hierhand.control.manipulation_pd import ManipulationPD
 from hierhand.control.suppresser import Suppresser
-from hierhand.control.suppression import suppress
-from hierhand.control.trajectory import Trajectory
+from hierhand.control.trajectory import INTERPOLATIONS, Trajectory
 from hierhand.model import Hand, HandPlant
+
+from . import oracles
 
 REGRASP = {
     "middle": {"waypoints": [[0.15, 0.04798, 0.07000, 2.6], [0.35, 0.0328, 0.040, 3.0]]},
@@ -61,20 +55,21 @@ def _times(trajectories):
 
 @pytest.mark.parametrize("trajectories", [REGRASP, MANIPULATE, THREE_SEGMENTS, {}])
 @pytest.mark.parametrize("flags", [(True, True), (False, True), (True, False), (False, False)])
-def test_compiled_output_matches_the_numpy_reference(trajectories, flags):
+def test_compiled_output_matches_the_oracle(trajectories, flags):
     hand = Hand.default()
     pd = ManipulationPD(hand=hand, kp=[1.0, 2.0, 0.5] * 3, kd=0.015, trajectories=trajectories,
                         gravity_compensation=flags[0], load_compensation=flags[1])
     rng = np.random.default_rng(7)
     for t in _times(trajectories):
         inputs = {"q": hand.q0 + rng.normal(0.0, 0.1, 9), "qd": rng.normal(0.0, 1.0, 9),
-                  "fn": rng.choice([0.0, 0.04, 0.06, 2.0], 3)}
+                  "fn": rng.choice([0.0, 0.04, 0.06, 2.0], 3), "support": rng.normal(0.0, 1.0, 3)}
         fast = pd.output(float(t), None, inputs)
-        ref = pd.output_reference(float(t), None, inputs)
-        assert set(fast) == set(ref) == set(pd.outputs)
-        for port in ref:
+        expected = oracles.manipulation_output(pd, float(t), inputs)
+        assert set(fast) == set(expected) == set(pd.outputs)
+        for port in expected:
             assert fast[port].shape == (9,) and fast[port].dtype == np.float64
-            np.testing.assert_allclose(fast[port], ref[port], rtol=1e-11, atol=1e-13, err_msg=f"{port} at t={t}")
+            np.testing.assert_allclose(fast[port], expected[port], rtol=1e-11, atol=1e-13,
+                                       err_msg=f"{port} at t={t}")
 
 
 def test_outputs_are_fresh_arrays():
@@ -89,16 +84,18 @@ def test_outputs_are_fresh_arrays():
         assert not np.shares_memory(a[k], pd._params)
 
 
-def test_unusual_inputs_take_the_reference_path():
+def test_unusual_inputs_are_converted():
     hand = Hand.default()
     pd = ManipulationPD(hand=hand, trajectories=REGRASP)
     ref = pd.output(0.25, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)})
     listed = pd.output(0.25, None, {"q": list(hand.q0), "qd": [0] * 9, "fn": np.zeros(3, dtype=np.float32)})
     for k in ref:
-        np.testing.assert_allclose(listed[k], ref[k], rtol=1e-12, atol=1e-15)
+        np.testing.assert_array_equal(listed[k], ref[k])
     integer_time = pd.output(0, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)})
     np.testing.assert_array_equal(integer_time["q_ref"], pd.output(0.0, None, {"q": hand.q0, "qd": np.zeros(9),
                                                                              "fn": np.zeros(3)})["q_ref"])
+    with pytest.raises(ValueError, match="^qd must hold 9 values, got 8$"):
+        pd.output(0.25, None, {"q": hand.q0, "qd": np.zeros(8), "fn": np.zeros(3)})
 
 
 def test_a_target_unreachable_between_waypoints_raises_naming_the_finger():
@@ -111,65 +108,6 @@ def test_a_target_unreachable_between_waypoints_raises_naming_the_finger():
     pd.output(0.1, None, inputs)
     with pytest.raises(UnreachableError, match="fore: unreachable fingertip target"):
         pd.output(0.5, None, inputs)
-
-
-def test_ik_near_matches_finger_ik_near():
-    hand = Hand.default()
-    rng = np.random.default_rng(3)
-    for _ in range(3000):
-        f = int(rng.integers(3))
-        q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 0.8, 3)
-        ref_q = hand.q0[3 * f:3 * f + 3] + rng.normal(0.0, 1.5, 3)
-        p = hand.params.fingers[f]
-        target = finger_fk(p.base, p.base_angle, [link.length for link in p.links], q)
-        ok, *got = ik_near(hand.native, f, *target, *ref_q)
-        assert ok
-        np.testing.assert_allclose(got, finger_ik_near(hand, f, target, ref_q), rtol=1e-12, atol=1e-12)
-    ok, *_ = ik_near(hand.native, 1, 1.0, 1.0, 0.0, *hand.q0[3:6])
-    assert not ok
-
-
-@pytest.mark.parametrize("interpolation", ["minjerk", "linear"])
-def test_trajectory_sampling_matches_trajectory(interpolation):
-    wp = [[0.1, 0.0, 1.0, 2.0], [0.3, 0.5, 1.0, 2.5], [0.35, 0.5, 1.0, 2.5], [0.9, -0.5, 2.0, 3.0]]
-    traj = Trajectory(wp, interpolation)
-    waypoints, meta = pack_trajectories([None, traj, Trajectory([[0.2, 1.0, 2.0, 3.0]])])
-    ts = list(np.linspace(0.0, 1.0, 1001)) + [w[0] for w in wp] + [np.nextafter(w[0], 0.0) for w in wp]
-    for t in ts:
-        assert sample(waypoints, meta, 1, t) == tuple(traj.sample(t)), t
-        assert moving(waypoints, meta, 1, t) == bool(np.any(traj.velocity(t))), t
-        assert sample(waypoints, meta, 2, t) == (1.0, 2.0, 3.0)
-        assert not moving(waypoints, meta, 2, t)
-
-
-@pytest.mark.parametrize("mode", ["magnitude", "signed"])
-@pytest.mark.parametrize("enabled", [True, False])
-def test_suppresser_kernel_matches_suppress(mode, enabled):
-    s = Suppresser(S_a=[200.0, 0.0, 50.0] * 3, S_b=[0.1, 0.2, 0.0] * 3, mode=mode, enabled=enabled)
-    rng = np.random.default_rng(5)
-    for scale in (1e-3, 0.1, 1.0, 1e3):
-        for _ in range(200):
-            inputs = {"tau_g": rng.normal(0.0, scale, 9), "tau_m": rng.normal(0.0, scale, 9)}
-            fast = s.output(0.0, None, inputs)
-            ref = s.output_reference(0.0, None, inputs)
-            if enabled:
-                np.testing.assert_allclose(ref["tau_g_eff"], suppress(inputs["tau_g"], inputs["tau_m"], s.S_a, s.S_b, mode))
-            for port in ("tau", "tau_g_eff"):
-                assert fast[port].shape == (9,) and fast[port].dtype == np.float64
-                np.testing.assert_allclose(fast[port], ref[port], rtol=1e-14, atol=1e-300)
-
-
-def test_suppresser_edge_values_and_unusual_inputs():
-    s = Suppresser(S_a=200.0, S_b=0.1)
-    tau_g = np.array([1.0, -2.0, 3.0, np.nan, 1.0, 1.0, 1e308, 0.0, 1.0])
-    tau_m = np.array([0.1, 1e300, -1e300, 0.0, np.inf, np.nan, 0.0, 5.0, -0.1])
-    fast = s.output(0.0, None, {"tau_g": tau_g, "tau_m": tau_m})
-    with np.errstate(all="ignore"):
-        ref = s.output_reference(0.0, None, {"tau_g": tau_g, "tau_m": tau_m})
-    for port in ref:
-        np.testing.assert_allclose(fast[port], ref[port], rtol=1e-14)
-    listed = s.output(0.0, None, {"tau_g": [0.3] * 9, "tau_m": np.zeros(9, dtype=np.float32)})
-    np.testing.assert_allclose(listed["tau_g_eff"], 0.3 / (1 + math.exp(-20.0)), rtol=1e-14)
 
 
 def test_unbound_plant_is_rejected_by_every_entry_point():
@@ -185,21 +123,20 @@ def test_unbound_plant_is_rejected_by_every_entry_point():
 def test_float64_arrays_with_a_distinct_dtype_object_take_the_native_path(monkeypatch):
     """Any C-contiguous float64 array goes straight to the native call, also one whose
     dtype object is equal but not identical to numpy's float64 (as arrays from other
-    libraries carry); nothing is converted and no reference path is taken."""
+    libraries carry); nothing is converted."""
     dtype = np.dtype(np.float64).newbyteorder("=")
     assert dtype == np.float64 and dtype is not np.dtype(np.float64)
     hand = Hand.default()
 
     def refuse(*args, **kwargs):
-        raise AssertionError("conversion or reference path taken")
+        raise AssertionError("conversion taken")
 
+    for module in (manipulation_pd, suppresser, reflex_kernel):
+        monkeypatch.setattr(module, "flat_float64", refuse)
     pd = ManipulationPD(hand=hand, trajectories=REGRASP)
     s = Suppresser()
     reflex = GraspReflex(hand=hand)
     reflex.bind(0.001)
-    monkeypatch.setattr(pd, "output_reference", refuse)
-    monkeypatch.setattr(s, "output_reference", refuse)
-    monkeypatch.setattr(reflex_kernel, "_f64", refuse)
     pd.output(0.2, None, {"q": hand.q0.astype(dtype), "qd": np.zeros(9, dtype), "fn": np.zeros(3, dtype)})
     s.output(0.0, None, {"tau_g": np.ones(9, dtype), "tau_m": np.zeros(9, dtype)})
     reflex_inputs = {"q": hand.q0.astype(dtype), "tip": hand.tip_poses(hand.q0).ravel().astype(dtype),
@@ -215,7 +152,7 @@ def test_float64_arrays_with_a_distinct_dtype_object_take_the_native_path(monkey
     plant.advance(0.0, state, {"tau": np.zeros(9, dtype), "f_ext": np.zeros(3, dtype)}, 2)
 
 
-def test_other_arrays_are_converted_or_take_the_reference_path():
+def test_other_arrays_are_converted():
     """Strided views, other dtypes and lists give what their float64 copies give."""
     hand = Hand.default()
     pd = ManipulationPD(hand=hand, trajectories=REGRASP)
@@ -229,11 +166,11 @@ def test_other_arrays_are_converted_or_take_the_reference_path():
     strided = {"q": np.column_stack([q, q])[:, 0], "qd": wide[:, 1], "fn": np.array([0, 2, 2])}
     assert not strided["q"].flags.c_contiguous
     for port, value in pd.output(0.2, None, strided).items():
-        np.testing.assert_allclose(value, pd.output(0.2, None, manip)[port], rtol=1e-12, atol=1e-15)
+        np.testing.assert_array_equal(value, pd.output(0.2, None, manip)[port])
     torques = {"tau_g": wide[:, 0], "tau_m": wide[:, 1].astype(np.float32)}
     expected = s.output(0.0, None, {k: np.array(v, dtype=float) for k, v in torques.items()})
     for port, value in s.output(0.0, None, torques).items():
-        np.testing.assert_allclose(value, expected[port], rtol=1e-14)
+        np.testing.assert_array_equal(value, expected[port])
     tip = hand.tip_poses(q)
     normal = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0]])
     exact = {"q": q, "tip": tip.ravel(), "normal": normal.ravel(), "fn": np.array([1.0, 1.0, 0.0]),
@@ -248,7 +185,7 @@ def test_other_arrays_are_converted_or_take_the_reference_path():
 
 def test_native_output_reports_the_unreachable_finger():
     """The status names the finger (UNREACHABLE + f) whose target, or a neighbour a
-    derivative step away, is out of reach; ``output`` then raises from the reference."""
+    derivative step away, is out of reach; ``output`` then raises naming it."""
     hand = Hand.default()
     pd = ManipulationPD(hand=hand, trajectories={"fore": {"waypoints": [[0.0, 0.035, 0.062, math.pi / 2],
                                                                         [1.0, 0.035, -0.038, math.pi / 2]]}})
@@ -258,25 +195,56 @@ def test_native_output_reports_the_unreachable_finger():
     assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.5, *inputs, out) == UNREACHABLE + 1
     with pytest.raises(ValueError, match="out must hold 27 values"):
         manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, np.empty(N_OUT - 1))
+    with pytest.raises(UnreachableError, match="^fore: unreachable"):
+        pd.output(0.5, None, dict(zip(("q", "qd", "fn", "support"), inputs)))
+
+
+def test_a_target_out_of_reach_only_a_derivative_step_ahead_is_named():
+    """The velocity target needs the poses a derivative step either side: one out of reach
+    there is the finger's error too, with the wrist's distance inside the inner radius."""
+    hand = Hand.default()
+    through_base = [[0.0, 0.035, 0.062, math.pi / 2], [1.0, 0.035, -0.038, math.pi / 2]]
+    pd = ManipulationPD(hand=hand, trajectories={"fore": {"waypoints": through_base}})
+    waypoints = np.array(through_base)
+
+    def reachable(t: float) -> bool:
+        target = oracles.trajectory_sample(waypoints, "minjerk", t)
+        return oracles.finger_ik_near(hand, 1, target, hand.q0[3:6]) is not None
+
+    lo, hi = 0.1, 0.5  # reachable, not: bisect to where the path leaves the annulus
+    for _ in range(60):
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if reachable(mid) else (lo, mid)
+    t = lo - 0.4e-3  # its own target reachable, the one a derivative step (1 ms) ahead not
+    assert reachable(t) and not reachable(t + 1e-3)
+    inputs = {"q": hand.q0, "qd": np.zeros(9), "fn": np.zeros(3)}
+    with pytest.raises(UnreachableError, match="^fore: unreachable") as info:
+        pd.output(t, None, inputs)
+    assert info.value.finger == "fore" and info.value.distance < info.value.r_min
 
 
 def test_trajectory_arrays_are_checked():
-    waypoints, meta = pack_trajectories([None, Trajectory([[0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 0.0, 0.0]]), None])
-    assert meta.dtype == np.float64 and meta[1, M_COUNT] == 2 and meta[1, M_INTERP] != INTERP_LINEAR
-    with pytest.raises(ValueError, match="finger 0 has no trajectory"):
-        sample(waypoints, meta, 0, 0.5)
-    with pytest.raises(ValueError, match="finger must be 0, 1 or 2"):
-        moving(waypoints, meta, 3, 0.5)
+    hand = Hand.default()
+    pd = ManipulationPD(hand=hand)
+    waypoints, meta = pack_trajectories([None, Trajectory([[0.0, 0.03, 0.06, 3.0], [1.0, 0.031, 0.06, 3.0]]), None])
+    assert meta.dtype == np.float64 and meta[1, M_COUNT] == 2 and meta[1, M_INTERP] == INTERPOLATIONS["minjerk"]
+    inputs = (hand.q0, np.zeros(9), np.zeros(3), np.zeros(3), np.empty((3, 9)))
+    assert manipulation_output(hand.native, pd._params, waypoints, meta, 0.5, *inputs) == OK
     for bad in (2.5, 3.0, -1.0, np.nan):
         wrong = meta.copy()
         wrong[1, M_COUNT] = bad
         with pytest.raises(ValueError, match="waypoint count"):
-            sample(waypoints, wrong, 1, 0.5)
+            manipulation_output(hand.native, pd._params, waypoints, wrong, 0.5, *inputs)
     wrong = meta.copy()
     wrong[1, M_INTERP] = 7
     with pytest.raises(ValueError, match="interpolation"):
-        moving(waypoints, wrong, 1, 0.5)
+        manipulation_output(hand.native, pd._params, waypoints, wrong, 0.5, *inputs)
     with pytest.raises(ValueError, match="3 x n x 4"):
-        sample(waypoints.ravel()[:-1].copy(), meta, 1, 0.5)
+        manipulation_output(hand.native, pd._params, waypoints.ravel()[:-1].copy(), meta, 0.5, *inputs)
     with pytest.raises(TypeError, match="float64"):
-        sample(waypoints, meta.astype(np.int64), 1, 0.5)
+        manipulation_output(hand.native, pd._params, waypoints, meta.astype(np.int64), 0.5, *inputs)
+    pose = np.empty(3)
+    with pytest.raises(ValueError, match="n x 4"):
+        _native.trajectory_sample(np.zeros(6), INTERPOLATIONS["linear"], 0.5, pose)
+    with pytest.raises(ValueError, match="interpolation"):
+        _native.trajectory_sample(np.zeros(4), 7, 0.5, pose)

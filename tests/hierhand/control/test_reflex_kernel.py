@@ -1,9 +1,9 @@
-"""The reflex's native (C) law against the numpy reference (``internal_forces``).
+"""The reflex's compiled law against its numpy oracle (``oracles.reflex_*``).
 
-``reference_*`` below are the reflex's numpy formulation (``project_internal`` with
-``numpy.linalg.pinv``, ``internal_directions`` as the fallback, ``Hand.tip_jacobians``);
-``GraspReflex`` must agree with them to round-off on random 2- and 3-contact grasps,
-approaching fingers and the fallback included.
+The oracle projects with ``numpy.linalg.pinv``, falls back to the centroid squeeze and
+maps forces through ``Hand.tip_jacobians``; ``GraspReflex`` must agree with it to
+round-off on random 2- and 3-contact grasps, approaching fingers and the fallback
+included.
 """
 
 from __future__ import annotations
@@ -12,7 +12,6 @@ import numpy as np
 import pytest
 
 from hierhand.control.grasp_reflex import GraspReflex
-from hierhand.control.internal_forces import internal_directions, project_internal
 from hierhand.control.reflex_kernel import (
     N_PARAMS,
     P_APPROACH,
@@ -32,60 +31,7 @@ from hierhand.control.reflex_kernel import (
 )
 from hierhand.model import Hand
 
-
-def reference_directions(reflex, state, tip, normal, fn):
-    grasp, touching = reflex.members(state, fn)
-    g = np.zeros((3, 2))
-    if grasp.sum() < 2:
-        return g, grasp, touching, False
-    points = tip.reshape(3, 3)[:, :2]
-    push = normal.reshape(3, 2).copy()
-    for i in np.flatnonzero(grasp & ~touching):
-        toward = points[grasp & (np.arange(3) != i)].mean(axis=0) - points[i]
-        push[i] = toward / max(np.linalg.norm(toward), 1e-12)
-    idx = np.flatnonzero(grasp)
-    internal = project_internal(points[idx], points[idx].mean(axis=0), push[idx].ravel()).reshape(-1, 2)
-    fallback = bool(np.any(np.einsum("ij,ij->i", internal, push[idx]) <= 0))
-    if fallback:
-        internal = internal_directions(points[idx])
-    g[idx] = internal / np.max(np.linalg.norm(internal, axis=1))
-    return g, grasp, touching, fallback
-
-
-def reference_forces(reflex, state, inputs):
-    g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], inputs["fn"])
-    length = np.linalg.norm(g, axis=1)
-    held_at = np.where(state[1:] > 0, np.minimum(state[0], state[1:]), state[0])  # handed over: at most then
-    scale = np.where(touching, held_at, reflex.approach_force / np.maximum(length, 1e-300))
-    return g * scale[:, None], grasp
-
-
-def reference_output(reflex, state, inputs):
-    f, grasp = reference_forces(reflex, state, inputs)
-    jac = reflex.hand.tip_jacobians(inputs["q"])
-    tau = np.concatenate([jac[i].T @ f[i] for i in range(3)])
-    return {"tau_g": tau, "force": np.linalg.norm(f, axis=1), "active": grasp.astype(float)}
-
-
-def reference_update(reflex, state, inputs):
-    fn, ft = inputs["fn"], inputs["ft"]
-    g, grasp, touching, _ = reference_directions(reflex, state, inputs["tip"], inputs["normal"], fn)
-    share = inputs.get("share", np.ones(3))
-    released = np.zeros(3, dtype=bool)
-    for i in np.argsort(share, kind="stable"):  # the least share first, while two others stay held
-        if grasp[i] and touching[i] and share[i] < reflex.release_share and (grasp & touching & ~released).sum() > 2:
-            released[i] = True
-    held = grasp & touching & ~released
-    scale = state[0]
-    if held.sum() >= 2:
-        normal = inputs["normal"].reshape(3, 2)[held]
-        gain = np.einsum("ij,ij->i", g[held], normal)
-        need = np.maximum(reflex.min_force * np.linalg.norm(g[held], axis=1),
-                          np.abs(ft[held]) / reflex.ratio_target)
-        shortfall = float(np.max((need - fn[held]) / np.maximum(gain, 1e-3)))
-        scale = min(max(scale + reflex.ki * reflex.dt * shortfall, 0.0), reflex.max_force)
-    first = np.where(state[1:] > 0, state[1:], max(state[0], np.finfo(float).tiny))
-    return np.concatenate(([scale], np.where(touching, np.where(released, first, 0.0), state[1:])))
+from . import oracles
 
 
 def make_reflex(grasp):
@@ -125,13 +71,13 @@ def random_case(rng, reflex, k, inward: bool):
 
 
 @pytest.mark.parametrize("k", [2, 3])
-def test_compiled_directions_forces_and_ports_match_the_numpy_reference(k):
+def test_compiled_directions_forces_and_ports_match_the_oracle(k):
     rng = np.random.default_rng(1234 + k)
     seen = {"fallback": 0, "projection": 0, "approaching": 0}
     for trial in range(600):
         reflex = make_reflex(["thumb", "fore", "middle"] if trial % 2 else ["thumb", "fore"])
         state, inputs = random_case(rng, reflex, k, inward=trial % 3 != 0)
-        g_ref, grasp_ref, touching_ref, fallback = reference_directions(
+        g_ref, grasp_ref, touching_ref, fallback = oracles.reflex_directions(
             reflex, state, inputs["tip"], inputs["normal"], inputs["fn"])
         g, grasp, touching = reflex.directions(state, inputs["tip"], inputs["normal"], inputs["fn"])
         assert grasp.tolist() == grasp_ref.tolist() and touching.tolist() == touching_ref.tolist()
@@ -140,19 +86,19 @@ def test_compiled_directions_forces_and_ports_match_the_numpy_reference(k):
             seen["fallback" if fallback else "projection"] += 1
             seen["approaching"] += int(np.any(grasp & ~touching))
 
-        f_ref, _ = reference_forces(reflex, state, inputs)
+        f_ref, _ = oracles.reflex_forces(reflex, state, inputs)
         f, grasp_f = reflex.forces(state, inputs)
         assert grasp_f.tolist() == grasp_ref.tolist()
         np.testing.assert_allclose(f, f_ref, rtol=1e-11, atol=1e-11 * max(1.0, state[0]))
 
-        out, out_ref = reflex.output(0.0, state, inputs), reference_output(reflex, state, inputs)
+        out, out_ref = reflex.output(0.0, state, inputs), oracles.reflex_output(reflex, state, inputs)
         assert set(out) == set(out_ref)
         for port, value in out_ref.items():
             assert out[port].shape == value.shape and out[port].dtype == np.float64
             np.testing.assert_allclose(out[port], value, rtol=1e-10, atol=1e-12 * max(1.0, state[0]))
 
         new = reflex.update(0.0, state.copy(), inputs)
-        np.testing.assert_allclose(new, reference_update(reflex, state, inputs), rtol=1e-10, atol=1e-12)
+        np.testing.assert_allclose(new, oracles.reflex_update(reflex, state, inputs), rtol=1e-10, atol=1e-12)
     assert min(seen.values()) > 10, seen  # every branch exercised
 
 
@@ -170,7 +116,7 @@ def test_the_projection_is_internal_and_nearest_to_the_pushes():
         assert abs(np.sum(r[:, 0] * g[:, 1] - r[:, 1] * g[:, 0])) < 1e-13
 
 
-def test_coincident_points_behave_as_the_reference():
+def test_coincident_points_behave_as_the_oracle():
     reflex = make_reflex(["thumb", "fore"])
     state = reflex.initial_state()
     tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
@@ -178,11 +124,11 @@ def test_coincident_points_behave_as_the_reference():
     # opposite normals: the pseudo-inverse drops the moment row, the pushes stay
     opposite = np.array([1.0, 0.0, -1.0, 0.0, 0.0, 0.0])
     g, _, _ = reflex.directions(state, tip, opposite, fn)
-    np.testing.assert_allclose(g, reference_directions(reflex, state, tip, opposite, fn)[0], atol=1e-15)
+    np.testing.assert_allclose(g, oracles.reflex_directions(reflex, state, tip, opposite, fn)[0], atol=1e-15)
     # equal normals: nothing internal is left (the SVD's pinv leaves round-off, which the
-    # reference then normalises) and no squeeze direction exists: the fallback's error
+    # oracle then normalises) and no squeeze direction exists: the fallback's error
     with pytest.raises(ValueError, match="all contact points coincide"):
-        internal_directions(tip.reshape(3, 3)[:2, :2])
+        oracles.internal_directions(tip.reshape(3, 3)[:2, :2])
     same = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="^internal forces are undefined: all contact points coincide$"):
         reflex.directions(state, tip, same, fn)
@@ -212,7 +158,7 @@ def test_kernel_takes_the_packed_parameters():
 
 
 def test_coincident_points_are_an_error_of_every_entry_point():
-    """The C law's status for coincident points becomes the reference's ValueError in
+    """The C law's status for coincident points becomes the oracle's ValueError in
     output and update too, not only in directions."""
     reflex = make_reflex(["thumb", "fore"])
     state = np.array([2.0, 1.0, 1.0, 0.0])

@@ -8,7 +8,9 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from hierhand.control import Trajectory
-from hierhand.control.trajectory import minjerk, minjerk_rate
+
+from . import oracles
+from .oracles import minjerk, minjerk_rate
 
 WAYPOINTS = [
     (0.1, 0.03, 0.06, 3.0),
@@ -50,11 +52,13 @@ def test_times_and_duration():
 
 
 def test_minjerk_profile_and_its_rate():
-    taus = np.linspace(0, 1, 11)
-    np.testing.assert_allclose([minjerk(x) for x in taus], 10 * taus**3 - 15 * taus**4 + 6 * taus**5, atol=1e-15)
-    assert minjerk(0.0) == 0.0 and minjerk(1.0) == 1.0 and minjerk(0.5) == 0.5
-    assert minjerk_rate(0.0) == 0.0 and minjerk_rate(1.0) == 0.0
-    assert minjerk_rate(0.5) == pytest.approx(1.875)
+    """On the unit segment from 0 to 1 the trajectory is the blend s(tau) itself."""
+    unit = Trajectory([(0.0, 0.0, 0.0, 0.0), (1.0, 1.0, 1.0, 1.0)])
+    for tau in np.linspace(0, 1, 11):
+        np.testing.assert_allclose(unit.sample(tau), 10 * tau**3 - 15 * tau**4 + 6 * tau**5, atol=1e-15)
+        np.testing.assert_allclose(unit.velocity(tau), 30 * tau**2 * (1 - tau) ** 2 if tau < 1 else 0.0, atol=1e-14)
+    assert unit.sample(0.5).tolist() == [0.5] * 3
+    assert unit.velocity(0.5) == pytest.approx([1.875] * 3)
 
 
 def test_minjerk_is_at_rest_at_every_waypoint():
@@ -151,3 +155,25 @@ def test_from_config():
         Trajectory.from_config({"waypoints": WAYPOINTS, "speed": 2})
     with pytest.raises(ValueError, match="needs waypoints"):
         Trajectory.from_config({"interpolation": "linear"})
+
+
+@pytest.mark.parametrize("mode", ["linear", "minjerk"])
+def test_samples_and_velocities_match_the_oracle(mode):
+    """To the bit, but for the minimum-jerk rate's (1 - tau)^2, which the oracle takes
+    with pow and the compiled law as a product."""
+    rng = np.random.default_rng(8)
+    for _ in range(200):
+        n = int(rng.integers(1, 6))
+        t = rng.uniform(-1.0, 1.0) + np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 1.0, n - 1))])
+        waypoints = np.column_stack([t, rng.uniform(-0.1, 0.1, (n, 2)), rng.uniform(-4.0, 4.0, n)])
+        traj = Trajectory(waypoints, mode)
+        for when in np.concatenate([rng.uniform(t[0] - 0.5, t[-1] + 0.5, 40), t, np.nextafter(t, -np.inf)]):
+            np.testing.assert_array_equal(traj.sample(when), oracles.trajectory_sample(waypoints, mode, when))
+            np.testing.assert_allclose(traj.velocity(when), oracles.trajectory_velocity(waypoints, mode, when),
+                                       rtol=1e-15, atol=0)
+
+
+@pytest.mark.parametrize("waypoints", [WAYPOINTS, WAYPOINTS[:1]])
+def test_a_nan_time_gives_nan(waypoints):
+    traj = Trajectory(waypoints)
+    assert np.all(np.isnan(traj.sample(float("nan")))) and np.all(np.isnan(traj.velocity(float("nan"))))

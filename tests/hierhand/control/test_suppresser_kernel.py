@@ -1,4 +1,5 @@
-"""The suppresser's gain: stable sigmoid, magnitude and signed modes, limits."""
+"""The suppresser's law: stable sigmoid, magnitude and signed modes, limits, shares; the
+compiled law against its numpy oracle."""
 
 from __future__ import annotations
 
@@ -10,7 +11,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from hierhand.control import sigmoid, suppress
+from hierhand.control import finger_shares, sigmoid, suppress
+from hierhand.control.suppresser import Suppresser
+
+from . import oracles
 
 finite = st.floats(-1e6, 1e6)
 
@@ -101,3 +105,57 @@ def test_bad_parameters_are_rejected(kwargs, message):
     args.update(kwargs)
     with pytest.raises(ValueError, match=message):
         suppress(**args)
+
+
+def test_suppress_matches_the_oracle_to_round_off():
+    """numpy's exp and libm's may differ in the last bit; nothing more."""
+    rng = np.random.default_rng(41)
+    for mode in ("magnitude", "signed"):
+        for scale in (1e-3, 0.1, 1.0, 1e3):
+            tau_g, tau_m = rng.normal(0.0, scale, (2, 500, 9))
+            s_a, s_b = rng.uniform(0.0, 500.0, 9), rng.uniform(-0.2, 0.3, 9)
+            np.testing.assert_allclose(suppress(tau_g, tau_m, s_a, s_b, mode),
+                                       oracles.suppress(tau_g, tau_m, s_a, s_b, mode), rtol=1e-15, atol=1e-300)
+    x = rng.normal(0.0, 50.0, 10000)
+    np.testing.assert_allclose(sigmoid(x), oracles.sigmoid(x), rtol=5e-16, atol=1e-300)
+
+
+def test_finger_shares_project_the_kept_torque_on_the_grasp_torque():
+    tau_g = np.array([1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0])
+    kept = np.array([0.5, 3.0, 0.0, 0.0, -1.0, 0.0, 1.0, 1.0, 1.0])  # the part across tau_g does not count
+    np.testing.assert_array_equal(finger_shares(tau_g, kept, np.zeros(9)), [0.5, -0.5, 1.0])
+    rng = np.random.default_rng(43)
+    for _ in range(200):
+        tau_g, tau_g_eff, tau_m = rng.normal(size=(3, 9))
+        np.testing.assert_allclose(finger_shares(tau_g, tau_g_eff, tau_m),
+                                   oracles.finger_shares(tau_g, tau_g_eff, tau_m), rtol=1e-14)
+
+
+@pytest.mark.parametrize("mode", ["magnitude", "signed"])
+@pytest.mark.parametrize("enabled", [True, False])
+def test_the_block_matches_the_oracle(mode, enabled):
+    s = Suppresser(S_a=[200.0, 0.0, 50.0] * 3, S_b=[0.1, 0.2, 0.0] * 3, mode=mode, enabled=enabled)
+    rng = np.random.default_rng(5)
+    for scale in (1e-3, 0.1, 1.0, 1e3):
+        for _ in range(200):
+            inputs = {"tau_g": rng.normal(0.0, scale, 9), "tau_m": rng.normal(0.0, scale, 9),
+                      "tau_ff": rng.normal(0.0, scale, 9)}
+            out, expected = s.output(0.0, None, inputs), oracles.suppresser_output(s, inputs)
+            for port in expected:
+                assert out[port].shape == expected[port].shape and out[port].dtype == np.float64
+                np.testing.assert_allclose(out[port], expected[port], rtol=1e-13, atol=1e-300)
+
+
+def test_the_block_at_edge_values_and_with_unusual_inputs():
+    s = Suppresser(S_a=200.0, S_b=0.1)
+    tau_g = np.array([1.0, -2.0, 3.0, np.nan, 1.0, 1.0, 1e308, 0.0, 1.0])
+    tau_m = np.array([0.1, 1e300, -1e300, 0.0, np.inf, np.nan, 0.0, 5.0, -0.1])
+    out = s.output(0.0, None, {"tau_g": tau_g, "tau_m": tau_m})
+    with np.errstate(all="ignore"):
+        expected = oracles.suppresser_output(s, {"tau_g": tau_g, "tau_m": tau_m})
+    for port in expected:
+        np.testing.assert_allclose(out[port], expected[port], rtol=1e-14)
+    listed = s.output(0.0, None, {"tau_g": [0.3] * 9, "tau_m": np.zeros(9, dtype=np.float32)})
+    np.testing.assert_allclose(listed["tau_g_eff"], 0.3 / (1 + math.exp(-20.0)), rtol=1e-14)
+    with pytest.raises(ValueError, match="^tau_m must hold 9 values, got 8$"):
+        s.output(0.0, None, {"tau_g": np.zeros(9), "tau_m": np.zeros(8)})

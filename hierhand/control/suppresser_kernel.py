@@ -1,0 +1,125 @@
+"""The suppresser's law, compiled: the manipulation torque turns the grasping torque down.
+
+``tau_g' = tau_g * sigmoid(S_a (S_b - g(tau_m)))``; the actuator command is then
+``tau_g' + tau_m``. Without it the grasping reflex fights a finger that manipulation wants
+to lift off (re-grasp), and both torques grow against each other.
+
+Two readings of ``g``:
+
+- ``"magnitude"`` (default), ``g = |tau_m|``: suppression grows with the size of the
+  manipulation torque, whichever its sign, as the paper's prose says.
+- ``"signed"``, ``g = tau_m``: the paper's literal formula; only positive ``tau_m``
+  suppresses, a large negative one passes ``tau_g`` through almost unchanged.
+
+``S_b`` is the manipulation torque at which ``tau_g`` is halved and ``S_a`` (>= 0) the
+steepness. Note that ``S_a = 0`` halves ``tau_g`` everywhere; "no suppression" is a large
+``S_a * S_b``, or bypassing the suppresser.
+
+The law is C (``hierhand/csrc/suppresser.c``): ``suppress_output`` is the ``Suppresser``
+block's one call per hit, and ``sigmoid``, ``suppress`` and ``finger_shares`` are the
+same functions for any number of joints, for users and tests. The parameter slots are
+defined once, in ``hierhand/csrc/control.h`` (``hierhand._native.LAYOUT``).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from .. import _native
+from .arrays import flat_float64
+
+__all__ = ["sigmoid", "suppress", "finger_shares", "MODES"]
+
+_L = _native.LAYOUT
+P_S_A: int = _L["SUPPRESS_P_S_A"]  # 9 sigmoid steepnesses
+P_S_B: int = _L["SUPPRESS_P_S_B"]  # 9 half-suppression torques
+P_MODE: int = _L["SUPPRESS_P_MODE"]  # PASS, MAGNITUDE or SIGNED
+N_PARAMS: int = _L["SUPPRESS_N_PARAMS"]
+PASS: int = _L["SUPPRESS_PASS"]
+MAGNITUDE: int = _L["SUPPRESS_MAGNITUDE"]
+SIGNED: int = _L["SUPPRESS_SIGNED"]
+O_TAU: int = _L["SUPPRESS_O_TAU"]
+O_TAU_G_EFF: int = _L["SUPPRESS_O_TAU_G_EFF"]
+O_SHARE: int = _L["SUPPRESS_O_SHARE"]
+N_OUT: int = _L["SUPPRESS_N_OUT"]
+
+MODES = {"magnitude": MAGNITUDE, "signed": SIGNED}
+"""The modes by name, with their codes in the packed parameters."""
+
+suppress_output = _native.suppress
+"""``suppress_output(params, tau_g, tau_m, tau_ff, out)``: over the 9 joints,
+``out[O_TAU_G_EFF:]`` = ``suppress(tau_g, tau_m, S_a, S_b)`` (``tau_g`` for mode ``PASS``),
+``out[O_TAU:]`` = that ``+ tau_m + tau_ff`` and ``out[O_SHARE:]`` = ``finger_shares``
+(ones for ``PASS``). Takes C-contiguous float64 arrays only (``TypeError`` otherwise)."""
+
+
+def mode_code(mode: str) -> int:
+    """The code of a mode name; ``ValueError`` for an unknown one."""
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {', '.join(MODES)}, got {mode!r}")
+    return MODES[mode]
+
+
+def check_steepness(S_a: Any) -> None:
+    """``ValueError`` unless every ``S_a`` is >= 0 (NaN included)."""
+    s_a = np.asarray(S_a, dtype=float)
+    if np.any(s_a < 0) or np.any(np.isnan(s_a)):
+        raise ValueError(f"S_a must be >= 0, got {S_a!r}")
+
+
+def pack_params(S_a: np.ndarray, S_b: np.ndarray, mode: int) -> np.ndarray:
+    """The ``params`` vector of ``suppress_output``: 9 values each of S_a and S_b, a mode."""
+    if mode not in (PASS, MAGNITUDE, SIGNED):
+        raise ValueError(f"mode must be PASS, MAGNITUDE or SIGNED ({PASS}, {MAGNITUDE}, {SIGNED}), got {mode!r}")
+    p = np.empty(N_PARAMS)
+    p[P_S_A:P_S_A + 9] = S_a
+    p[P_S_B:P_S_B + 9] = S_b
+    p[P_MODE] = mode
+    return p
+
+
+def _shaped(out: np.ndarray, shape: tuple[int, ...]) -> Any:
+    """``out`` in ``shape``: a float for a scalar."""
+    return float(out[0]) if shape == () else out.reshape(shape)
+
+
+def sigmoid(x: Any) -> Any:
+    """Logistic function ``1 / (1 + exp(-x))``, without overflow for large ``|x|``.
+
+    Scalars give a float, arrays an array of the same shape.
+    """
+    values = flat_float64(x)
+    out = np.empty_like(values)
+    _native.sigmoid(values, out)
+    return _shaped(out, np.shape(x))
+
+
+def suppress(tau_g: Any, tau_m: Any, S_a: Any, S_b: Any, mode: str = "magnitude") -> Any:
+    """Suppressed grasping torque ``tau_g * sigmoid(S_a * (S_b - g(tau_m)))``, elementwise.
+
+    ``S_a`` and ``S_b`` may be scalars or per-joint arrays (broadcast with the torques).
+    Raises ``ValueError`` for an unknown ``mode`` or a negative ``S_a``.
+    """
+    code = mode_code(mode)
+    check_steepness(S_a)
+    arrays = np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (tau_g, tau_m, S_a, S_b)))
+    shape = arrays[0].shape
+    flat = [flat_float64(a) for a in arrays]
+    out = np.empty(flat[0].size)
+    _native.suppress_joints(*flat, code, out)
+    return _shaped(out, shape)
+
+
+def finger_shares(tau_g: Any, tau_g_eff: Any, tau_m: Any) -> np.ndarray:
+    """Per finger (3), how much of its grasping torque survives in the voluntary part of its
+    command: ``(tau_g_eff_i + tau_m_i) . tau_g_i / |tau_g_i|^2``, 1 where ``tau_g_i`` is zero.
+
+    1 means the reflex's torque reaches the joints whole; below 1 the suppresser and the
+    manipulation torque are taking the finger over (0: cancelled, negative: pulled back).
+    The torques have 9 values each.
+    """
+    share = np.empty(3)
+    _native.finger_shares(flat_float64(tau_g), flat_float64(tau_g_eff), flat_float64(tau_m), share)
+    return share
