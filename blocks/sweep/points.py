@@ -43,7 +43,7 @@ def check_key(key: str, option: str) -> str:
 
 
 def parse_value(text: str, where: str) -> Any:
-    """One value read as YAML (as ``hierhand run --set`` does), '1e-3' included as a number."""
+    """One value read as YAML (as ``run --set`` does), '1e-3' included as a number."""
     try:
         value = yaml.safe_load(text) if text.strip() else None
     except yaml.YAMLError as exc:

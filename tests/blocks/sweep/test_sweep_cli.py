@@ -8,7 +8,6 @@ import csv
 import shutil
 import socket
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -76,6 +75,12 @@ def test_random_points_and_sweep_plot(tmp_path):
                  "-o", str(tmp_path / "h.png")]) == 0
     assert (tmp_path / "l.png").stat().st_size > 1000 and (tmp_path / "h.png").stat().st_size > 1000
     assert main(["sweep-plot", str(out), "--x", "prop.q", "--metric", "y", "-o", str(tmp_path / "x.png")]) == 2
+
+
+def test_sweep_plot_of_a_folder_without_a_sweep_names_the_command(tmp_path, capsys):
+    assert main(["sweep-plot", str(tmp_path), "--x", "a.b", "--metric", "m", "-o", str(tmp_path / "x.png")]) == 2
+    assert capsys.readouterr().err == (f"hierhand: error: {tmp_path}: no sweep.csv here; is this the -o folder of "
+                                       "'hierhand sweep'?\n")
 
 
 def test_points_file(tmp_path):
@@ -201,8 +206,17 @@ def test_a_point_that_kills_its_worker_fails_alone(tmp_path, monkeypatch, capfd)
 
 
 def test_a_point_that_fails_to_load_names_the_option_that_gave_it():
-    from hierhand.sweep.runner import SweepJob, run_point
+    from blocks.sweep.runner import SweepJob, run_point
 
     job = SweepJob(diagram=TOY, t_end="10 ms", origins=(("prop.k.x", "--grid prop.k.x=1,2"),))
     outcome = run_point(job, {"prop.k.x": 1})
     assert outcome.status == "failed" and outcome.error.startswith("--grid prop.k.x=1,2: 'prop.k' is a float")
+
+
+def test_the_start_method_variable_is_checked_before_anything_runs(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("HIERHAND_SWEEP_START", "bogus")
+    assert main(["sweep", *BASE, "-o", str(tmp_path / "s"), "--grid", "prop.k=1", "--workers", "1"]) == 2
+    assert capsys.readouterr().err.startswith("hierhand: error: HIERHAND_SWEEP_START=bogus: this platform starts "
+                                              "processes with ")
+    assert not (tmp_path / "s").exists()
+    assert main(["sweep", *BASE, "-o", str(tmp_path / "s"), "--grid", "prop.k=1", "--serial"]) == 0

@@ -17,7 +17,6 @@ platform can fork (``start_method``), so they start with all of that done.
 from __future__ import annotations
 
 import logging
-import os
 import signal
 import threading
 import time
@@ -47,23 +46,23 @@ and their fast monitoring ticks take the GIL from the running simulation: with t
 every 10 s re-grasp run took about 5 % longer on 2 cores."""
 
 
-def start_method() -> str:
-    """How LocalCluster starts its worker processes: forked where the platform can fork.
+def start_method(requested: str | None = None, source: str = "start_method") -> str:
+    """How LocalCluster starts its worker processes: ``requested`` (fork, spawn, forkserver)
+    if given, else forked where the platform can fork.
 
     A forked worker starts with this process's modules imported and the diagram already
     run once by ``warm_up``: about 0.1 s for two workers here, against about a second for
     spawned ones that import everything again, which is longer than a whole sweep of
-    short runs. ``HIERHAND_SWEEP_START`` (fork, spawn, forkserver)
-    overrides the choice.
+    short runs. ``source`` names where ``requested`` came from, for the message when this
+    platform cannot start processes that way.
     """
     import multiprocessing
 
-    chosen = os.environ.get("HIERHAND_SWEEP_START")
-    if chosen:
-        if chosen not in multiprocessing.get_all_start_methods():
-            raise SweepError(f"HIERHAND_SWEEP_START={chosen}: this platform starts processes with "
+    if requested:
+        if requested not in multiprocessing.get_all_start_methods():
+            raise SweepError(f"{source}={requested}: this platform starts processes with "
                              f"{', '.join(multiprocessing.get_all_start_methods())}")
-        return chosen
+        return requested
     return "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
 
 
@@ -100,13 +99,13 @@ def _connect(scheduler: str, timeout: float):
     return client
 
 
-def _local_cluster(workers: int | None):
+def _local_cluster(workers: int | None, method: str | None):
     import dask
     from distributed import LocalCluster
 
     from .worker_plugin import IgnoreCtrlC
 
-    settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method()}
+    settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method(method)}
     with dask.config.set(settings), _children_ignore_ctrl_c():
         return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
                             host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL,
@@ -114,8 +113,10 @@ def _local_cluster(workers: int | None):
 
 
 def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, workers: int | None = None,
-             scheduler: str | None = None, connect_timeout: float = 20.0) -> SweepReport:
-    """Run the points on a new LocalCluster (``workers`` processes) or at ``scheduler``.
+             scheduler: str | None = None, connect_timeout: float = 20.0,
+             method: str | None = None) -> SweepReport:
+    """Run the points on a new LocalCluster (``workers`` processes, started by ``method``:
+    see ``start_method``) or at ``scheduler``.
 
     Runs are recorded as their tasks complete. On any exit (Ctrl-C included) the tasks in
     flight are cancelled, their points left to a later resume, and the client and the
@@ -131,7 +132,7 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
         if scheduler:
             client = _connect(scheduler, connect_timeout)
         else:
-            cluster = _local_cluster(workers)
+            cluster = _local_cluster(workers, method)
             client = Client(cluster)
         workers_info = client.scheduler_info()["workers"]
         threads = sum(w["nthreads"] for w in workers_info.values())

@@ -24,9 +24,11 @@ EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
 
 class StopSignals:
     """A context that turns SIGINT and SIGTERM into stop requests (in the main thread only,
-    where Python delivers signals); ``received`` names the first signal that came."""
+    where Python delivers signals); ``received`` names the first signal that came. Notes on
+    stderr begin with ``program``, the command's name."""
 
-    def __init__(self):
+    def __init__(self, program: str):
+        self.program = program
         self.received: str | None = None
         self._holding = False
         self._previous: dict[int, object] = {}
@@ -57,7 +59,7 @@ class StopSignals:
             self.received = name
             raise StopRequest(name)
         self.received = self.received or name
-        os.write(2, f"hierhand: {name} while the results are saved: stopping once they are\n".encode())
+        os.write(2, f"{self.program}: {name} while the results are saved: stopping once they are\n".encode())
 
 
 def exit_code(stop: KeyboardInterrupt | str | None) -> int:

@@ -16,7 +16,7 @@ import pytest
 
 from blocks import Results
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 TOY = REPO / "diagrams" / "toy.yaml"
 TOY_BLOCKS = ("ref", "err", "plant", "integ", "prop", "u")
 LIBRARY_TYPES = ("Constant", "Step", "Ramp", "Gain", "Sum", "Saturation", "UnitDelay",

@@ -5,22 +5,23 @@
 own message and suggestion) and the metrics (against the diagram's logged signals).
 A bad *value* of one point is not refused here: that point runs, fails and is recorded
 as failed, and the other points go on. ``execute`` appends every finished run to the
-store and skips the points the store already holds.
+store and skips the points the store already holds. ``run_sweep`` does both in one call.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from .errors import SweepError
-from .metrics import Metric
+from .metrics import Metric, parse_metrics
 from .points import Point, point_json, unique_points
 from .progress import SweepProgress
 from .cluster import run_dask
 from .runner import Outcome, SweepJob, SweepReport, run_serial, warm_up
-from .store import OK, SweepStore, read_sweep
+from .store import OK, SWEEP_CSV, SweepStore, read_sweep
 
 
 @dataclass
@@ -80,11 +81,13 @@ def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_e
 
 
 def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, scheduler: str | None = None,
-            serial: bool = False, progress: bool = True) -> tuple[SweepReport, int, int]:
+            serial: bool = False, progress: bool = True,
+            start_method: str | None = None) -> tuple[SweepReport, int, int]:
     """Run the points missing from OUTPUT/sweep.csv and append each as it finishes.
 
     Returns the execution report, the number of points skipped (already in the file) and
     the number of failed points in the whole sweep (recorded before or now).
+    ``start_method`` is how a LocalCluster starts its workers (``cluster.start_method``).
     """
     store = SweepStore(output, plan.parameters, [m.name for m in plan.job.metrics])
     done = store.open()
@@ -103,7 +106,8 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
         else:
             warm_up(plan.job, todo[0][1])
             report = (run_serial(plan.job, todo, record) if serial
-                      else run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler))
+                      else run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,
+                                    method=start_method))
     finally:
         bar.close()
     return report, len(plan.points) - len(todo), failed_before + report.failed
@@ -116,3 +120,59 @@ def stored_count(plan: SweepPlan, output: str | Path) -> int:
     except SweepError:
         return 0
     return sum(h in held for h, _ in plan.points)
+
+
+@dataclass
+class SweepSummary:
+    """What ``run_sweep`` did: the sweep's points, those run now (``report``), those already
+    in the file, the failed points of the whole sweep, and the file."""
+
+    points: int
+    report: SweepReport
+    skipped: int
+    failed: int
+    csv: Path
+    wall_s: float = 0.0
+    """Seconds from opening the file to the last row (the checks before excluded)."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped ``run_sweep``: ``stored`` of the ``total`` points are in ``csv``; the
+    same call runs the rest."""
+
+    def __init__(self, stored: int, total: int, csv: Path):
+        super().__init__(f"sweep interrupted: {stored} of {total} points are in {csv}")
+        self.stored, self.total, self.csv = stored, total, csv
+
+
+def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metric], output: str | Path, *,
+              t_end: str | None = None, workers: int | None = None, scheduler: str | None = None,
+              serial: bool = False, trust: bool = False, progress: bool = True,
+              axes: dict[str, Any] | None = None, origins: dict[str, str] | None = None,
+              start_method: str | None = None) -> SweepSummary:
+    """Run the diagram file at every point and append one row per run to OUTPUT/sweep.csv.
+
+    ``points``: dicts of ``block.param`` overrides, all naming the same parameters
+    (``points.grid_points``, ``random_points``, ``csv_points`` make them); ``metrics``:
+    ``"NAME=EXPR"`` texts (``metrics``) or parsed ``Metric`` objects, one column each;
+    ``t_end``: every run's end time as the CLI's ``--t-end`` takes it (default: the
+    diagram's). The points run on a new LocalCluster of ``workers`` processes (default:
+    one per core), on the workers of a running ``scheduler``, or in this process with
+    ``serial`` (or ``workers=0``). Points already in the file are skipped, so calling again resumes; a point
+    that fails is recorded as failed and the others go on. ``axes`` is recorded in
+    sweep.json; ``origins`` says how each parameter was given, for load errors.
+
+    Raises ``DiagramError`` or ``SweepError`` before anything runs when the sweep cannot
+    work, and ``SweepInterrupted`` on Ctrl-C, with only whole rows in the file.
+    """
+    plan = prepare(diagram, points, parse_metrics(metrics), t_end=None if t_end is None else str(t_end),
+                   trust=trust, axes=axes, origins=origins)
+    t0 = time.perf_counter()
+    try:
+        report, skipped, failed = execute(plan, output, workers=workers, scheduler=scheduler,
+                                          serial=serial or workers == 0, progress=progress,
+                                          start_method=start_method)
+    except KeyboardInterrupt:
+        raise SweepInterrupted(stored_count(plan, output), len(plan.points), Path(output) / SWEEP_CSV) from None
+    return SweepSummary(len(plan.points), report, skipped, failed, Path(output) / SWEEP_CSV,
+                        time.perf_counter() - t0)

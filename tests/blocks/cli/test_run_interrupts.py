@@ -22,7 +22,7 @@ from blocks import Results
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 DECIMATE, PERIOD = 100, 1e-4
 SPAN = """\
 name: span

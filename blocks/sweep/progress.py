@@ -1,6 +1,6 @@
 """The sweep's one-line progress report on stderr: done/total, failed, elapsed and ETA.
 
-Shown only on a terminal (like ``hierhand run``'s progress bar), so logs and pipes stay clean.
+Shown only on a terminal (like a run's progress bar), so logs and pipes stay clean.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from hierhand.sweep.chunks import TASKS_PER_WORKER, ChunkSizer
+from blocks.sweep.chunks import TASKS_PER_WORKER, ChunkSizer
 
 
 def test_first_tasks_hold_one_point():

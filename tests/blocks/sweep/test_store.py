@@ -6,8 +6,8 @@ import csv
 
 import pytest
 
-from hierhand.sweep import SweepError
-from hierhand.sweep.store import SweepStore, read_sweep
+from blocks.sweep import SweepError
+from blocks.sweep.store import SweepStore, read_sweep
 
 
 def test_rows_append_and_reopen(tmp_path):

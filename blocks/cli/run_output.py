@@ -1,4 +1,4 @@
-"""Where ``hierhand run`` puts its results.
+"""Where the ``run`` command puts its results.
 
 The output folder is checked before the run (created, a folder, writable), so a bad
 ``-o`` costs nothing; the files and plots are then written as one set
@@ -43,16 +43,16 @@ def remove_if_empty(out: Path) -> None:
         out.rmdir()
 
 
-def save_run(results: Results, out: Path, csv: bool, plot: bool) -> Saved:
+def save_run(results: Results, out: Path, csv: bool, plot: bool, temp_prefix: str = "results-") -> Saved:
     """Write the results (signals.csv with ``csv``, plots with ``plot``) into ``out``, or
-    failing that into a new temporary folder."""
+    failing that into a new temporary folder whose name starts with ``temp_prefix``."""
     try:
         return Saved(out, write(results, out, csv, plot))
     except OSError as exc:
         reason = describe(exc)
     spare = None
     try:
-        spare = Path(tempfile.mkdtemp(prefix="hierhand-results-"))
+        spare = Path(tempfile.mkdtemp(prefix=temp_prefix))
         plots = write(results, spare, csv, plot)
     except OSError as exc:
         if spare is not None:

@@ -13,12 +13,12 @@ import numpy as np
 import pytest
 
 from blocks import Results
-from hierhand.run_output import save_run
+from blocks.cli.run_output import save_run
 
 from .test_cli import LONG_DIAGRAM
-from .test_results_folder import read_only_folder
+from ..test_results_folder import read_only_folder
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def hierhand(tmp_path: Path, *args: str, timeout: float = 60) -> subprocess.CompletedProcess:

@@ -1,7 +1,8 @@
-"""The numbers the paper's tasks are judged by, computed from a run's Results.
+"""Summaries of the paper's tasks: the numbers each task is judged by, from a run's Results.
 
 Every function takes the Results of a shipped task diagram and the names of its plant,
-reflex and controller blocks, so the same measures serve sweeps and tests.
+reflex and controller blocks, so the same numbers serve the reproduction, the tests and,
+as the scalar measures of ``measures``, sweeps.
 """
 
 from __future__ import annotations

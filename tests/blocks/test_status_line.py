@@ -2,8 +2,8 @@
 
 import io
 
-from hierhand.status_line import StatusLine
-from hierhand.sweep.progress import SweepProgress
+from blocks.status_line import StatusLine
+from blocks.sweep.progress import SweepProgress
 
 
 class Terminal(io.StringIO):

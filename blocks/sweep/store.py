@@ -14,10 +14,10 @@ import csv
 import io
 import json
 import os
-import tempfile
 from pathlib import Path
 from typing import Any, Sequence
 
+from ..atomic_file import write_atomically
 from .errors import SweepError
 
 SWEEP_CSV = "sweep.csv"
@@ -73,17 +73,7 @@ class SweepStore:
     def write_description(self, description: dict[str, Any]) -> Path:
         """Write DIR/sweep.json atomically (a reader never sees half a file)."""
         self.directory.mkdir(parents=True, exist_ok=True)
-        path = self.directory / SWEEP_JSON
-        fd, tmp = tempfile.mkstemp(prefix=".sweep.json.", suffix=".tmp", dir=self.directory)
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                json.dump(description, f, indent=2, default=str)
-                f.write("\n")
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+        return write_atomically(self.directory / SWEEP_JSON, json.dumps(description, indent=2, default=str) + "\n")
 
     def _append_text(self, text: str) -> None:
         data = text.encode("utf-8")
@@ -111,12 +101,20 @@ def _csv_line(cells: Sequence[str]) -> str:
     return buf.getvalue()
 
 
+class NotASweep(SweepError):
+    """A folder without sweep.csv, where a finished sweep was expected."""
+
+    def __init__(self, directory: Path, expected: str = "the output folder of a sweep"):
+        super().__init__(f"{directory}: no {SWEEP_CSV} here; is this {expected}?")
+        self.directory = directory
+
+
 def read_sweep(directory: str | Path) -> tuple[dict[str, Any], list[dict[str, str]]]:
     """sweep.json and the rows of sweep.csv (the last row per point wins)."""
     directory = Path(directory)
     csv_path, json_path = directory / SWEEP_CSV, directory / SWEEP_JSON
     if not csv_path.is_file():
-        raise SweepError(f"{directory}: no {SWEEP_CSV} here; is this the -o folder of 'hierhand sweep'?")
+        raise NotASweep(directory)
     try:
         description = json.loads(json_path.read_text(encoding="utf-8")) if json_path.is_file() else {}
         with open(csv_path, newline="", encoding="utf-8") as f:

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from blocks import Results
-from hierhand.tasks.metrics import grasp_summary, regrasp_events, regrasp_succeeded, regrasp_summary, rigid_target
+from hierhand.tasks.summaries import grasp_summary, regrasp_events, regrasp_succeeded, regrasp_summary, rigid_target
 
 
 def test_rigid_target_recovers_a_known_motion():

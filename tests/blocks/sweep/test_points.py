@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from hierhand.sweep import SweepError
-from hierhand.sweep.points import (combine, csv_points, grid_points, origins, parse_grid, parse_random,
+from blocks.sweep import SweepError
+from blocks.sweep.points import (combine, csv_points, grid_points, origins, parse_grid, parse_random,
                                    point_hash, random_points, split_top_level, unique_points)
 
 
