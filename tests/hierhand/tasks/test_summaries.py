@@ -1,4 +1,4 @@
-"""Task measures on hand-made signals with known answers."""
+"""Task summaries on hand-made signals with known answers."""
 
 from __future__ import annotations
 
