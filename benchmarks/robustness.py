@@ -6,7 +6,7 @@ the suppresser's S_a and S_b x0.8-1.2 each, contact stiffness (k_n and k_t toget
 x0.7-1.3 and the PD's kp x0.8-1.2. Every point runs diagrams/regrasp.yaml (with the
 suppresser) and diagrams/regrasp_unsuppressed.yaml (without). A re-grasp succeeds when the
 middle finger touches, the forefinger lets go during its withdrawal and stays off, and the
-object is not dropped (``hierhand.tasks.metrics.regrasp_succeeded``). Without the suppresser
+object is not dropped (``hierhand.tasks.summaries.regrasp_succeeded``). Without the suppresser
 the forefinger must never let go.
 
 Prints the success rates, the failed points, the same rates for other values of the
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 import blocks
-from hierhand.tasks.metrics import regrasp_events, regrasp_succeeded, regrasp_summary
+from hierhand.tasks.summaries import regrasp_events, regrasp_succeeded, regrasp_summary
 from hierhand.tasks.reproduce import withdrawal
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -28,11 +28,11 @@ from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
-from hierhand.sweep.cluster import start_method
-from hierhand.sweep.metrics import parse_metrics
-from hierhand.sweep.plan import SweepPlan, execute, prepare
-from hierhand.sweep.points import grid_points
-from hierhand.sweep.runner import default_workers, run_point
+from blocks.sweep.cluster import start_method
+from blocks.sweep.metrics import parse_metrics
+from blocks.sweep.plan import SweepPlan, execute, prepare
+from blocks.sweep.points import grid_points
+from blocks.sweep.runner import default_workers, run_point
 
 ROOT = Path(__file__).resolve().parent.parent
 REGRASP = ROOT / "diagrams" / "regrasp.yaml"

@@ -8,9 +8,9 @@ because loading a diagram must never run code the user did not choose to run.
 from __future__ import annotations
 
 import importlib
-from importlib.metadata import entry_points
 
 from .block import Block
+from .plugins import load_group
 
 ENTRY_POINT_GROUP = "blocks.types"
 PYTHON_PREFIX = "python:"
@@ -35,18 +35,15 @@ def block_types() -> dict[str, type[Block]]:
         from .library import LIBRARY
 
         types: dict[str, type[Block]] = {cls.registered_name(): cls for cls in LIBRARY}
-        for ep in entry_points(group=ENTRY_POINT_GROUP):
-            try:
-                cls = ep.load()
-            except Exception as exc:  # a broken plug-in must not break every diagram
-                _load_errors[ep.name] = f"{ep.value}: {exc}"
-                continue
-            if isinstance(cls, type) and issubclass(cls, Block):
-                types[ep.name] = cls
-            else:
-                _load_errors[ep.name] = f"{ep.value} is not a Block subclass"
+        installed, errors = load_group(ENTRY_POINT_GROUP, _not_a_block)
+        types.update(installed)
+        _load_errors.update(errors)
         _cache = types
     return _cache
+
+
+def _not_a_block(obj) -> str | None:
+    return None if isinstance(obj, type) and issubclass(obj, Block) else "is not a Block subclass"
 
 
 def resolve_type(name: str, trust: bool = False) -> type[Block]:

@@ -29,7 +29,6 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-import os
 import platform
 import struct
 import uuid
@@ -40,6 +39,7 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 import hierhand
+from blocks.atomic_file import write_atomically
 from hierhand import _native, native_sources
 
 FMU_DIR = Path("fmu")
@@ -115,10 +115,7 @@ def export_plant_fmu(out: Path | None = None, fmi: int = 2, hand: Path | None = 
         files["sources/buildDescription.xml"] = build_description(identifier)
     target = _output_path(out, fmi)
     target.parent.mkdir(parents=True, exist_ok=True)
-    partial = target.with_name(target.name + ".partial")
-    partial.write_bytes(_zip(files))
-    os.replace(partial, target)
-    return target
+    return write_atomically(target, _zip(files))
 
 
 def fmu_library(fmi: int) -> Path:

@@ -1,4 +1,5 @@
-"""The paper's three tasks: measures, figures and the one-command reproduction."""
+"""The paper's three tasks: summaries, sweep measures, figures and the
+one-command reproduction."""
 
 from .reproduce import TASKS, reproduce
 

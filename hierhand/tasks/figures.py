@@ -8,7 +8,7 @@ import numpy as np
 
 from blocks import Results
 
-from .metrics import FORE, SAFETY_RATIO, THUMB, TaskBlocks
+from .summaries import FORE, SAFETY_RATIO, THUMB, TaskBlocks
 
 FINGER_NAMES = ("thumb", "forefinger", "middle finger")
 

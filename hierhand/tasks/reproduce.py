@@ -16,7 +16,7 @@ import blocks
 from blocks import Results
 
 from .figures import draw_figures
-from .metrics import (SAFETY_RATIO, TaskBlocks, grasp_summary, manipulation_summary, regrasp_succeeded,
+from .summaries import (SAFETY_RATIO, TaskBlocks, grasp_summary, manipulation_summary, regrasp_succeeded,
                       regrasp_summary)
 from .separation import separation_relation
 

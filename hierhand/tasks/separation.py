@@ -14,7 +14,7 @@ from pathlib import Path
 
 import blocks
 
-from .metrics import TaskBlocks, regrasp_events
+from .summaries import TaskBlocks, regrasp_events
 
 SHIFTS = (-0.05, 0.0, 0.05, 0.1)
 """Seconds by which the forefinger's withdrawal is moved."""

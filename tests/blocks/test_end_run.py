@@ -194,8 +194,8 @@ def test_cli_run_reports_the_end_and_exits_0(tmp_path):
 
 
 def test_a_sweep_point_ended_by_a_block_is_ok(tmp_path):
-    from hierhand.sweep.runner import SweepJob, run_point
-    from hierhand.sweep.store import OK
+    from blocks.sweep.runner import SweepJob, run_point
+    from blocks.sweep.store import OK
 
     diagram = tmp_path / "ends.yaml"
     diagram.write_text(THREE_RATES, encoding="utf-8")

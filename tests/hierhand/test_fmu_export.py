@@ -544,7 +544,7 @@ def native_regrasp():
 def test_regrasp_with_the_exported_plant_matches_the_native_run(fmus, native_regrasp, fmi):
     """diagrams/regrasp_fmu.yaml: the same task with the plant as an FMU, at 1 ms steps."""
     import blocks
-    from hierhand.tasks.metrics import regrasp_events
+    from hierhand.tasks.summaries import regrasp_events
 
     diagram = blocks.load_diagram(REPO / "diagrams" / "regrasp_fmu.yaml",
                                   overrides={"plant.path": str(fmus[fmi])})

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from blocks import Results
 
-from ..blocks.test_cli import LONG_DIAGRAM as LONG
+from ..blocks.cli.test_cli import LONG_DIAGRAM as LONG
 from .corpus import Case
 
 SHORT = """\

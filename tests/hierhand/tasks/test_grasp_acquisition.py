@@ -9,7 +9,7 @@ import pytest
 
 import blocks
 from hierhand.control.grasp_reflex import GraspReflex
-from hierhand.tasks.metrics import grasp_summary
+from hierhand.tasks.summaries import grasp_summary
 from hierhand.tasks.reproduce import handover_time
 
 DIAGRAMS = Path(__file__).resolve().parents[3] / "diagrams"

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 import blocks
-from hierhand.tasks.metrics import regrasp_events, regrasp_succeeded, regrasp_summary
+from hierhand.tasks.summaries import regrasp_events, regrasp_succeeded, regrasp_summary
 from hierhand.tasks.reproduce import withdrawal
 
 DIAGRAMS = Path(__file__).resolve().parents[3] / "diagrams"

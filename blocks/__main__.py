@@ -1,0 +1,6 @@
+"""``python -m blocks``: the framework's generic commands (run, validate, graph, plot, fmu
+info, sweep, sweep-plot, blocks) on any diagram."""
+
+from blocks.cli import PROGRAM, entry
+
+entry(PROGRAM)

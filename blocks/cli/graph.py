@@ -1,0 +1,43 @@
+"""``graph``: the wiring of a diagram as DOT text, or drawn to SVG, PNG or PDF."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .options import diagram_args, load
+from .program import EXIT_OK, UsageError
+
+
+def add(sub, program) -> argparse.ArgumentParser:
+    """The ``graph`` command."""
+    graph = sub.add_parser("graph", help="draw the wiring of a diagram (DOT, SVG or PNG)")
+    diagram_args(graph)
+    graph.add_argument("-o", "--output", type=Path,
+                       help="file to write: .dot, .svg or .png (default: DOT text on stdout)")
+    graph.set_defaults(handler=cmd_graph)
+    return graph
+
+
+def cmd_graph(args: argparse.Namespace) -> int:
+    """Write the wiring where -o says, by its suffix, or print the DOT text."""
+    from blocks import build_schedule
+    from blocks.graph import render, to_dot
+
+    diagram = load(args)
+    schedule = build_schedule(diagram, None)
+    out = args.output
+    if out is None:
+        sys.stdout.write(to_dot(diagram, schedule))
+        return EXIT_OK
+    suffix = out.suffix.lower()
+    if suffix in (".dot", ".gv"):
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(to_dot(diagram, schedule), encoding="utf-8")
+    elif suffix in (".svg", ".png", ".pdf"):
+        render(diagram, schedule, out)
+    else:
+        raise UsageError(f"-o {out}: unknown format {suffix or '(none)'!r}; use .dot, .svg or .png")
+    print(f"wrote {out}")
+    return EXIT_OK

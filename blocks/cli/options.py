@@ -1,0 +1,76 @@
+"""The options every diagram command shares (DIAGRAM, --set, --t-end, --trust) and reading them.
+
+``run``, ``validate`` and ``graph`` take the same diagram arguments; ``load`` turns them
+into a ``Diagram`` and ``end_time`` into the run's end time, with the command line's own
+messages for values that are not right.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any, Sequence
+
+import yaml
+
+from .program import UsageError
+
+
+def diagram_args(p: argparse.ArgumentParser) -> None:
+    """Add DIAGRAM, --set, --t-end (alias --stop-time) and --trust to a command's parser."""
+    p.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
+    p.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
+                   help="override a parameter (value read as YAML; repeatable), e.g. --set prop.k=2")
+    p.add_argument("--t-end", "--stop-time", dest="t_end", metavar="T",
+                   help="end time, e.g. 2, '0.5 s' or '300 ms' (default: the diagram's time.t_end)")
+    trust_arg(p)
+
+
+def trust_arg(p: argparse.ArgumentParser) -> None:
+    """Add --trust, which lets a diagram name Python classes as block types."""
+    p.add_argument("--trust", action="store_true",
+                   help="allow 'python:module:Class' block types, which import code named in the diagram")
+
+
+def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
+    """``["plant.k=2", "ctrl.gains=[1, 2]"]`` -> {"plant.k": 2, "ctrl.gains": [1, 2]}."""
+    overrides: dict[str, Any] = {}
+    for item in items:
+        key, eq, text = item.partition("=")
+        key = key.strip()
+        if not eq or "." not in key or not all(key.split(".")):
+            raise UsageError(f"--set {item!r}: expected BLOCK.PARAM=VALUE, e.g. --set prop.k=2")
+        try:
+            overrides[key] = yaml.safe_load(text) if text.strip() else None
+        except yaml.YAMLError as exc:
+            first = str(exc).splitlines()[0]
+            raise UsageError(f"--set {item!r}: the value is not valid YAML ({first})") from None
+        if overrides[key] is None:
+            raise UsageError(f"--set {item!r}: no value after '='")
+    return overrides
+
+
+def load(args: argparse.Namespace):
+    """The diagram the arguments name, with their overrides."""
+    from blocks import load_diagram
+
+    return load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
+
+
+def end_time(args: argparse.Namespace, diagram):
+    """The end time: --t-end if given (checked), else the diagram's; DiagramError if neither."""
+    from blocks import DiagramError
+    from blocks.timebase import DurationError, parse_duration
+
+    if args.t_end is None:
+        if diagram.t_end is None:
+            raise DiagramError([diagram.issue(None, "no end time", "add time: {t_end: 1 s} to the "
+                                              "diagram or pass --t-end")])
+        return diagram.t_end
+    try:
+        t_end = parse_duration(args.t_end)
+    except DurationError as exc:
+        raise UsageError(f"--t-end: {exc}") from None
+    if t_end <= 0:
+        raise UsageError(f"--t-end must be positive, got {args.t_end!r}")
+    return t_end

@@ -1,0 +1,100 @@
+"""``run``: simulate a diagram and write its results folder, with a progress bar on a terminal."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..status_line import StatusLine
+from .options import diagram_args, end_time, load
+from .program import EXIT_FAILED, EXIT_OK, UsageError
+
+
+def add(sub, program) -> argparse.ArgumentParser:
+    """The ``run`` command."""
+    run = sub.add_parser("run", help="simulate a diagram and write its results",
+                         description="Simulate DIAGRAM and write signals.npz and run.json to the output folder.")
+    diagram_args(run)
+    run.add_argument("-o", "--output", type=Path,
+                     help="results folder (default: runs/<diagram name>, the name made one safe folder name)")
+    run.add_argument("--csv", action="store_true", help="also write signals.csv")
+    run.add_argument("--plot", action="store_true", help="also plot the logged signals to <output>/plots/")
+    run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary line")
+    run.set_defaults(handler=cmd_run)
+    return run
+
+
+class ProgressBar:
+    """The run's progress on stderr: only on a terminal, and only once a run takes a second."""
+
+    def __init__(self, t_end: float, enabled: bool):
+        self.t_end = t_end
+        self.line = StatusLine(enabled)
+
+    def __call__(self, fraction: float, elapsed: float) -> None:
+        if elapsed < 1.0 and not self.line.shown:
+            return
+        width = 30
+        filled = int(width * fraction)
+        eta = elapsed * (1 - fraction) / fraction if fraction > 0 else float("nan")
+        self.line.show(f"[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
+                       f"t = {fraction * self.t_end:.4g} / {self.t_end:.4g} s  eta {eta:5.1f} s")
+
+    def close(self) -> None:
+        self.line.close()
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    """Simulate and save. The output folder is checked before the run; Ctrl-C or SIGTERM
+    stops the run and its results so far are saved, and no signal cuts the saving short
+    (``stop_signals``); after an interrupt the plots are skipped, to stop soon. A run that
+    a block ends early (``EndRun``) is complete: it says where and why, even with -q."""
+    from blocks import DiagramError, simulate
+    from blocks.results_folder import OutputFolderError
+    from blocks.safepath import folder_name
+
+    from .run_output import check_output, remove_if_empty, save_run
+    from .stop_signals import StopSignals, exit_code
+
+    prog = args.program.name
+    diagram = load(args)
+    t_end = end_time(args, diagram)
+    out = args.output or Path("runs") / folder_name(diagram.name)
+    try:
+        created = check_output(out)
+    except OutputFolderError as exc:
+        raise UsageError(f"output folder {exc}") from None
+    bar = ProgressBar(float(t_end), enabled=not args.quiet)
+    with StopSignals(prog) as stops:
+        try:
+            results = simulate(diagram, t_end=t_end, progress=bar)
+        except (DiagramError, KeyboardInterrupt):  # refused, or stopped, before it started
+            if created:
+                remove_if_empty(out)
+            raise
+        finally:
+            bar.close()
+        with stops.held():
+            saved = save_run(results, out, csv=args.csv, plot=args.plot and not results.interrupted,
+                             temp_prefix=f"{prog}-results-")
+    if not results.complete:
+        print(f"{prog}: {diagram.file}: {results.status}", file=sys.stderr)
+    if saved.problem:
+        print(f"{prog}: {saved.problem}", file=sys.stderr)
+        return EXIT_FAILED
+    if not results.complete:
+        skipped = (f"; plots skipped after the interrupt ('{prog} plot {out}' draws them)"
+                   if args.plot and results.interrupted else "")
+        print(f"{prog}: partial results (marked incomplete) saved in {out}{skipped}", file=sys.stderr)
+        return exit_code(stops.received) if results.interrupted else EXIT_FAILED
+    if results.ended_by is not None:
+        print(f"{diagram.name}: {results.end_note}")
+    if not args.quiet:
+        info = results.info
+        rtf = info.get("real_time_factor")
+        simulated = results.stop_time if results.ended_by is not None else float(t_end)
+        print(f"{diagram.name}: {simulated:g} s simulated in {info['wall_time_s']:.3g} s"
+              + (f" ({rtf:.3g}x real time)" if rtf else "") + f"; results in {out}"
+              + (f", plots: {', '.join(str(p) for p in saved.plots)}" if saved.plots else ""))
+    return EXIT_OK

@@ -1,0 +1,91 @@
+"""``validate``: check a diagram and print its blocks, rates, references and execution order."""
+
+from __future__ import annotations
+
+import argparse
+
+from .options import diagram_args, end_time, load
+from .program import EXIT_OK
+
+
+def add(sub, program) -> argparse.ArgumentParser:
+    """The ``validate`` command."""
+    validate = sub.add_parser("validate", help="check a diagram and print its schedule",
+                              description="Check DIAGRAM and print blocks, periods, base tick, "
+                                          "hyperperiod and execution order.")
+    diagram_args(validate)
+    validate.set_defaults(handler=cmd_validate)
+    return validate
+
+
+def cmd_validate(args: argparse.Namespace) -> int:
+    from blocks import build_schedule
+    from blocks.timebase import format_duration
+
+    diagram = load(args)
+    t_end = end_time(args, diagram) if (args.t_end or diagram.t_end) else None
+    s = build_schedule(diagram, t_end)
+    print(f"diagram {diagram.name!r} ({diagram.file}): valid")
+    if diagram.description:
+        print(f"  {diagram.description}")
+    print(f"base tick: {format_duration(s.base_tick)}; hyperperiod: {s.hyperperiod} ticks "
+          f"({format_duration(s.hyperperiod * s.base_tick)})"
+          + (f"; t_end: {format_duration(t_end)} = {s.n_ticks} ticks" if t_end else ""))
+    print("blocks:")
+    wn = max(len(n) for n in diagram.blocks)
+    wt = max(len(b.type_name) for b in diagram.blocks.values())
+    for name, spec in diagram.blocks.items():
+        blk = spec.block
+        ins = ", ".join(f"{p}[{w}]" for p, w in blk.inputs.items()) or "-"
+        outs = ", ".join(f"{p}[{w}]" for p, w in blk.outputs.items()) or "-"
+        notes = []
+        if name in s.advanced:
+            notes.append("advanced between events")
+        if blk.has_feedthrough():
+            notes.append("feedthrough")
+        if any(blk.initial_reads(p) != blk.reads(p) for p in blk.outputs):
+            initial = sorted(set().union(*(blk.initial_reads(p) for p in blk.outputs)))
+            notes.append(f"feedthrough at t = 0 from {', '.join(initial)}" if initial
+                         else "no feedthrough at t = 0")
+        print(f"  {name:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
+              + (f"  ({', '.join(notes)})" if notes else ""))
+    print_references_and_notes(diagram)
+    print("execution order:")
+    print(f"  t = 0: {s.initial.describe()}")
+    for held in s.initial_held:
+        print(f"    {held.block}.{held.port} holds its initial value at t = 0: {held.block} is computed "
+              f"before its source, which depends on it ({held.loop})")
+    seen: dict[int, list[int]] = {}
+    for r, j in zip(s.event_ticks, s.event_programs):
+        seen.setdefault(j, []).append(int(r))
+    for j, ticks in seen.items():
+        at = ", ".join(format_duration(r * s.base_tick) for r in ticks[:6]) + (", ..." if len(ticks) > 6 else "")
+        print(f"  at {at} (mod {format_duration(s.hyperperiod * s.base_tick)}): {s.programs[j].describe()}")
+    if not s.event_ticks.size and s.advanced:
+        print(f"  no other events: {', '.join(sorted(s.advanced))} advanced from t = 0 to t_end")
+    return EXIT_OK
+
+
+def print_references_and_notes(diagram) -> None:
+    """``validate``'s block references (``reflex.hand -> plant``) and, per block, where its
+    configuration comes from: its params_file, its own ``describe()``, who refers to it."""
+    references = diagram.references()
+    if references:
+        print("references:")
+        for ref in references:
+            print(f"  {ref}")
+    notes = []
+    for name, spec in diagram.blocks.items():
+        users = [f"{r.block}.{r.param}" for r in references if r.target == name]
+        parts = [f"params_file {spec.params_file}" if spec.params_file else "", spec.block.describe(),
+                 f"referenced by {', '.join(users)}" if users else ""]
+        if any(parts):
+            notes.append(f"  {name}: {'; '.join(p for p in parts if p)}")
+    if notes:
+        print("notes:")
+        print("\n".join(notes))
+    conversions = diagram.conversions()
+    if conversions:
+        print("conversions (connections between ports of different types):")
+        for conversion in conversions:
+            print(f"  {conversion}")

@@ -1,0 +1,190 @@
+"""Running a sweep on Dask: a new LocalCluster of single-threaded worker processes, or the
+workers of a running scheduler, through the same code.
+
+This process submits tasks of one or more points (``chunks.ChunkSizer`` chooses how many),
+keeps a few of them in flight per worker, takes them ``as_completed`` and hands every run
+to ``record``, so it is the only writer of sweep.csv. When a worker dies under a task,
+Dask retries the task elsewhere and finally fails it, and it also fails tasks that only
+waited on that worker. So the points of a lost task are run again one at a time, with
+nothing else in flight, and only a point that is lost even then is recorded as failed:
+the point that kills its worker, not its neighbours.
+
+``warm_up`` has run the diagram briefly in this process before the cluster starts
+(modules imported, FMUs unpacked), and LocalCluster workers are forked from it where the
+platform can fork (``start_method``), so they start with all of that done.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import threading
+import time
+import uuid
+from collections import deque
+from contextlib import contextmanager
+from typing import Any
+
+from .chunks import ChunkSizer
+from .errors import SweepError
+from .points import Point
+from .runner import Outcome, Record, SweepJob, SweepReport, default_workers, one_line, run_points
+from .store import FAILED, OK
+
+WORKER_WAIT_S = 30.0
+"""How long to wait for a remote scheduler to have at least one worker."""
+
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.worker.memory.monitor-interval": "1s",
+}
+"""Dask settings for the LocalCluster a sweep starts. The workers' statistical profiler
+(a stack sample every 10 ms, read only by the dashboard, which a sweep does not start)
+and their fast monitoring ticks take the GIL from the running simulation: with them,
+every 10 s re-grasp run took about 5 % longer on 2 cores."""
+
+
+def start_method(requested: str | None = None, source: str = "start_method") -> str:
+    """How LocalCluster starts its worker processes: ``requested`` (fork, spawn, forkserver)
+    if given, else forked where the platform can fork.
+
+    A forked worker starts with this process's modules imported and the diagram already
+    run once by ``warm_up``: about 0.1 s for two workers here, against about a second for
+    spawned ones that import everything again, which is longer than a whole sweep of
+    short runs. ``source`` names where ``requested`` came from, for the message when this
+    platform cannot start processes that way.
+    """
+    import multiprocessing
+
+    if requested:
+        if requested not in multiprocessing.get_all_start_methods():
+            raise SweepError(f"{source}={requested}: this platform starts processes with "
+                             f"{', '.join(multiprocessing.get_all_start_methods())}")
+        return requested
+    return "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+
+
+@contextmanager
+def _children_ignore_ctrl_c():
+    """Start processes with SIGINT ignored.
+
+    Ctrl-C in a terminal reaches the whole process group, workers included. This process
+    answers it (cancel, close the cluster, keep the CSV whole); workers that took it too
+    would each print a traceback while being shut down.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _connect(scheduler: str, timeout: float):
+    from distributed import Client
+
+    try:
+        client = Client(scheduler, timeout=timeout)
+    except (OSError, TimeoutError) as exc:
+        raise SweepError(f"--scheduler {scheduler}: cannot connect: {one_line(exc)}") from None
+    try:
+        client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+    except TimeoutError:
+        client.close()
+        raise SweepError(f"--scheduler {scheduler}: no workers after {WORKER_WAIT_S:g} s") from None
+    return client
+
+
+def _local_cluster(workers: int | None, method: str | None):
+    import dask
+    from distributed import LocalCluster
+
+    from .worker_plugin import IgnoreCtrlC
+
+    settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method(method)}
+    with dask.config.set(settings), _children_ignore_ctrl_c():
+        return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
+                            host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL,
+                            plugins={IgnoreCtrlC()})
+
+
+def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, workers: int | None = None,
+             scheduler: str | None = None, connect_timeout: float = 20.0,
+             method: str | None = None) -> SweepReport:
+    """Run the points on a new LocalCluster (``workers`` processes, started by ``method``:
+    see ``start_method``) or at ``scheduler``.
+
+    Runs are recorded as their tasks complete. On any exit (Ctrl-C included) the tasks in
+    flight are cancelled, their points left to a later resume, and the client and the
+    cluster this call started are closed.
+    """
+    from distributed import Client, as_completed
+
+    report = SweepReport()
+    t0 = time.perf_counter()
+    cluster = client = None
+    in_flight: dict[Any, list[tuple[str, Point]]] = {}
+    try:
+        if scheduler:
+            client = _connect(scheduler, connect_timeout)
+        else:
+            cluster = _local_cluster(workers, method)
+            client = Client(cluster)
+        workers_info = client.scheduler_info()["workers"]
+        threads = sum(w["nthreads"] for w in workers_info.values())
+        report.workers = len(workers_info)
+        report.startup_s = time.perf_counter() - t0
+
+        sizer = ChunkSizer(threads)
+        queue, suspects = deque(todo), deque()
+        isolated: set[Any] = set()
+        token, submitted = uuid.uuid4().hex[:8], 0
+        finished = as_completed()
+
+        def submit(chunk: list[tuple[str, Point]]) -> Any:
+            nonlocal submitted
+            future = client.submit(run_points, job, [p for _, p in chunk], key=f"sweep-{token}-{submitted}")
+            submitted += 1
+            in_flight[future] = chunk
+            finished.add(future)
+            return future
+
+        def top_up() -> None:
+            if suspects:  # one at a time, nothing else in flight: each is judged on its own
+                if not in_flight:
+                    isolated.add(submit([suspects.popleft()]))
+                return
+            while queue and len(in_flight) < sizer.in_flight:
+                submit([queue.popleft() for _ in range(sizer.size(len(queue)))])
+
+        top_up()
+        for future in finished:
+            chunk = in_flight.pop(future)
+            try:
+                outcomes = future.result()
+            except Exception as exc:  # the task itself was lost: a worker died under it, ...
+                if future not in isolated:
+                    suspects.extend(chunk)
+                    top_up()
+                    continue
+                outcomes = [Outcome(FAILED, one_line(f"{type(exc).__name__}: {exc}"))]
+            for (h, point), outcome in zip(chunk, outcomes):
+                record(h, point, outcome)
+                sizer.observe(outcome.wall_s)
+                report.ran += 1
+                report.failed += outcome.status != OK
+            top_up()
+        report.run_s = time.perf_counter() - t0 - report.startup_s
+    finally:
+        if client is not None:
+            if in_flight:
+                client.cancel(list(in_flight))
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    report.wall_s = time.perf_counter() - t0
+    return report

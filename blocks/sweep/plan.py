@@ -1,0 +1,178 @@
+"""A sweep checked before it runs: the points with their hashes, the metrics, the job.
+
+``prepare`` does every check that can fail before the first run: the parameter names
+(through the diagram loader, with the first point's values, so a typo gets the loader's
+own message and suggestion) and the metrics (against the diagram's logged signals).
+A bad *value* of one point is not refused here: that point runs, fails and is recorded
+as failed, and the other points go on. ``execute`` appends every finished run to the
+store and skips the points the store already holds. ``run_sweep`` does both in one call.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .errors import SweepError
+from .metrics import Metric, parse_metrics
+from .points import Point, point_json, unique_points
+from .progress import SweepProgress
+from .cluster import run_dask
+from .runner import Outcome, SweepJob, SweepReport, run_serial, warm_up
+from .store import OK, SWEEP_CSV, SweepStore, read_sweep
+
+
+@dataclass
+class SweepPlan:
+    """A validated sweep: the job every point runs and the (hash, point) pairs, in order."""
+
+    job: SweepJob
+    points: list[tuple[str, Point]]
+    parameters: list[str]
+    diagram_hash: str
+    axes: dict[str, Any] = field(default_factory=dict)
+
+    def description(self) -> dict[str, Any]:
+        """What sweep.json records: enough to read the CSV and to repeat the sweep."""
+        return {
+            "diagram": self.job.diagram,
+            "diagram_hash": self.diagram_hash,
+            "t_end": self.job.t_end,
+            "parameters": self.parameters,
+            "axes": self.axes,
+            "metrics": {m.name: m.text.partition("=")[2].strip() for m in self.job.metrics},
+            "points": len(self.points),
+        }
+
+
+def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_end: str | None = None,
+            trust: bool = False, axes: dict[str, Any] | None = None,
+            origins: dict[str, str] | None = None) -> SweepPlan:
+    """Check the points' parameter names and the metrics against the diagram; hash the points.
+
+    Raises the loader's DiagramError for an unknown block or parameter, SweepError for
+    anything else that cannot work. ``origins`` says how the user gave each parameter
+    (``points.origins``), for the loader's messages about it.
+    """
+    from blocks import DiagramError, load_diagram
+
+    if not points:
+        raise SweepError("no points: give --grid, --random or --points")
+    keys = list(points[0])
+    for p in points:
+        if list(p) != keys:
+            raise SweepError(f"every point must set the same parameters; {point_json(p)} differs from "
+                             f"{', '.join(keys)}")
+    base = load_diagram(diagram, trust=trust)
+    checked = base
+    try:
+        checked = load_diagram(diagram, overrides=points[0], trust=trust, origins=origins)
+    except DiagramError as exc:
+        if any(i.override for i in exc.issues):
+            raise
+    for metric in metrics:
+        metric.check(checked)
+    job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust,
+                   origins=tuple((origins or {}).items()))
+    return SweepPlan(job=job, points=unique_points(points, base.source_hash, t_end), parameters=keys,
+                     diagram_hash=base.source_hash, axes=axes or {})
+
+
+def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, scheduler: str | None = None,
+            serial: bool = False, progress: bool = True,
+            start_method: str | None = None) -> tuple[SweepReport, int, int]:
+    """Run the points missing from OUTPUT/sweep.csv and append each as it finishes.
+
+    Returns the execution report, the number of points skipped (already in the file) and
+    the number of failed points in the whole sweep (recorded before or now).
+    ``start_method`` is how a LocalCluster starts its workers (``cluster.start_method``).
+    """
+    store = SweepStore(output, plan.parameters, [m.name for m in plan.job.metrics])
+    done = store.open()
+    store.write_description(plan.description())
+    todo = [(h, p) for h, p in plan.points if h not in done]
+    failed_before = sum(1 for h, _ in plan.points if done.get(h, OK) != OK)
+    bar = SweepProgress(len(todo), enabled=progress)
+
+    def record(h: str, point: Point, outcome: Outcome) -> None:
+        store.append(h, point, outcome.status, outcome.error, outcome.wall_s, outcome.values)
+        bar.update(outcome.status == OK)
+
+    try:
+        if not todo:
+            report = SweepReport()
+        else:
+            warm_up(plan.job, todo[0][1])
+            report = (run_serial(plan.job, todo, record) if serial
+                      else run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,
+                                    method=start_method))
+    finally:
+        bar.close()
+    return report, len(plan.points) - len(todo), failed_before + report.failed
+
+
+def stored_count(plan: SweepPlan, output: str | Path) -> int:
+    """How many of the plan's points OUTPUT/sweep.csv holds (finished, ok or failed)."""
+    try:
+        held = {row["point_hash"] for row in read_sweep(output)[1]}
+    except SweepError:
+        return 0
+    return sum(h in held for h, _ in plan.points)
+
+
+@dataclass
+class SweepSummary:
+    """What ``run_sweep`` did: the sweep's points, those run now (``report``), those already
+    in the file, the failed points of the whole sweep, and the file."""
+
+    points: int
+    report: SweepReport
+    skipped: int
+    failed: int
+    csv: Path
+    wall_s: float = 0.0
+    """Seconds from opening the file to the last row (the checks before excluded)."""
+
+
+class SweepInterrupted(KeyboardInterrupt):
+    """Ctrl-C stopped ``run_sweep``: ``stored`` of the ``total`` points are in ``csv``; the
+    same call runs the rest."""
+
+    def __init__(self, stored: int, total: int, csv: Path):
+        super().__init__(f"sweep interrupted: {stored} of {total} points are in {csv}")
+        self.stored, self.total, self.csv = stored, total, csv
+
+
+def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metric], output: str | Path, *,
+              t_end: str | None = None, workers: int | None = None, scheduler: str | None = None,
+              serial: bool = False, trust: bool = False, progress: bool = True,
+              axes: dict[str, Any] | None = None, origins: dict[str, str] | None = None,
+              start_method: str | None = None) -> SweepSummary:
+    """Run the diagram file at every point and append one row per run to OUTPUT/sweep.csv.
+
+    ``points``: dicts of ``block.param`` overrides, all naming the same parameters
+    (``points.grid_points``, ``random_points``, ``csv_points`` make them); ``metrics``:
+    ``"NAME=EXPR"`` texts (``metrics``) or parsed ``Metric`` objects, one column each;
+    ``t_end``: every run's end time as the CLI's ``--t-end`` takes it (default: the
+    diagram's). The points run on a new LocalCluster of ``workers`` processes (default:
+    one per core), on the workers of a running ``scheduler``, or in this process with
+    ``serial`` (or ``workers=0``). Points already in the file are skipped, so calling again resumes; a point
+    that fails is recorded as failed and the others go on. ``axes`` is recorded in
+    sweep.json; ``origins`` says how each parameter was given, for load errors.
+
+    Raises ``DiagramError`` or ``SweepError`` before anything runs when the sweep cannot
+    work, and ``SweepInterrupted`` on Ctrl-C, with only whole rows in the file.
+    """
+    plan = prepare(diagram, points, parse_metrics(metrics), t_end=None if t_end is None else str(t_end),
+                   trust=trust, axes=axes, origins=origins)
+    t0 = time.perf_counter()
+    try:
+        report, skipped, failed = execute(plan, output, workers=workers, scheduler=scheduler,
+                                          serial=serial or workers == 0, progress=progress,
+                                          start_method=start_method)
+    except KeyboardInterrupt:
+        raise SweepInterrupted(stored_count(plan, output), len(plan.points), Path(output) / SWEEP_CSV) from None
+    return SweepSummary(len(plan.points), report, skipped, failed, Path(output) / SWEEP_CSV,
+                        time.perf_counter() - t0)

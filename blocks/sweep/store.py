@@ -1,0 +1,125 @@
+"""The sweep's files: sweep.csv (one row per finished run, append-only) and sweep.json.
+
+Every row is written whole with one ``write`` on a file opened for appending, then
+flushed and fsynced, so an interrupted sweep (Ctrl-C, a killed process, a crash) leaves
+a file whose rows are all complete; a torn last line (a power cut mid-write) is cut off
+when the sweep is resumed. Resuming reads the hashes already present and runs only the
+points that are missing. Parameter cells hold the value as JSON; metric cells hold the
+number, or nothing when the event never happened or the run failed.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+from pathlib import Path
+from typing import Any, Sequence
+
+from ..atomic_file import write_atomically
+from .errors import SweepError
+
+SWEEP_CSV = "sweep.csv"
+SWEEP_JSON = "sweep.json"
+FIXED_COLUMNS = ("point_hash", "status", "error", "wall_s")
+OK, FAILED = "ok", "failed"
+
+
+def columns(parameters: Sequence[str], metrics: Sequence[str]) -> list[str]:
+    """The header: the fixed columns, then the parameters, then the metrics."""
+    return [*FIXED_COLUMNS, *parameters, *metrics]
+
+
+class SweepStore:
+    """Appends finished runs to DIR/sweep.csv; knows which points it already holds."""
+
+    def __init__(self, directory: str | Path, parameters: Sequence[str], metrics: Sequence[str]):
+        self.directory = Path(directory)
+        self.path = self.directory / SWEEP_CSV
+        self.parameters = list(parameters)
+        self.metrics = list(metrics)
+        self.header = columns(self.parameters, self.metrics)
+
+    def open(self) -> dict[str, str]:
+        """Prepare the file (header if new, torn tail cut) and return {hash: status} of the rows in it.
+
+        A file written by a different sweep (other parameters or metrics) is refused rather
+        than mixed, with a message naming both headers.
+        """
+        self.directory.mkdir(parents=True, exist_ok=True)
+        if not self.path.exists() or self.path.stat().st_size == 0:
+            self._append_text(_csv_line(self.header))
+            return {}
+        self._cut_torn_tail()
+        with open(self.path, newline="", encoding="utf-8") as f:
+            reader = csv.reader(f)
+            header = next(reader, None)
+            if header != self.header:
+                raise SweepError(f"{self.path} belongs to another sweep (columns {', '.join(header or [])}; "
+                                 f"this sweep writes {', '.join(self.header)}); use another -o folder")
+            return {row[0]: row[1] for row in reader if len(row) == len(self.header)}
+
+    def append(self, point_hash: str, point: dict[str, Any], status: str, error: str, wall_s: float,
+               values: dict[str, Any]) -> None:
+        """Append one finished run as a whole line, flushed and fsynced before returning."""
+        from .metrics import metric_value_text
+
+        row = [point_hash, status, " ".join(error.split()), f"{wall_s:.6g}"]
+        row += [json.dumps(point[p], default=str) for p in self.parameters]
+        row += [metric_value_text(values.get(m)) for m in self.metrics]
+        self._append_text(_csv_line(row))
+
+    def write_description(self, description: dict[str, Any]) -> Path:
+        """Write DIR/sweep.json atomically (a reader never sees half a file)."""
+        self.directory.mkdir(parents=True, exist_ok=True)
+        return write_atomically(self.directory / SWEEP_JSON, json.dumps(description, indent=2, default=str) + "\n")
+
+    def _append_text(self, text: str) -> None:
+        data = text.encode("utf-8")
+        fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        try:
+            written = os.write(fd, data)
+            while written < len(data):
+                written += os.write(fd, data[written:])
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+    def _cut_torn_tail(self) -> None:
+        with open(self.path, "rb+") as f:
+            data = f.read()
+            if data and not data.endswith(b"\n"):
+                f.truncate(data.rfind(b"\n") + 1)
+                f.flush()
+                os.fsync(f.fileno())
+
+
+def _csv_line(cells: Sequence[str]) -> str:
+    buf = io.StringIO()
+    csv.writer(buf, lineterminator="\n").writerow(cells)
+    return buf.getvalue()
+
+
+class NotASweep(SweepError):
+    """A folder without sweep.csv, where a finished sweep was expected."""
+
+    def __init__(self, directory: Path, expected: str = "the output folder of a sweep"):
+        super().__init__(f"{directory}: no {SWEEP_CSV} here; is this {expected}?")
+        self.directory = directory
+
+
+def read_sweep(directory: str | Path) -> tuple[dict[str, Any], list[dict[str, str]]]:
+    """sweep.json and the rows of sweep.csv (the last row per point wins)."""
+    directory = Path(directory)
+    csv_path, json_path = directory / SWEEP_CSV, directory / SWEEP_JSON
+    if not csv_path.is_file():
+        raise NotASweep(directory)
+    try:
+        description = json.loads(json_path.read_text(encoding="utf-8")) if json_path.is_file() else {}
+        with open(csv_path, newline="", encoding="utf-8") as f:
+            rows = [r for r in csv.DictReader(f) if None not in r.values() and None not in r]
+    except (OSError, ValueError) as exc:
+        raise SweepError(f"{directory}: cannot read the sweep: {exc}") from None
+    latest = {r["point_hash"]: r for r in rows}
+    return description, list(latest.values())

@@ -1,0 +1,191 @@
+"""Summaries of the paper's tasks: the numbers each task is judged by, from a run's Results.
+
+Every function takes the Results of a shipped task diagram and the names of its plant,
+reflex and controller blocks, so the same numbers serve the reproduction, the tests and,
+as the scalar measures of ``measures``, sweeps.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from blocks import Results
+
+SAFETY_RATIO = 0.6
+DROP_DISTANCE = 0.02
+"""An object that ends more than 2 cm below where it started has been dropped."""
+
+THUMB, FORE, MIDDLE = 0, 1, 2
+
+CONTACT_FADE = 0.005
+"""Seconds before a separation left out of the torque window: the contact force fades out
+over the last milliseconds and the reflex drops the finger, so its torque there says nothing
+about suppression."""
+
+
+@dataclass(frozen=True)
+class TaskBlocks:
+    """Names of the blocks a task diagram uses."""
+
+    plant: str = "plant"
+    reflex: str = "reflex"
+    manipulation: str = "manip"
+    suppresser: str = "suppress"
+
+
+def _signal(results: Results, name: str) -> tuple[np.ndarray, np.ndarray]:
+    try:
+        return results[name]
+    except KeyError as exc:
+        raise ValueError(f"the task needs the logged signal {exc}") from None
+
+
+def object_dropped(results: Results, b: TaskBlocks = TaskBlocks()) -> bool:
+    """Dropped: fewer than two fingers touch it at the end, or it fell by DROP_DISTANCE."""
+    _, contact = _signal(results, f"{b.plant}.contact")
+    _, obj = _signal(results, f"{b.plant}.obj")
+    return bool(contact[-1].sum() < 2 or obj[0, 1] - obj[-1, 1] > DROP_DISTANCE)
+
+
+def first_time(t: np.ndarray, condition: np.ndarray, after: float = -math.inf) -> float | None:
+    """First sample time after ``after`` where ``condition`` holds, or None."""
+    hits = np.flatnonzero(condition & (t > after))
+    return float(t[hits[0]]) if hits.size else None
+
+
+def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = TaskBlocks(),
+                  fingers: tuple[int, ...] = (THUMB, FORE), steady_window: float = 0.2,
+                  handover_time: float | None = None) -> dict:
+    """Peak |f_t|/f_n after the disturbance, when it is back under the safety ratio for
+    good, its maximum over the last ``steady_window`` seconds, how far the object moved,
+    and the peak while the fingers close (before ``handover_time``, when the support lets
+    the object go; None without one)."""
+    t, ratio = _signal(results, f"{b.plant}.ratio")
+    worst = ratio[:, list(fingers)].max(axis=1)
+    after = t >= disturbance_time
+    peak = float(worst[after].max())
+    above = np.flatnonzero(after & (worst > SAFETY_RATIO))
+    if above.size == 0:
+        recovery = 0.0
+    elif above[-1] + 1 < t.size:
+        recovery = float(t[above[-1] + 1] - disturbance_time)
+    else:
+        recovery = None
+    steady = t >= t[-1] - steady_window
+    t_obj, obj = _signal(results, f"{b.plant}.obj")
+    i0 = max(int(np.searchsorted(t_obj, disturbance_time)) - 1, 0)  # the last pose before the push
+    closing = t < handover_time if handover_time is not None else np.zeros(t.size, dtype=bool)
+    return {
+        "disturbance_time_s": float(disturbance_time),
+        "peak_ratio": peak,
+        "recovery_time_s": recovery,
+        "steady_ratio_max": float(worst[steady].max()),
+        "closing_peak_ratio": float(worst[closing].max()) if closing.any() else None,
+        "object_displacement_m": float(np.linalg.norm(obj[-1, :2] - obj[i0, :2])),
+        "object_dropped": object_dropped(results, b),
+    }
+
+
+def rigid_target(start_tips: np.ndarray, end_tips: np.ndarray, start_pose: np.ndarray) -> np.ndarray:
+    """The object pose that moves rigidly with two fingertips from ``start_tips`` (2, 2) to
+    ``end_tips``: the rotation of the line between them, then the matching translation."""
+    d0, d1 = start_tips[1] - start_tips[0], end_tips[1] - end_tips[0]
+    angle = math.atan2(d1[1], d1[0]) - math.atan2(d0[1], d0[0])
+    c, s = math.cos(angle), math.sin(angle)
+    rot = np.array([[c, -s], [s, c]])
+    centre = end_tips.mean(axis=0) + rot @ (start_pose[:2] - start_tips.mean(axis=0))
+    return np.array([centre[0], centre[1], start_pose[2] + angle])
+
+
+def manipulation_summary(results: Results, trajectories: dict, initial_pose: np.ndarray,
+                         b: TaskBlocks = TaskBlocks(), fingers: tuple[str, str] = ("thumb", "fore")) -> dict:
+    """Target pose implied by the two fingertip trajectories, the pose reached, the errors,
+    and the largest |f_t|/f_n once the grasp has settled (from the first waypoint on)."""
+    first = [np.asarray(trajectories[f]["waypoints"][0], dtype=float) for f in fingers]
+    last = [np.asarray(trajectories[f]["waypoints"][-1], dtype=float) for f in fingers]
+    target = rigid_target(np.array([w[1:3] for w in first]), np.array([w[1:3] for w in last]),
+                          np.asarray(initial_pose, dtype=float))
+    settle = min(w[0] for w in first)
+    t, ratio = _signal(results, f"{b.plant}.ratio")
+    _, obj = _signal(results, f"{b.plant}.obj")
+    final = obj[-1]
+    return {
+        "max_ratio_after_settle": float(ratio[t >= settle][:, [THUMB, FORE]].max()),
+        "target_pose": [float(v) for v in target],
+        "final_pose": [float(v) for v in final],
+        "position_error_m": float(np.linalg.norm(final[:2] - target[:2])),
+        "angle_error_rad": float(abs(final[2] - target[2])),
+        "object_dropped": object_dropped(results, b),
+    }
+
+
+def regrasp_events(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
+    """When the middle finger first touches the object, when the forefinger then lets go,
+    whether it stays off, and whether the object was dropped (from the contact flags)."""
+    t, contact = _signal(results, f"{b.plant}.contact")
+    middle = first_time(t, contact[:, MIDDLE] > 0)
+    separation = first_time(t, contact[:, FORE] == 0, after=middle) if middle is not None else None
+    return {
+        "middle_contact_time_s": middle,
+        "fore_separation_time_s": separation,
+        "fore_stays_off": bool(separation is not None and not contact[t > separation, FORE].any()),
+        "object_dropped": object_dropped(results, b),
+    }
+
+
+def holding_kept(results: Results, since: float | None, b: TaskBlocks = TaskBlocks()) -> float | None:
+    """The smallest share of its grasp torque that any joint of the holding fingers (thumb
+    and middle) kept through the suppresser from ``since`` on, over the samples where that
+    joint's grasp torque is at least a tenth of the largest among those joints; None
+    without such samples."""
+    if since is None:
+        return None
+    t, tau_g = _signal(results, f"{b.reflex}.tau_g")
+    _, applied = _signal(results, f"{b.suppresser}.tau_g_eff")
+    joints = [*range(3 * THUMB, 3 * THUMB + 3), *range(3 * MIDDLE, 3 * MIDDLE + 3)]
+    g, a = tau_g[t >= since][:, joints], applied[t >= since][:, joints]
+    large = np.abs(g) >= 0.1 * np.abs(g).max() if g.size and np.abs(g).max() > 0 else np.zeros(g.shape, bool)
+    return float((a[large] / g[large]).min()) if large.any() else None
+
+
+def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBlocks = TaskBlocks(),
+                    joint: int = 3 * FORE) -> dict:
+    """``regrasp_events``, ``holding_kept`` from the middle finger's first contact, and the
+    paper's Fig. 14 relation on the forefinger's ``joint`` (its MP joint by default) while it
+    withdraws: the applied grasp torque (``suppress.tau_g_eff``) at the start of the
+    withdrawal, its peak and its last value CONTACT_FADE before separation, and its
+    correlation with |tau_m| over that window (negative: the grasp torque falls as the
+    manipulation torque grows). ``withdrawal`` is the forefinger trajectory's (start, end)
+    time."""
+    events = regrasp_events(results, b)
+    t_g, tau_g = _signal(results, f"{b.suppresser}.tau_g_eff")
+    _signal(results, f"{b.manipulation}.tau_m")  # a clear error if it was not logged
+    held_m = np.abs(results.held(f"{b.manipulation}.tau_m", t_g)[:, joint])
+    separation = events["fore_separation_time_s"]
+    end = separation - CONTACT_FADE if separation is not None else math.inf
+    window = (t_g >= withdrawal[0]) & (t_g < end)
+    grasp, manipulation = tau_g[window, joint], held_m[window]
+    varied = grasp.size > 2 and np.ptp(grasp) > 0 and np.ptp(manipulation) > 0
+    return {
+        **events,
+        "holding_grasp_torque_kept": holding_kept(results, events["middle_contact_time_s"], b),
+        "withdrawal_start_s": float(withdrawal[0]),
+        "withdrawal_end_s": float(withdrawal[1]),
+        "fore_grasp_torque_at_withdrawal_Nm": float(grasp[0]) if grasp.size else None,
+        "fore_grasp_torque_peak_Nm": float(grasp.max()) if grasp.size else None,
+        "fore_grasp_torque_last_Nm": float(grasp[-1]) if grasp.size else None,
+        "fore_manipulation_torque_last_Nm": float(manipulation[-1]) if grasp.size else None,
+        "grasp_vs_manipulation_correlation": float(np.corrcoef(grasp, manipulation)[0, 1]) if varied else None,
+    }
+
+
+def regrasp_succeeded(summary: dict) -> bool:
+    """The re-grasp as the paper describes it: the middle finger touches, the forefinger
+    then lets go while it withdraws and stays off, and the object is not dropped."""
+    sep = summary["fore_separation_time_s"]
+    return (summary["middle_contact_time_s"] is not None and sep is not None
+            and summary["withdrawal_start_s"] <= sep <= summary["withdrawal_end_s"]
+            and summary["fore_stays_off"] and not summary["object_dropped"])

@@ -1,0 +1,66 @@
+"""Metric expressions: parsing, checking against a diagram, and the reducers on hand-made Results
+(measures have their own tests, in test_measures)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from blocks import Results, load_diagram
+from blocks.sweep import SweepError
+from blocks.sweep.metrics import parse_metric, parse_metrics
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def results() -> Results:
+    t = np.array([0.0, 0.1, 0.2, 0.3])
+    y = np.array([[0.0, 5.0], [2.0, 4.0], [3.0, 1.0], [1.0, 0.5]])
+    return Results({"plant.y": (t, y), "g.out": (t, y[:, :1])}, {"status": "complete"})
+
+
+@pytest.mark.parametrize("text, value", [
+    ("m=final(plant.y[1])", 0.5),
+    ("m=max(plant.y[0])", 3.0),
+    ("m=min(plant.y[1])", 0.5),
+    ("m=mean(plant.y[0])", 1.5),
+    ("m=final(g.out)", 1.0),
+    ("m=first_time_above(plant.y[0], 1.5)", 0.1),
+    ("m=first_time_below(plant.y[1], 2)", 0.2),
+    ("m=first_time_above(plant.y[0], 10)", None),
+])
+def test_reducers(text, value):
+    assert parse_metric(text).evaluate(results(), None) == value
+
+
+@pytest.mark.parametrize("text, message", [
+    ("final(plant.y)", "expected NAME="),
+    ("m=median(plant.y)", "unknown reducer or measure 'median'"),
+    ("m=final(plant)", "not a signal"),
+    ("m=first_time_above(plant.y[0])", "takes 2 argument"),
+    ("m=first_time_above(plant.y[0], abc)", "not a number"),
+    ("m=final(plant.y[-1])", "must be 0 or more"),
+])
+def test_bad_metrics_are_refused(text, message):
+    with pytest.raises(SweepError, match=message):
+        parse_metric(text)
+
+
+def test_duplicate_names_are_refused():
+    with pytest.raises(SweepError, match="used twice"):
+        parse_metrics(["a=final(plant.y)", "a=max(plant.y)"])
+
+
+@pytest.mark.parametrize("text, message", [
+    ("m=final(nope.y)", "no block named 'nope'"),
+    ("m=final(plant.z)", "has no output 'z'"),
+    ("m=final(prop.y)", "not logged"),
+    ("m=final(plant.y[1])", "out of range"),
+])
+def test_metrics_are_checked_against_the_diagram(text, message):
+    diagram = load_diagram(ROOT / "diagrams" / "toy.yaml")
+    parse_metric("ok=final(plant.y)").check(diagram)
+    with pytest.raises(SweepError, match=message):
+        parse_metric(text).check(diagram)
