@@ -286,28 +286,3 @@ def _init_parameters(init) -> dict[str, inspect.Parameter]:
     return {name: p for name, p in sig.parameters.items()
             if name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
 
-
-def as_vector(value: Any, name: str) -> Signal:
-    """A parameter as a 1-D float64 array (a scalar becomes width 1)."""
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim == 0:
-        arr = arr.reshape(1)
-    if arr.ndim != 1:
-        raise ValueError(f"parameter '{name}' must be a scalar or a vector, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"parameter '{name}' must be finite")
-    return arr
-
-
-def as_matrix(value: Any, name: str) -> np.ndarray:
-    """A parameter as a 2-D float64 array (a scalar becomes 1x1, a list a row)."""
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim == 0:
-        arr = arr.reshape(1, 1)
-    elif arr.ndim == 1:
-        arr = arr.reshape(1, -1)
-    if arr.ndim != 2:
-        raise ValueError(f"parameter '{name}' must be a matrix, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"parameter '{name}' must be finite")
-    return arr

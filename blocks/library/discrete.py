@@ -7,7 +7,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from blocks.block import Block, Signal, as_vector
+from blocks.arrays import float_array
+from blocks.block import Block, Signal
 
 
 class UnitDelay(Block):
@@ -19,9 +20,7 @@ class UnitDelay(Block):
     }
 
     def __init__(self, initial: Any = 0.0, width: int | None = None):
-        self.initial = as_vector(initial, "initial")
-        if self.initial.size == 0:
-            raise ValueError("parameter 'initial' must not be empty")
+        self.initial = float_array(initial, "initial", ndim=1, allow_empty=False)
         if width is not None:
             try:
                 width = operator.index(width)

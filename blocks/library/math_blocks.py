@@ -7,25 +7,12 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from blocks.arrays import float_array
 from blocks.block import Block, Signal
 
 # Python-float scalars cost an extra conversion inside every ufunc call; 0-d arrays
 # multiply and compare against a small vector about a third faster, so scalar
 # parameters are stored as 0-d float64 arrays.
-
-
-def _real_array(value: Any, name: str, allow_inf: bool = False) -> np.ndarray:
-    """A parameter as a float64 array, rejecting NaN (and infinities unless allowed)."""
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter '{name}' must be numeric, got {value!r}") from None
-    bad = np.isnan(arr) if allow_inf else ~np.isfinite(arr)
-    if np.any(bad):
-        raise ValueError(f"parameter '{name}' must be {'not NaN' if allow_inf else 'finite'}")
-    if arr.size == 0:
-        raise ValueError(f"parameter '{name}' must not be empty")
-    return arr
 
 
 class Gain(Block):
@@ -36,7 +23,7 @@ class Gain(Block):
     }
 
     def __init__(self, k: Any = 1.0):
-        arr = _real_array(k, "k")
+        arr = float_array(k, "k", allow_empty=False)
         if arr.ndim > 2:
             raise ValueError(f"parameter 'k' must be a scalar, vector or matrix, got shape {arr.shape}")
         self.k = arr
@@ -161,8 +148,8 @@ class Saturation(Block):
     }
 
     def __init__(self, lower: Any = -1.0, upper: Any = 1.0):
-        lo = _real_array(lower, "lower", allow_inf=True)
-        hi = _real_array(upper, "upper", allow_inf=True)
+        lo = float_array(lower, "lower", allow_inf=True, allow_empty=False)
+        hi = float_array(upper, "upper", allow_inf=True, allow_empty=False)
         for name, arr in (("lower", lo), ("upper", hi)):
             if arr.ndim > 1:
                 raise ValueError(f"parameter '{name}' must be a scalar or a vector, got shape {arr.shape}")

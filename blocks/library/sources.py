@@ -7,7 +7,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from blocks.block import Block, Signal, as_vector
+from blocks.arrays import float_array
+from blocks.block import Block, Signal
 
 
 def _finite_scalar(value: Any, name: str) -> float:
@@ -26,10 +27,7 @@ def broadcast_vectors(**params: Any) -> dict[str, Signal]:
 
     Raises ValueError naming the parameters when two of them have different widths > 1.
     """
-    vectors = {name: as_vector(value, name) for name, value in params.items()}
-    for name, v in vectors.items():
-        if v.size == 0:
-            raise ValueError(f"parameter '{name}' must not be empty")
+    vectors = {name: float_array(value, name, ndim=1, allow_empty=False) for name, value in params.items()}
     widths = {name: v.size for name, v in vectors.items() if v.size != 1}
     if len(set(widths.values())) > 1:
         desc = ", ".join(f"'{n}' has width {w}" for n, w in widths.items())
@@ -44,9 +42,7 @@ class Constant(Block):
     param_docs = {"value": "the output value, a scalar or a vector"}
 
     def __init__(self, value: Any):
-        self.value = as_vector(value, "value")
-        if self.value.size == 0:
-            raise ValueError("parameter 'value' must not be empty")
+        self.value = float_array(value, "value", ndim=1, allow_empty=False)
         self.inputs = {}
         self.outputs = {"y": self.value.size}
         self.feedthrough = False
