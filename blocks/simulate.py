@@ -25,7 +25,8 @@ from typing import Any, Callable
 import numpy as np
 
 from .block import BlockError, EndRun
-from .diagram import Diagram, DiagramError
+from .diagram import Diagram
+from .issues import DiagramError
 from .results import Results
 from .schedule import EventProgram, Schedule, build_schedule, final_program
 from .timebase import DurationError, format_duration, parse_duration
