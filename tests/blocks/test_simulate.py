@@ -329,6 +329,27 @@ log: [b.y]
     np.testing.assert_allclose(simulate(diagram)["b.y"][1], simulate(reference)["b.y"][1], rtol=1e-12)
 
 
+def test_every_advance_chunk_starts_at_its_exact_tick_time():
+    """A span of several ADVANCE_CHUNK hits: each chunk gets ``k * base_tick`` of its first
+    tick, computed from the integer k (adding up chunks of 4096 periods of 0.1 ms in
+    floats gives 1.2288000000000001 s, not 1.2288 s, for the fourth chunk)."""
+    from blocks.simulate import ADVANCE_CHUNK
+
+    r = run(f"""
+time: {{t_end: 1.6384 s}}
+blocks:
+  one: {{type: Constant, params: {{value: 1.0}}}}
+  acc: {{type: "{DEFS}:ChunkStart", period: 0.1 ms}}
+connections: [one.y -> acc.u]
+log: [acc.y]
+""")
+    t, y = r["acc.y"]
+    hits = np.arange(1, len(t))
+    first_tick = (hits - 1) // ADVANCE_CHUNK * ADVANCE_CHUNK
+    assert len(t) == 4 * ADVANCE_CHUNK + 1
+    assert [float(y[i, 0]) for i in hits] == [int(k) / 10000 for k in first_tick]
+
+
 def test_an_interrupt_inside_one_long_advance_span_records_the_time_reached():
     """No other block fires after t = 0, so the whole run is one advance span, made of
     chunks of ADVANCE_CHUNK hits; Ctrl-C in the third chunk stops it after two."""
