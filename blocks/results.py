@@ -142,6 +142,10 @@ class Results:
     def write_files(self, folder: Path, csv: bool = False) -> None:
         """Write signals.npz, run.json (and signals.csv) into ``folder`` as they are: the
         staging folder of ``results_folder.writing``, which makes them one set."""
+        for name, (_, v) in self.signals.items():
+            if np.ndim(v) != 2:
+                raise ValueError(f"signal '{name}' cannot be saved: its values must be an array of "
+                                 f"shape (samples, width), got shape {np.shape(v)}")
         arrays = {}
         for name, (t, v) in self.signals.items():
             arrays[name] = v
