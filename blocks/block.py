@@ -95,7 +95,9 @@ class Block:
     - ``time_varying``: the outputs depend on ``t`` itself (sources such as Step).
 
     and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
-    Parameters are the keyword arguments of ``__init__``; ``param_docs`` documents them.
+    Parameters are the keyword arguments of ``__init__``, with their defaults; the
+    ``Parameters`` section (numpydoc) of the class docstring documents them, which
+    ``hierhand blocks`` shows (see ``blocks.paramdocs``).
 
     Block references. A parameter named in ``block_params`` takes another block of the
     same diagram, as Drake's controllers take the ``MultibodyPlant`` they model: in the
@@ -108,6 +110,8 @@ class Block:
 
     type_name: ClassVar[str | None] = None
     param_docs: ClassVar[dict[str, str]] = {}
+    """Parameter -> description: the older way to document parameters, still honoured
+    (its entries win over the docstring's); write a ``Parameters`` section instead."""
     path_params: ClassVar[tuple[str, ...]] = ()
     """Parameters holding file paths: the loader resolves relative ones against the
     diagram's folder, as it does ``params_file``."""

@@ -251,16 +251,24 @@ class _LinearBlock(Block):
 
 
 class DiscreteStateSpace(_LinearBlock):
-    """Discrete state-space model x[k+1] = A x + B u, y = C x + D u (optionally from continuous)."""
+    """Discrete state-space model x[k+1] = A x + B u, y = C x + D u (optionally from continuous).
 
-    param_docs = {
-        "A": "state matrix, n x n",
-        "B": "input matrix, n x m (a length-n list is taken as a column)",
-        "C": "output matrix, p x n",
-        "D": "feedthrough matrix, p x m; omitted means zero (no feedthrough)",
-        "x0": "initial state, n entries (of the continuous model when method is given); default zeros",
-        "method": "None if A, B, C, D are discrete; 'zoh' or 'tustin' to discretise a continuous model at the block period",
-    }
+    Parameters
+    ----------
+    A : matrix
+        state matrix, n x n
+    B : matrix
+        input matrix, n x m (a length-n list is taken as a column)
+    C : matrix
+        output matrix, p x n
+    D : matrix
+        feedthrough matrix, p x m; omitted means zero (no feedthrough)
+    x0 : vector
+        initial state, n entries (of the continuous model when method is given); default zeros
+    method : {None, 'zoh', 'tustin'}
+        None if A, B, C, D are discrete; 'zoh' or 'tustin' to discretise a continuous model
+        at the block period
+    """
 
     def __init__(self, A: Any, B: Any, C: Any, D: Any = None, x0: Any = None,
                  method: str | None = None):
@@ -270,14 +278,20 @@ class DiscreteStateSpace(_LinearBlock):
 
 
 class DiscreteTransferFunction(_LinearBlock):
-    """Single-input single-output transfer function num(z)/den(z) (or num(s)/den(s) with method)."""
+    """Single-input single-output transfer function num(z)/den(z) (or num(s)/den(s) with method).
 
-    param_docs = {
-        "num": "numerator coefficients, highest power first",
-        "den": "denominator coefficients, highest power first; degree >= numerator degree",
-        "method": "None if num/den are in z; 'zoh' or 'tustin' to discretise num(s)/den(s) at the block period",
-        "x0": "initial state of the controllable canonical realisation (denominator degree entries); default zeros",
-    }
+    Parameters
+    ----------
+    num : vector
+        numerator coefficients, highest power first
+    den : vector
+        denominator coefficients, highest power first; degree >= numerator degree
+    method : {None, 'zoh', 'tustin'}
+        None if num/den are in z; 'zoh' or 'tustin' to discretise num(s)/den(s) at the block period
+    x0 : vector
+        initial state of the controllable canonical realisation (denominator degree entries);
+        default zeros
+    """
 
     def __init__(self, num: Any, den: Any, method: str | None = None, x0: Any = None):
         method = _check_method(method)

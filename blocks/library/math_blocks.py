@@ -16,11 +16,13 @@ from blocks.block import Block, Signal
 
 
 class Gain(Block):
-    """Multiplies the input by ``k``: scalar, elementwise vector, or matrix (y = K @ u)."""
+    """Multiplies the input by ``k``: scalar, elementwise vector, or matrix (y = K @ u).
 
-    param_docs = {
-        "k": "gain: a scalar (any width), a vector (elementwise) or a matrix (y = K @ u)",
-    }
+    Parameters
+    ----------
+    k : scalar, vector or matrix
+        gain: a scalar (any width), a vector (elementwise) or a matrix (y = K @ u)
+    """
 
     def __init__(self, k: Any = 1.0):
         arr = float_array(k, "k", allow_empty=False)
@@ -114,11 +116,13 @@ _SUM_KERNELS: dict[str, Callable[[Mapping[str, Signal]], Signal]] = {
 
 
 class Sum(Block):
-    """Signed sum of the inputs ``u0, u1, ...``, one sign character per input."""
+    """Signed sum of the inputs ``u0, u1, ...``, one sign character per input.
 
-    param_docs = {
-        "signs": "one '+' or '-' per input, in port order u0, u1, ... (e.g. '+-' gives u0 - u1)",
-    }
+    Parameters
+    ----------
+    signs : str
+        one '+' or '-' per input, in port order u0, u1, ... (e.g. '+-' gives u0 - u1)
+    """
 
     def __init__(self, signs: str = "++"):
         if not isinstance(signs, str) or not signs or set(signs) - {"+", "-"}:
@@ -140,12 +144,15 @@ class Sum(Block):
 
 
 class Saturation(Block):
-    """Clips the input to ``[lower, upper]`` elementwise."""
+    """Clips the input to ``[lower, upper]`` elementwise.
 
-    param_docs = {
-        "lower": "lower limit, a scalar (any width) or a vector; -inf for no lower limit",
-        "upper": "upper limit, a scalar (any width) or a vector; inf for no upper limit",
-    }
+    Parameters
+    ----------
+    lower : scalar or vector
+        lower limit, a scalar applying to any width; -inf for no lower limit
+    upper : scalar or vector
+        upper limit, a scalar applying to any width; inf for no upper limit
+    """
 
     def __init__(self, lower: Any = -1.0, upper: Any = 1.0):
         lo = float_array(lower, "lower", allow_inf=True, allow_empty=False)

@@ -37,9 +37,13 @@ def broadcast_vectors(**params: Any) -> dict[str, Signal]:
 
 
 class Constant(Block):
-    """Outputs a fixed value at every hit."""
+    """Outputs a fixed value at every hit.
 
-    param_docs = {"value": "the output value, a scalar or a vector"}
+    Parameters
+    ----------
+    value : scalar or vector
+        the output value
+    """
 
     def __init__(self, value: Any):
         self.value = float_array(value, "value", ndim=1, allow_empty=False)
@@ -52,13 +56,17 @@ class Constant(Block):
 
 
 class Step(Block):
-    """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time)."""
+    """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time).
 
-    param_docs = {
-        "time": "switching time in seconds; the output is 'after' from this time on",
-        "before": "output before the switching time, a scalar or a vector",
-        "after": "output from the switching time on, a scalar or a vector",
-    }
+    Parameters
+    ----------
+    time : float
+        switching time in seconds; the output is 'after' from this time on
+    before : scalar or vector
+        output before the switching time
+    after : scalar or vector
+        output from the switching time on
+    """
     time_varying = True
 
     def __init__(self, time: float, before: Any = 0.0, after: Any = 1.0):
@@ -74,13 +82,17 @@ class Step(Block):
 
 
 class Ramp(Block):
-    """Outputs ``initial + slope * max(0, t - start)``: flat until ``start``, then linear."""
+    """Outputs ``initial + slope * max(0, t - start)``: flat until ``start``, then linear.
 
-    param_docs = {
-        "slope": "rate of change after the start time (units per second), scalar or vector",
-        "start": "time in seconds at which the ramp starts rising",
-        "initial": "output value up to the start time, scalar or vector",
-    }
+    Parameters
+    ----------
+    slope : scalar or vector
+        rate of change after the start time (units per second)
+    start : float
+        time in seconds at which the ramp starts rising
+    initial : scalar or vector
+        output value up to the start time
+    """
     time_varying = True
 
     def __init__(self, slope: Any = 1.0, start: float = 0.0, initial: Any = 0.0):
