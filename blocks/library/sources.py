@@ -2,24 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any, Mapping
 
 import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, Signal
-
-
-def _finite_scalar(value: Any, name: str) -> float:
-    """A parameter that must be one finite real number."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter '{name}' must be a finite scalar, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"parameter '{name}' must be a finite scalar, got {value!r}")
-    return x
 
 
 def broadcast_vectors(**params: Any) -> dict[str, Signal]:
@@ -70,7 +58,7 @@ class Step(Block):
     time_varying = True
 
     def __init__(self, time: float, before: Any = 0.0, after: Any = 1.0):
-        self.time = _finite_scalar(time, "time")
+        self.time = float(float_array(time, "time", ndim=0))
         vectors = broadcast_vectors(before=before, after=after)
         self.before, self.after = vectors["before"], vectors["after"]
         self.inputs = {}
@@ -96,7 +84,7 @@ class Ramp(Block):
     time_varying = True
 
     def __init__(self, slope: Any = 1.0, start: float = 0.0, initial: Any = 0.0):
-        self.start = _finite_scalar(start, "start")
+        self.start = float(float_array(start, "start", ndim=0))
         vectors = broadcast_vectors(slope=slope, initial=initial)
         self.slope, self.initial = vectors["slope"], vectors["initial"]
         self.inputs = {}

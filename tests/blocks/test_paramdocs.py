@@ -87,7 +87,8 @@ def test_the_section_ends_at_a_line_that_is_no_entry():
 
 
 def test_param_docs_still_win_and_subclasses_inherit_what_they_do_not_document():
-    assert parameter_docs(Legacy) == {"a": ParamDoc("", "from param_docs"), "b": ParamDoc("int", "from the docstring too")}
+    assert parameter_docs(Legacy) == {"a": ParamDoc("", "from param_docs"),
+                                      "b": ParamDoc("int", "from the docstring too")}
     refined = parameter_docs(Refined)
     assert refined["gain"] == ParamDoc("int", "a whole gain")
     assert refined["lo"] == ParamDoc("scalar or vector", "the limits")
