@@ -5,7 +5,9 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``simula
 """
 
 from .block import Block, BlockError, EndRun, ParameterError
-from .diagram import Diagram, DiagramError, Issue, load_diagram, loads_diagram
+from .diagram import Diagram
+from .issues import DiagramError, Issue
+from .load import load_diagram, loads_diagram
 from .results import Results, ResultsError
 from .schedule import Schedule, build_schedule
 from .simulate import SimulationError, StopRequest, simulate

@@ -95,7 +95,9 @@ class Block:
     - ``time_varying``: the outputs depend on ``t`` itself (sources such as Step).
 
     and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
-    Parameters are the keyword arguments of ``__init__``; ``param_docs`` documents them.
+    Parameters are the keyword arguments of ``__init__``, with their defaults; the
+    ``Parameters`` section (numpydoc) of the class docstring documents them, which
+    ``hierhand blocks`` shows (see ``blocks.paramdocs``).
 
     Block references. A parameter named in ``block_params`` takes another block of the
     same diagram, as Drake's controllers take the ``MultibodyPlant`` they model: in the
@@ -108,6 +110,8 @@ class Block:
 
     type_name: ClassVar[str | None] = None
     param_docs: ClassVar[dict[str, str]] = {}
+    """Parameter -> description: the older way to document parameters, still honoured
+    (its entries win over the docstring's); write a ``Parameters`` section instead."""
     path_params: ClassVar[tuple[str, ...]] = ()
     """Parameters holding file paths: the loader resolves relative ones against the
     diagram's folder, as it does ``params_file``."""
@@ -286,28 +290,3 @@ def _init_parameters(init) -> dict[str, inspect.Parameter]:
     return {name: p for name, p in sig.parameters.items()
             if name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
 
-
-def as_vector(value: Any, name: str) -> Signal:
-    """A parameter as a 1-D float64 array (a scalar becomes width 1)."""
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim == 0:
-        arr = arr.reshape(1)
-    if arr.ndim != 1:
-        raise ValueError(f"parameter '{name}' must be a scalar or a vector, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"parameter '{name}' must be finite")
-    return arr
-
-
-def as_matrix(value: Any, name: str) -> np.ndarray:
-    """A parameter as a 2-D float64 array (a scalar becomes 1x1, a list a row)."""
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim == 0:
-        arr = arr.reshape(1, 1)
-    elif arr.ndim == 1:
-        arr = arr.reshape(1, -1)
-    if arr.ndim != 2:
-        raise ValueError(f"parameter '{name}' must be a matrix, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"parameter '{name}' must be finite")
-    return arr

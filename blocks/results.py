@@ -22,6 +22,20 @@ from .results_folder import RUN_JSON, SIGNALS_CSV, SIGNALS_NPZ, reading, writing
 TIME_PREFIX = "time:"
 
 
+def held_index(t: np.ndarray, times, rtol: float = 0.0) -> np.ndarray:
+    """Zero-order hold: for each of ``times``, the index into the sample times ``t`` of the
+    last sample at or before it (-1 if there is none).
+
+    With ``rtol``, a sample up to ``rtol * max(1, max |times|)`` after a time counts as at
+    it: times computed in floats (a frame every 1/25 s) that stand for sample times land
+    on those samples rather than one sample short.
+    """
+    times = np.asarray(times, dtype=float)
+    if rtol:
+        times = times + rtol * max(1.0, float(np.abs(times).max(initial=0.0)))
+    return np.searchsorted(t, times, side="right") - 1
+
+
 class ResultsError(Exception):
     """A results folder that cannot be read."""
 
@@ -99,19 +113,19 @@ class Results:
         found = re.match(r"\w+ at t=([-+0-9.eE]+) s", self.status)
         return float(found.group(1)) if found else None
 
-    def held(self, name: str, times: np.ndarray) -> np.ndarray:
+    def held(self, name: str, times: np.ndarray, rtol: float = 0.0) -> np.ndarray:
         """The signal's held (zero-order hold) values at each of ``times`` (one row per
-        time), NaN before its first sample."""
+        time), NaN before its first sample; ``rtol`` as in ``held_index``."""
         t, v = self[name]
-        idx = np.searchsorted(t, times, side="right") - 1
+        idx = held_index(t, times, rtol)
         if not len(t):
-            return np.full((len(times), v.shape[1]), np.nan)
+            return np.full((len(idx), v.shape[1]), np.nan)
         return np.where((idx >= 0)[:, None], v[np.clip(idx, 0, None)], np.nan)
 
     def value_at(self, name: str, t: float) -> np.ndarray:
         """The held (zero-order hold) value of a signal at time ``t``."""
         times, values = self[name]
-        i = np.searchsorted(times, t, side="right") - 1
+        i = int(held_index(times, [t])[0])
         if i < 0:
             raise ValueError(f"signal '{name}' has no sample at or before t = {t}")
         return values[i]
@@ -128,6 +142,10 @@ class Results:
     def write_files(self, folder: Path, csv: bool = False) -> None:
         """Write signals.npz, run.json (and signals.csv) into ``folder`` as they are: the
         staging folder of ``results_folder.writing``, which makes them one set."""
+        for name, (_, v) in self.signals.items():
+            if np.ndim(v) != 2:
+                raise ValueError(f"signal '{name}' cannot be saved: its values must be an array of "
+                                 f"shape (samples, width), got shape {np.shape(v)}")
         arrays = {}
         for name, (t, v) in self.signals.items():
             arrays[name] = v

@@ -23,6 +23,7 @@ Everything that can be decided before a run is decided here, once:
 from __future__ import annotations
 
 import math
+import weakref
 from collections import deque
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -32,7 +33,8 @@ from typing import NamedTuple
 import networkx as nx
 import numpy as np
 
-from .diagram import Connection, Diagram, DiagramError, Issue
+from .diagram import Connection, Diagram
+from .issues import DiagramError, Issue
 from .timebase import format_duration, fraction_gcd
 
 MAX_HYPERPERIOD_TICKS = 10_000_000
@@ -146,14 +148,25 @@ class Schedule:
         return "inherited" + (", lazy" if block in self.lazy else "")
 
 
+_plans: dict[int, dict[Fraction | None, Schedule]] = {}
+"""Schedules already built: by diagram (its id, while it lives), then by end time."""
+
+
 def build_schedule(diagram: Diagram, t_end: Fraction | None) -> Schedule:
     """Plan a run of ``diagram`` to ``t_end`` (None: check everything that does not need it).
 
-    A Diagram is not changed after loading, so its plans are kept on it by end time.
+    A Diagram is not changed after loading, so a plan once built is kept for the next
+    call with the same end time (loading plans a diagram, then ``simulate``, ``validate``
+    and sweeps ask again). The plans are held here, not on the Diagram, which stays pure
+    data; they go when their diagram is garbage collected.
     """
-    plan = diagram.plans.get(t_end)
+    plans = _plans.get(id(diagram))
+    if plans is None:
+        plans = _plans[id(diagram)] = {}
+        weakref.finalize(diagram, _plans.pop, id(diagram), None)
+    plan = plans.get(t_end)
     if plan is None:
-        plan = diagram.plans[t_end] = _Planner(diagram).plan(t_end)
+        plan = plans[t_end] = _Planner(diagram).plan(t_end)
     return plan
 
 

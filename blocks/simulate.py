@@ -25,7 +25,8 @@ from typing import Any, Callable
 import numpy as np
 
 from .block import BlockError, EndRun
-from .diagram import Diagram, DiagramError
+from .diagram import Diagram
+from .issues import DiagramError
 from .results import Results
 from .schedule import EventProgram, Schedule, build_schedule, final_program
 from .timebase import DurationError, format_duration, parse_duration
@@ -211,7 +212,7 @@ class _Run:
             for op in samples:
                 op()
             for op in advances:
-                op(k, t, next_k)
+                op(k, next_k)
 
         return run
 
@@ -277,12 +278,15 @@ class _Run:
         return op
 
     def advance_op(self, name: str, last: bool):
-        """Steps ``name`` to the next event in chunks. An interrupt in the span records how
-        far the last advanced block of the event got (the earlier ones are further, the
-        later ones still at the event): every block was computed up to there."""
+        """Steps ``name`` to the next event in chunks, each from the time of its first
+        tick (``tick * base_tick``, as at events, never a sum of periods). An interrupt in
+        the span records how far the last advanced block of the event got (the earlier
+        ones are further, the later ones still at the event): every block was computed
+        up to there."""
         blk = self.d.blocks[name].block
         advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
-        period, dt = self.s.period_ticks[name], float(blk.period)
+        period = self.s.period_ticks[name]
+        num, den = self.s.base_tick.numerator, self.s.base_tick.denominator
         ports = tuple(blk.outputs)
         by_port: dict[str, list[tuple[dict, str]]] = {}
         for d, dp, sp in self.hold_targets(name, ports) + self.fanout[name]:
@@ -291,20 +295,19 @@ class _Run:
         loggers = [(lg.add_rows, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
         checked, key = self.checked, name + ":advance"
 
-        def op(k: int, t: float, next_k: int) -> None:
+        def op(k: int, next_k: int) -> None:
             n = (next_k - k) // period
             done = 0
             try:
                 while n > 0:
                     m = n if n <= ADVANCE_CHUNK else ADVANCE_CHUNK
-                    states[i], rows = advance(t, states[i], inp, m)
+                    states[i], rows = advance((k + done * period) * num / den, states[i], inp, m)
                     if key not in checked:
                         self.check_rows(name, rows, ports, m)
                     for add, p in loggers:
                         add(rows[p])
                     n -= m
                     done += m
-                    t += m * dt
                 for p, dests in targets:
                     value = rows[p][-1]
                     for d, dp in dests:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import inspect
 
 from .block import Block
+from .paramdocs import parameter_docs
 
 
 def summary(cls: type[Block]) -> str:
@@ -19,14 +20,16 @@ def describe_type(cls: type[Block]) -> str:
     if summary(cls):
         lines.append(f"  {summary(cls)}")
     params = cls.parameters()
+    docs = parameter_docs(cls)
     if params:
         lines.append("  parameters:")
         for name, p in params.items():
-            default = "required" if p.default is p.empty else f"default {p.default!r}"
+            doc = docs.get(name)
+            notes = [doc.type] if doc is not None and doc.type else []
+            notes.append("required" if p.default is p.empty else f"default {p.default!r}")
             if name in cls.block_params:
-                default += "; the name of another block of the diagram"
-            doc = cls.param_docs.get(name, "")
-            lines.append(f"    {name} ({default})" + (f": {doc}" if doc else ""))
+                notes.append("the name of another block of the diagram")
+            lines.append(f"    {name} ({'; '.join(notes)})" + (f": {doc.text}" if doc is not None and doc.text else ""))
     try:
         block = cls.example()
     except Exception:

@@ -20,10 +20,14 @@ from typing import Any
 
 import numpy as np
 
+from blocks.results import held_index
+
 __all__ = ["AnimationError", "animate_run"]
 
 MAX_FRAMES = 1000
 ARROW_SIGNALS = ("fn", "ft", "normal")
+HOLD_RTOL = 1e-9
+"""Frame times are sums of float steps: a sample this close (relative) after one is at it."""
 
 
 class AnimationError(ValueError):
@@ -149,41 +153,33 @@ def _frame_indices(t_q: np.ndarray, fps: float, speed: float, every: int | None,
         idx = np.arange(0, n, every)
     else:
         targets = t_q[0] + step * np.arange(count)
-        tol = 1e-9 * max(1.0, abs(float(t_q[-1])))
-        idx = np.clip(np.searchsorted(t_q, targets + tol, side="right") - 1, 0, n - 1)
+        idx = np.clip(held_index(t_q, targets, HOLD_RTOL), 0, n - 1)
     if idx[-1] != n - 1:
         idx = np.append(idx, n - 1)  # always end on the final state
     return idx
 
 
-def _held_indices(t: np.ndarray, times: np.ndarray) -> np.ndarray:
-    """Zero-order hold: the last sample at or before each time (-1 if none)."""
-    tol = 1e-9 * max(1.0, float(np.abs(times).max(initial=0.0)))
-    return np.searchsorted(t, times + tol, side="right") - 1
-
-
 def _held(results, name: str, times: np.ndarray, required: bool = False) -> np.ndarray:
+    """The signal's values held at the frame times (it is sampled with q, so it has a
+    sample at or before every frame)."""
     plant, port = name.rsplit(".", 1)
-    t, v = _signal(results, plant, port, required=required)
+    t, _ = _signal(results, plant, port, required=required)
     if not len(t):
         raise AnimationError(f"signal '{name}' has no samples")
-    return v[np.clip(_held_indices(t, times), 0, None)]  # before its first sample: the first
+    return results.held(name, times, HOLD_RTOL)
 
 
 def _forces(results, plant: str, hand, q: np.ndarray, times: np.ndarray) -> np.ndarray | None:
     """(frames, 3, 4): per finger where its force on the object acts and the force; None
     without ``fn`` and ``normal`` logged. Fingers with no sample yet get NaN (no arrow)."""
-    sig = {port: _signal(results, plant, port) for port in ARROW_SIGNALS}
-    if sig["fn"] is None or sig["normal"] is None:
+    logged = {port for port in ARROW_SIGNALS if f"{plant}.{port}" in results}
+    if not {"fn", "normal"} <= logged:
         return None
 
     def held(port: str, width: int) -> np.ndarray:
-        if sig[port] is None:
+        if port not in logged:
             return np.zeros((len(times), width))
-        t, v = sig[port]
-        i = _held_indices(t, times)
-        out = v[np.clip(i, 0, None)] if len(t) else np.zeros((len(times), width))
-        return np.where((i >= 0)[:, None], out, np.nan)
+        return results.held(f"{plant}.{port}", times, HOLD_RTOL)
 
     fn = held("fn", 3)
     ft = held("ft", 3)

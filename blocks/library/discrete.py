@@ -7,21 +7,23 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from blocks.block import Block, Signal, as_vector
+from blocks.arrays import float_array
+from blocks.block import Block, Signal
 
 
 class UnitDelay(Block):
-    """Delays its input by one sample: outputs the input of the previous hit (z^-1)."""
+    """Delays its input by one sample: outputs the input of the previous hit (z^-1).
 
-    param_docs = {
-        "initial": "output at the first hit, a scalar (repeated to the width) or a vector",
-        "width": "signal width; omit to take it from a vector 'initial' or from the connections",
-    }
+    Parameters
+    ----------
+    initial : scalar or vector
+        output at the first hit; a scalar is repeated to the width
+    width : int
+        signal width; omit to take it from a vector 'initial' or from the connections
+    """
 
     def __init__(self, initial: Any = 0.0, width: int | None = None):
-        self.initial = as_vector(initial, "initial")
-        if self.initial.size == 0:
-            raise ValueError("parameter 'initial' must not be empty")
+        self.initial = float_array(initial, "initial", ndim=1, allow_empty=False)
         if width is not None:
             try:
                 width = operator.index(width)
@@ -61,8 +63,6 @@ class UnitDelay(Block):
 
 class ZeroOrderHold(Block):
     """Samples its input at its own period and holds it in between (y = u at each hit)."""
-
-    param_docs: dict[str, str] = {}
 
     def __init__(self):
         self.inputs = {"u": None}

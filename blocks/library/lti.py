@@ -16,7 +16,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from blocks.block import Block, BlockError, Signal, as_matrix, as_vector
+from blocks.arrays import float_array
+from blocks.block import Block, BlockError, Signal
 
 METHODS = ("zoh", "tustin")
 """Discretisation methods accepted by ``method`` (python-control names)."""
@@ -46,25 +47,25 @@ def _check_method(method: str | None) -> str | None:
 
 def _state_space_matrices(A: Any, B: Any, C: Any, D: Any) -> tuple[np.ndarray, ...]:
     """Validated float matrices A (n,n), B (n,m), C (p,n), D (p,m); D=None means zeros."""
-    A = as_matrix(A, "A")
+    A = float_array(A, "A", ndim=2)
     n = A.shape[0]
     if A.shape != (n, n) or n == 0:
         raise ValueError(f"parameter 'A' must be a non-empty square matrix, got shape {A.shape}")
-    B_arr = np.asarray(B, dtype=float)
+    B_arr = float_array(B, "B")
     if B_arr.ndim == 1 and n > 1 and B_arr.size == n:
         B_arr = B_arr.reshape(n, 1)
-    B = as_matrix(B_arr, "B")
+    B = float_array(B_arr, "B", ndim=2)
     if B.shape[0] != n or B.shape[1] == 0:
         raise ValueError(f"parameter 'B' must have shape ({n}, m) to match A, got {B.shape}")
     m = B.shape[1]
-    C = as_matrix(C, "C")
+    C = float_array(C, "C", ndim=2)
     if C.shape[1] != n or C.shape[0] == 0:
         raise ValueError(f"parameter 'C' must have shape (p, {n}) to match A, got {C.shape}")
     p = C.shape[0]
     if D is None:
         D = np.zeros((p, m))
     else:
-        D = as_matrix(D, "D")
+        D = float_array(D, "D", ndim=2)
         if D.shape != (p, m):
             raise ValueError(f"parameter 'D' must have shape ({p}, {m}) to match C and B, got {D.shape}")
     return A, B, C, D
@@ -73,7 +74,7 @@ def _state_space_matrices(A: Any, B: Any, C: Any, D: Any) -> tuple[np.ndarray, .
 def _initial_vector(x0: Any, n: int) -> np.ndarray:
     if x0 is None:
         return np.zeros(n)
-    x0 = as_vector(x0, "x0")
+    x0 = float_array(x0, "x0", ndim=1)
     if x0.size != n:
         raise ValueError(f"parameter 'x0' must have {n} entries (one per state), got {x0.size}")
     return x0
@@ -85,8 +86,8 @@ def transfer_function_realisation(num: Any, den: Any) -> tuple[np.ndarray, ...]:
     The state count is the denominator degree (after dropping leading zeros); a pure
     gain has no state. Raises ValueError for an improper or zero-denominator function.
     """
-    num = np.trim_zeros(as_vector(num, "num"), "f")
-    den = np.trim_zeros(as_vector(den, "den"), "f")
+    num = np.trim_zeros(float_array(num, "num", ndim=1), "f")
+    den = np.trim_zeros(float_array(den, "den", ndim=1), "f")
     if den.size == 0:
         raise ValueError("parameter 'den' must have a nonzero coefficient")
     if num.size == 0:
@@ -250,16 +251,24 @@ class _LinearBlock(Block):
 
 
 class DiscreteStateSpace(_LinearBlock):
-    """Discrete state-space model x[k+1] = A x + B u, y = C x + D u (optionally from continuous)."""
+    """Discrete state-space model x[k+1] = A x + B u, y = C x + D u (optionally from continuous).
 
-    param_docs = {
-        "A": "state matrix, n x n",
-        "B": "input matrix, n x m (a length-n list is taken as a column)",
-        "C": "output matrix, p x n",
-        "D": "feedthrough matrix, p x m; omitted means zero (no feedthrough)",
-        "x0": "initial state, n entries (of the continuous model when method is given); default zeros",
-        "method": "None if A, B, C, D are discrete; 'zoh' or 'tustin' to discretise a continuous model at the block period",
-    }
+    Parameters
+    ----------
+    A : matrix
+        state matrix, n x n
+    B : matrix
+        input matrix, n x m (a length-n list is taken as a column)
+    C : matrix
+        output matrix, p x n
+    D : matrix
+        feedthrough matrix, p x m; omitted means zero (no feedthrough)
+    x0 : vector
+        initial state, n entries (of the continuous model when method is given); default zeros
+    method : {None, 'zoh', 'tustin'}
+        None if A, B, C, D are discrete; 'zoh' or 'tustin' to discretise a continuous model
+        at the block period
+    """
 
     def __init__(self, A: Any, B: Any, C: Any, D: Any = None, x0: Any = None,
                  method: str | None = None):
@@ -269,18 +278,24 @@ class DiscreteStateSpace(_LinearBlock):
 
 
 class DiscreteTransferFunction(_LinearBlock):
-    """Single-input single-output transfer function num(z)/den(z) (or num(s)/den(s) with method)."""
+    """Single-input single-output transfer function num(z)/den(z) (or num(s)/den(s) with method).
 
-    param_docs = {
-        "num": "numerator coefficients, highest power first",
-        "den": "denominator coefficients, highest power first; degree >= numerator degree",
-        "method": "None if num/den are in z; 'zoh' or 'tustin' to discretise num(s)/den(s) at the block period",
-        "x0": "initial state of the controllable canonical realisation (denominator degree entries); default zeros",
-    }
+    Parameters
+    ----------
+    num : vector
+        numerator coefficients, highest power first
+    den : vector
+        denominator coefficients, highest power first; degree >= numerator degree
+    method : {None, 'zoh', 'tustin'}
+        None if num/den are in z; 'zoh' or 'tustin' to discretise num(s)/den(s) at the block period
+    x0 : vector
+        initial state of the controllable canonical realisation (denominator degree entries);
+        default zeros
+    """
 
     def __init__(self, num: Any, den: Any, method: str | None = None, x0: Any = None):
         method = _check_method(method)
-        self.num = np.asarray(num, dtype=float)
-        self.den = np.asarray(den, dtype=float)
         A, B, C, D = transfer_function_realisation(num, den)
+        self.num = float_array(num, "num", ndim=1)
+        self.den = float_array(den, "den", ndim=1)
         self._configure(A, B, C, D, _initial_vector(x0, A.shape[0]), method)

@@ -7,6 +7,7 @@ from typing import Any, Callable, Mapping
 
 import numpy as np
 
+from blocks.arrays import float_array
 from blocks.block import Block, Signal
 
 # Python-float scalars cost an extra conversion inside every ufunc call; 0-d arrays
@@ -14,29 +15,17 @@ from blocks.block import Block, Signal
 # parameters are stored as 0-d float64 arrays.
 
 
-def _real_array(value: Any, name: str, allow_inf: bool = False) -> np.ndarray:
-    """A parameter as a float64 array, rejecting NaN (and infinities unless allowed)."""
-    try:
-        arr = np.array(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter '{name}' must be numeric, got {value!r}") from None
-    bad = np.isnan(arr) if allow_inf else ~np.isfinite(arr)
-    if np.any(bad):
-        raise ValueError(f"parameter '{name}' must be {'not NaN' if allow_inf else 'finite'}")
-    if arr.size == 0:
-        raise ValueError(f"parameter '{name}' must not be empty")
-    return arr
-
-
 class Gain(Block):
-    """Multiplies the input by ``k``: scalar, elementwise vector, or matrix (y = K @ u)."""
+    """Multiplies the input by ``k``: scalar, elementwise vector, or matrix (y = K @ u).
 
-    param_docs = {
-        "k": "gain: a scalar (any width), a vector (elementwise) or a matrix (y = K @ u)",
-    }
+    Parameters
+    ----------
+    k : scalar, vector or matrix
+        gain: a scalar (any width), a vector (elementwise) or a matrix (y = K @ u)
+    """
 
     def __init__(self, k: Any = 1.0):
-        arr = _real_array(k, "k")
+        arr = float_array(k, "k", allow_empty=False)
         if arr.ndim > 2:
             raise ValueError(f"parameter 'k' must be a scalar, vector or matrix, got shape {arr.shape}")
         self.k = arr
@@ -127,11 +116,13 @@ _SUM_KERNELS: dict[str, Callable[[Mapping[str, Signal]], Signal]] = {
 
 
 class Sum(Block):
-    """Signed sum of the inputs ``u0, u1, ...``, one sign character per input."""
+    """Signed sum of the inputs ``u0, u1, ...``, one sign character per input.
 
-    param_docs = {
-        "signs": "one '+' or '-' per input, in port order u0, u1, ... (e.g. '+-' gives u0 - u1)",
-    }
+    Parameters
+    ----------
+    signs : str
+        one '+' or '-' per input, in port order u0, u1, ... (e.g. '+-' gives u0 - u1)
+    """
 
     def __init__(self, signs: str = "++"):
         if not isinstance(signs, str) or not signs or set(signs) - {"+", "-"}:
@@ -153,16 +144,19 @@ class Sum(Block):
 
 
 class Saturation(Block):
-    """Clips the input to ``[lower, upper]`` elementwise."""
+    """Clips the input to ``[lower, upper]`` elementwise.
 
-    param_docs = {
-        "lower": "lower limit, a scalar (any width) or a vector; -inf for no lower limit",
-        "upper": "upper limit, a scalar (any width) or a vector; inf for no upper limit",
-    }
+    Parameters
+    ----------
+    lower : scalar or vector
+        lower limit, a scalar applying to any width; -inf for no lower limit
+    upper : scalar or vector
+        upper limit, a scalar applying to any width; inf for no upper limit
+    """
 
     def __init__(self, lower: Any = -1.0, upper: Any = 1.0):
-        lo = _real_array(lower, "lower", allow_inf=True)
-        hi = _real_array(upper, "upper", allow_inf=True)
+        lo = float_array(lower, "lower", allow_inf=True, allow_empty=False)
+        hi = float_array(upper, "upper", allow_inf=True, allow_empty=False)
         for name, arr in (("lower", lo), ("upper", hi)):
             if arr.ndim > 1:
                 raise ValueError(f"parameter '{name}' must be a scalar or a vector, got shape {arr.shape}")

@@ -2,23 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any, Mapping
 
 import numpy as np
 
-from blocks.block import Block, Signal, as_vector
-
-
-def _finite_scalar(value: Any, name: str) -> float:
-    """A parameter that must be one finite real number."""
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"parameter '{name}' must be a finite scalar, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"parameter '{name}' must be a finite scalar, got {value!r}")
-    return x
+from blocks.arrays import float_array
+from blocks.block import Block, Signal
 
 
 def broadcast_vectors(**params: Any) -> dict[str, Signal]:
@@ -26,10 +15,7 @@ def broadcast_vectors(**params: Any) -> dict[str, Signal]:
 
     Raises ValueError naming the parameters when two of them have different widths > 1.
     """
-    vectors = {name: as_vector(value, name) for name, value in params.items()}
-    for name, v in vectors.items():
-        if v.size == 0:
-            raise ValueError(f"parameter '{name}' must not be empty")
+    vectors = {name: float_array(value, name, ndim=1, allow_empty=False) for name, value in params.items()}
     widths = {name: v.size for name, v in vectors.items() if v.size != 1}
     if len(set(widths.values())) > 1:
         desc = ", ".join(f"'{n}' has width {w}" for n, w in widths.items())
@@ -39,14 +25,16 @@ def broadcast_vectors(**params: Any) -> dict[str, Signal]:
 
 
 class Constant(Block):
-    """Outputs a fixed value at every hit."""
+    """Outputs a fixed value at every hit.
 
-    param_docs = {"value": "the output value, a scalar or a vector"}
+    Parameters
+    ----------
+    value : scalar or vector
+        the output value
+    """
 
     def __init__(self, value: Any):
-        self.value = as_vector(value, "value")
-        if self.value.size == 0:
-            raise ValueError("parameter 'value' must not be empty")
+        self.value = float_array(value, "value", ndim=1, allow_empty=False)
         self.inputs = {}
         self.outputs = {"y": self.value.size}
         self.feedthrough = False
@@ -56,17 +44,21 @@ class Constant(Block):
 
 
 class Step(Block):
-    """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time)."""
+    """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time).
 
-    param_docs = {
-        "time": "switching time in seconds; the output is 'after' from this time on",
-        "before": "output before the switching time, a scalar or a vector",
-        "after": "output from the switching time on, a scalar or a vector",
-    }
+    Parameters
+    ----------
+    time : float
+        switching time in seconds; the output is 'after' from this time on
+    before : scalar or vector
+        output before the switching time
+    after : scalar or vector
+        output from the switching time on
+    """
     time_varying = True
 
     def __init__(self, time: float, before: Any = 0.0, after: Any = 1.0):
-        self.time = _finite_scalar(time, "time")
+        self.time = float(float_array(time, "time", ndim=0))
         vectors = broadcast_vectors(before=before, after=after)
         self.before, self.after = vectors["before"], vectors["after"]
         self.inputs = {}
@@ -78,17 +70,21 @@ class Step(Block):
 
 
 class Ramp(Block):
-    """Outputs ``initial + slope * max(0, t - start)``: flat until ``start``, then linear."""
+    """Outputs ``initial + slope * max(0, t - start)``: flat until ``start``, then linear.
 
-    param_docs = {
-        "slope": "rate of change after the start time (units per second), scalar or vector",
-        "start": "time in seconds at which the ramp starts rising",
-        "initial": "output value up to the start time, scalar or vector",
-    }
+    Parameters
+    ----------
+    slope : scalar or vector
+        rate of change after the start time (units per second)
+    start : float
+        time in seconds at which the ramp starts rising
+    initial : scalar or vector
+        output value up to the start time
+    """
     time_varying = True
 
     def __init__(self, slope: Any = 1.0, start: float = 0.0, initial: Any = 0.0):
-        self.start = _finite_scalar(start, "start")
+        self.start = float(float_array(start, "start", ndim=0))
         vectors = broadcast_vectors(slope=slope, initial=initial)
         self.slope, self.initial = vectors["slope"], vectors["initial"]
         self.inputs = {}

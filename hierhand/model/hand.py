@@ -16,6 +16,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from blocks.arrays import float_array
+
 from .. import _native
 from .handfile import HandFileError, HandParams, merge_with_default, parse_hand, read_hand_file
 from .layout import (
@@ -189,7 +191,5 @@ class Hand:
 
 
 def _vector(x: Any, n: int, name: str) -> np.ndarray:
-    arr = np.ascontiguousarray(x, dtype=float)
-    if arr.shape != (n,):
-        raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
-    return arr
+    """``x`` as the float64 vector of width ``n`` that a native call takes."""
+    return float_array(x, name, width=n, finite=False, what="argument")

@@ -15,6 +15,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from blocks.arrays import float_array
 from blocks.block import Block, BlockError
 
 from .. import _native
@@ -294,7 +295,8 @@ class HandPlant(Block):
 
 
 def _port_vector(x: Any, n: int, name: str) -> np.ndarray:
-    arr = np.ascontiguousarray(x, dtype=np.float64)
-    if arr.shape != (n,):
-        raise BlockError(f"HandPlant input '{name}' must have width {n}, got shape {arr.shape}", port=name)
-    return arr
+    """Input ``name`` as the float64 vector of width ``n`` the core takes; else a BlockError naming it."""
+    try:
+        return float_array(x, name, width=n, finite=False, what="input")
+    except ValueError as exc:
+        raise BlockError(f"HandPlant {exc}", port=name) from None

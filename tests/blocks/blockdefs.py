@@ -35,6 +35,15 @@ class FastAccumulator(Accumulator):
         return rows[-1].copy(), {"y": rows}
 
 
+class ChunkStart(FastAccumulator):
+    """The accumulator whose ``advance`` outputs, at every hit of a call, the time ``t``
+    that call was given: the logged values show the start time of each advance chunk."""
+
+    def advance(self, t, state, inputs, n):
+        state, rows = super().advance(t, state, inputs, n)
+        return state, {"y": np.full_like(rows["y"], t)}
+
+
 class SplitFeedthrough(Block):
     """Two outputs: ``direct`` = u (feedthrough), ``held`` = state (none); state <- u."""
 

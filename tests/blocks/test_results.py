@@ -182,9 +182,10 @@ def test_failed_save_keeps_the_previous_file_and_no_temporary_file(tmp_path):
     good = two_rate_results()
     good.save(tmp_path, csv=True)
     before = (tmp_path / "signals.csv").read_bytes()
-    # Values that are not (samples, width) cannot be written as CSV columns.
+    # Values that are not (samples, width) cannot be saved: refused inside the staging folder.
     bad = Results({"a.y": (np.array([0.0, 1.0]), np.array([1.0, 2.0]))}, {"status": "complete"})
-    with pytest.raises(Exception):
+    with pytest.raises(ValueError, match=r"^signal 'a\.y' cannot be saved: its values must be an array "
+                       r"of shape \(samples, width\), got shape \(2,\)$"):
         bad.save(tmp_path, csv=True)
     assert (tmp_path / "signals.csv").read_bytes() == before
     leftovers = [p.name for p in tmp_path.iterdir() if p.name.startswith(".") or p.suffix == ".tmp"]

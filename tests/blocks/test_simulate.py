@@ -18,6 +18,18 @@ def run(text: str, t_end=None, trust: bool = True):
     return simulate(loads_diagram(text, filename="test.yaml", trust=trust), t_end=t_end)
 
 
+def accumulate_ones(kind: str, period: str, t_end: str, params: str = "{}"):
+    """Run a constant 1 into ``acc``, a ``kind`` block of blockdefs, logging ``acc.y``."""
+    return run(f"""
+time: {{t_end: {t_end}}}
+blocks:
+  one: {{type: Constant, params: {{value: 1.0}}}}
+  acc: {{type: "{DEFS}:{kind}", period: {period}, params: {params}}}
+connections: [one.y -> acc.u]
+log: [acc.y]
+""")
+
+
 def toy_hand_loop(n_ticks: int) -> np.ndarray:
     """The toy diagram written out: plant every tick, integ every 10, prop every 100 ticks."""
     xp = xi = yprop = u = 0.0
@@ -123,14 +135,7 @@ log: [g.y, c.y]
 
 
 def test_value_logged_at_t_end_is_the_state_after_the_last_update():
-    res = run(f"""
-time: {{t_end: 10 ms}}
-blocks:
-  one: {{type: Constant, params: {{value: 1.0}}}}
-  acc: {{type: "{DEFS}:Accumulator", period: 1 ms}}
-connections: [one.y -> acc.u]
-log: [acc.y]
-""")
+    res = accumulate_ones("Accumulator", "1 ms", "10 ms")
     t, y = res["acc.y"]
     np.testing.assert_array_equal(t, np.arange(11) / 1000)
     np.testing.assert_array_equal(y[:, 0], np.arange(11))
@@ -329,19 +334,26 @@ log: [b.y]
     np.testing.assert_allclose(simulate(diagram)["b.y"][1], simulate(reference)["b.y"][1], rtol=1e-12)
 
 
+def test_every_advance_chunk_starts_at_its_exact_tick_time():
+    """A span of several ADVANCE_CHUNK hits: each chunk gets ``k * base_tick`` of its first
+    tick, computed from the integer k (adding up chunks of 4096 periods of 0.1 ms in
+    floats gives 1.2288000000000001 s, not 1.2288 s, for the fourth chunk)."""
+    from blocks.simulate import ADVANCE_CHUNK
+
+    r = accumulate_ones("ChunkStart", "0.1 ms", "1.6384 s")
+    t, y = r["acc.y"]
+    hits = np.arange(1, len(t))
+    first_tick = (hits - 1) // ADVANCE_CHUNK * ADVANCE_CHUNK
+    assert len(t) == 4 * ADVANCE_CHUNK + 1
+    assert [float(y[i, 0]) for i in hits] == [int(k) / 10000 for k in first_tick]
+
+
 def test_an_interrupt_inside_one_long_advance_span_records_the_time_reached():
     """No other block fires after t = 0, so the whole run is one advance span, made of
     chunks of ADVANCE_CHUNK hits; Ctrl-C in the third chunk stops it after two."""
     from blocks.simulate import ADVANCE_CHUNK
 
-    r = run(f"""
-time: {{t_end: 1000 s}}
-blocks:
-  one: {{type: Constant, params: {{value: 1.0}}}}
-  acc: {{type: "{DEFS}:InterruptedAccumulator", period: 1 ms, params: {{calls: 3}}}}
-connections: [one.y -> acc.u]
-log: [acc.y]
-""")
+    r = accumulate_ones("InterruptedAccumulator", "1 ms", "1000 s", "{calls: 3}")
     reached = 2 * ADVANCE_CHUNK * 1e-3
     assert r.interrupted and r.status == f"interrupted at t={reached:.9g} s", r.status
     t, y = r["acc.y"]

@@ -1,0 +1,99 @@
+"""The framework's import structure: ``blocks`` never imports ``hierhand``, and the
+modules of ``blocks`` import each other without a cycle, so its layers (data -> loader ->
+planner -> executor -> results) stay layers.
+
+Imports are read from the source with ``ast``, wherever they stand: at module level,
+under ``if TYPE_CHECKING``, or inside a function (a deferred import is still a
+dependency, only a later one).
+"""
+
+from __future__ import annotations
+
+import ast
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import networkx as nx
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+PACKAGE = ROOT / "blocks"
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(ROOT).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def imported(module: str) -> set[str]:
+    """Every module ``module`` imports: ``from pkg import sub`` counts as ``pkg.sub`` when
+    that is a module, relative imports resolved."""
+    path = MODULES[module]
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
+        if isinstance(node, ast.Import):
+            found.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - node.level + 1]
+                source = ".".join(base + ([node.module] if node.module else []))
+            else:
+                source = node.module
+            for alias in node.names:
+                sub = f"{source}.{alias.name}"
+                found.add(sub if sub in MODULES else source)
+    return found
+
+
+def import_graph() -> nx.DiGraph:
+    graph = nx.DiGraph()
+    graph.add_nodes_from(MODULES)
+    for module in MODULES:
+        graph.add_edges_from((module, target) for target in imported(module) if target in MODULES)
+    return graph
+
+
+def test_the_import_reader_sees_imports_inside_functions_and_relative_ones():
+    assert "blocks.library" in imported("blocks.registry")  # inside block_types()
+    assert "blocks.block" in imported("blocks.loader")  # from .block import ...
+    assert "blocks.fmu_interrupt" in imported("blocks.fmu")  # from blocks import fmu_interrupt
+
+
+@pytest.mark.parametrize("module", sorted(MODULES))
+def test_no_blocks_module_imports_hierhand(module):
+    bad = sorted(m for m in imported(module) if m == "hierhand" or m.startswith("hierhand."))
+    assert not bad, f"{MODULES[module].relative_to(ROOT)} imports {', '.join(bad)}"
+
+
+def test_importing_every_blocks_module_loads_nothing_of_hierhand():
+    code = (f"import {', '.join(sorted(MODULES))}\n"
+            "import sys\n"
+            "loaded = sorted(m for m in sys.modules if m == 'hierhand' or m.startswith('hierhand.'))\n"
+            "assert not loaded, loaded\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(filter(None, [str(ROOT), os.environ.get("PYTHONPATH")])))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True,
+                          timeout=120)
+    assert proc.returncode == 0, proc.stderr
+
+
+def test_the_blocks_modules_import_each_other_without_a_cycle():
+    graph = import_graph()
+    cycles = list(nx.simple_cycles(graph))
+    assert not cycles, "import cycles: " + "; ".join(" -> ".join(c + [c[0]]) for c in cycles)
+
+
+LAYERS = ["blocks.issues", "blocks.diagram", "blocks.loader", "blocks.schedule", "blocks.load", "blocks.simulate"]
+"""The core modules from the lowest layer up: data, loader, planner, load (loader +
+planner), executor."""
+
+
+@pytest.mark.parametrize("lower, higher", [(a, b) for i, a in enumerate(LAYERS) for b in LAYERS[i + 1:]])
+def test_a_lower_layer_never_reaches_a_higher_one(lower, higher):
+    graph = import_graph()
+    assert not nx.has_path(graph, lower, higher), " -> ".join(nx.shortest_path(graph, lower, higher))
