@@ -3,4 +3,5 @@ info, sweep, sweep-plot, blocks) on any diagram."""
 
 from blocks.cli import PROGRAM, entry
 
-entry(PROGRAM)
+if __name__ == "__main__":
+    entry(PROGRAM)

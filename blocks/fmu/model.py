@@ -19,7 +19,6 @@ from typing import Any
 from .description import read_description
 from .port_types import KINDS, NOT_PORTS
 from .ports import group_variables, groups, initial_reads, port_name, vectors
-from .start_values import settable
 
 
 def import_fmpy():
@@ -132,3 +131,16 @@ def float_or_none(text: Any) -> float | None:
     except (TypeError, ValueError):
         return None
     return value if math.isfinite(value) and value > 0 else None
+
+
+def settable(v: Any) -> str | None:
+    """Why ``v`` cannot be given a start value, or None if it can."""
+    if v.variability == "constant":
+        return "it is a constant"
+    if v.causality == "structuralParameter":
+        return "it is a structural parameter (configuration mode is not supported)"
+    if v.causality in ("calculatedParameter", "independent"):
+        return f"it is computed by the FMU (causality={v.causality})"
+    if v.causality in ("parameter", "input") or v.initial in ("exact", "approx"):
+        return None
+    return f"it is computed by the FMU (causality={v.causality}, initial={v.initial})"

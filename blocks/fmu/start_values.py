@@ -15,15 +15,14 @@ from __future__ import annotations
 import difflib
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .port_types import KINDS
+from .model import Model, settable
 from .ports import variable_width
 
-if TYPE_CHECKING:
-    from .model import Model
 
 
 @dataclass
@@ -98,19 +97,6 @@ def _unknown(model: Model, name: str) -> str:
     shown = ", ".join(sorted(settable_names)[:12]) + (", ..." if len(settable_names) > 12 else "")
     return (f"unknown variable '{name}' in start_values: {model.shown} has no such variable "
             f"({hint}settable variables: {shown or 'none'})")
-
-
-def settable(v: Any) -> str | None:
-    """Why ``v`` cannot be given a start value, or None if it can."""
-    if v.variability == "constant":
-        return "it is a constant"
-    if v.causality == "structuralParameter":
-        return "it is a structural parameter (configuration mode is not supported)"
-    if v.causality in ("calculatedParameter", "independent"):
-        return f"it is computed by the FMU (causality={v.causality})"
-    if v.causality in ("parameter", "input") or v.initial in ("exact", "approx"):
-        return None
-    return f"it is computed by the FMU (causality={v.causality}, initial={v.initial})"
 
 
 def convert(kind: str, value: Any, name: str, major: int) -> Any:

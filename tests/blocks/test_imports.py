@@ -62,7 +62,8 @@ def import_graph() -> nx.DiGraph:
 def test_the_import_reader_sees_imports_inside_functions_and_relative_ones():
     assert "blocks.library" in imported("blocks.registry")  # inside block_types()
     assert "blocks.block" in imported("blocks.loader")  # from .block import ...
-    assert "blocks.fmu_interrupt" in imported("blocks.fmu")  # from blocks import fmu_interrupt
+    assert "blocks.fmu.interrupt" in imported("blocks.fmu.block")  # from . import interrupt
+    assert "blocks.timebase" in imported("blocks.fmu.block")  # from ..timebase import ...
 
 
 @pytest.mark.parametrize("module", sorted(MODULES))
@@ -97,3 +98,11 @@ planner), executor."""
 def test_a_lower_layer_never_reaches_a_higher_one(lower, higher):
     graph = import_graph()
     assert not nx.has_path(graph, lower, higher), " -> ".join(nx.shortest_path(graph, lower, higher))
+
+
+def test_importing_the_command_line_and_sweeps_loads_no_application_code():
+    """Nor Dask's distributed or matplotlib, which only the commands that need them import."""
+    code = ("import sys, blocks.cli, blocks.sweep, blocks.sweep.plan, blocks.sweep.plot; "
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('hierhand', 'distributed', 'matplotlib')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, check=True)
+    assert out.stdout.strip() == "[]"
