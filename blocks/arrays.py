@@ -1,4 +1,4 @@
-"""Numbers as float64 arrays: the one place that coerces and checks parameters and inputs.
+"""Numbers as float64 arrays: the one place that coerces (and checks) parameters and inputs.
 
 Blocks take numbers from YAML (integers, floats, nested lists, numeric text such as
 ``"1e-3"``) and from Python (arrays of any dtype, views, lists). ``float_array`` turns
@@ -18,13 +18,14 @@ _SHAPES = {0: "a scalar", 1: "a scalar or a vector", 2: "a matrix"}
 
 
 def float_array(value: Any, name: str, *, ndim: int | None = None, width: int | None = None,
-                finite: bool = True, allow_inf: bool = False, allow_empty: bool = True,
-                what: str = "parameter") -> np.ndarray:
+                broadcast: bool = False, finite: bool = True, allow_inf: bool = False,
+                allow_empty: bool = True, what: str = "parameter") -> np.ndarray:
     """``value`` as a new C-contiguous float64 array, checked.
 
     - ``ndim``: None keeps the shape given; 1 makes a scalar a vector of one element; 2
       makes a scalar 1x1 and a vector a row. Any other shape is an error.
-    - ``width``: the array must be a vector of exactly this width (no scalar is widened).
+    - ``width``: the array must be a vector of exactly this width; with ``broadcast`` a
+      scalar (or one-element vector) is widened to it (a per-joint gain given once).
     - ``finite``: reject NaN and infinities (only NaN with ``allow_inf``).
     - ``allow_empty``: whether an array without elements is accepted.
     - ``what``: the word before the name in messages (``parameter``, ``input``, ``argument``).
@@ -41,8 +42,11 @@ def float_array(value: Any, name: str, *, ndim: int | None = None, width: int | 
             arr = arr.reshape(1, -1)
         if arr.ndim != ndim:
             raise ValueError(f"{label} must be {_SHAPES.get(ndim, f'{ndim}-dimensional')}, got shape {arr.shape}")
+    if broadcast and width is not None and arr.size == 1:
+        arr = np.full(width, arr.reshape(-1)[0])
     if width is not None and arr.shape != (width,):
-        raise ValueError(f"{label} must have width {width}, got shape {arr.shape}")
+        raise ValueError(f"{label} must have width {width}{' (or be a scalar)' if broadcast else ''}, "
+                         f"got shape {arr.shape}")
     if not allow_empty and arr.size == 0:
         raise ValueError(f"{label} must not be empty")
     if finite:
@@ -50,3 +54,10 @@ def float_array(value: Any, name: str, *, ndim: int | None = None, width: int | 
         if bad.any():
             raise ValueError(f"{label} must be {'not NaN' if allow_inf else 'finite'}")
     return arr
+
+
+def flat_float64(value: Any) -> np.ndarray:
+    """``value`` as a 1-D C-contiguous float64 array, without checks, and without a copy
+    when it already is one: the hot-path sibling of ``float_array``, for arguments of
+    compiled calls that refuse anything else (a list, another dtype, a strided view)."""
+    return np.ascontiguousarray(value, dtype=np.float64).reshape(-1)

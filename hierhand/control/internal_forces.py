@@ -23,8 +23,9 @@ import math
 
 import numpy as np
 
+from blocks.arrays import flat_float64
+
 from .. import _native
-from .arrays import flat_float64
 
 __all__ = [
     "grasp_matrix",

@@ -17,8 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from blocks.arrays import flat_float64
+
 from .. import _native
-from .arrays import flat_float64
 
 __all__ = ["UnreachableError", "finger_ik", "finger_ik_near", "finger_fk", "hand_ik", "wrap_angle"]
 

@@ -29,9 +29,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
+from blocks.arrays import flat_float64, float_array
 
 from ..model.hand_source import HAND_DOC, ModelsTheHand, hand_of
-from .arrays import flat_float64
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
@@ -64,10 +64,10 @@ class ManipulationPD(ModelsTheHand, Block):
                  gravity_compensation: bool = True, load_compensation: bool = True,
                  contact_threshold: float = 0.05):
         self.hand = hand_of(hand)
-        self.kp = np.broadcast_to(np.asarray(kp, dtype=float), (9,)).copy()
-        self.kd = np.broadcast_to(np.asarray(kd, dtype=float), (9,)).copy()
-        if np.any(self.kp < 0) or np.any(self.kd < 0) or not np.all(np.isfinite(self.kp + self.kd)):
-            raise ValueError("kp and kd must be finite and non-negative")
+        self.kp = float_array(kp, "kp", ndim=1, width=9, broadcast=True)
+        self.kd = float_array(kd, "kd", ndim=1, width=9, broadcast=True)
+        if np.any(self.kp < 0) or np.any(self.kd < 0):
+            raise ValueError("kp and kd must be non-negative")
         self.gravity_compensation = bool(gravity_compensation)
         self.load_compensation = bool(load_compensation)
         self.threshold = float(contact_threshold)

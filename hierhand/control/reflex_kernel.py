@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from blocks.arrays import flat_float64
+
 from .. import _native
-from .arrays import flat_float64
 from .internal_forces import _COINCIDENT_RTOL
 
 _L = _native.LAYOUT

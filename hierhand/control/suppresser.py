@@ -10,8 +10,8 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
+from blocks.arrays import flat_float64, float_array
 
-from .arrays import flat_float64
 from .suppresser_kernel import (
     N_OUT,
     O_SHARE,
@@ -51,8 +51,8 @@ class Suppresser(Block):
 
     def __init__(self, S_a: Any = 100.0, S_b: Any = 0.1, mode: str = "magnitude", enabled: bool = True):
         code = mode_code(mode)
-        self.S_a = np.broadcast_to(np.asarray(S_a, dtype=float), (9,)).copy()
-        self.S_b = np.broadcast_to(np.asarray(S_b, dtype=float), (9,)).copy()
+        self.S_a = float_array(S_a, "S_a", ndim=1, width=9, broadcast=True)
+        self.S_b = float_array(S_b, "S_b", ndim=1, width=9, broadcast=True)
         check_steepness(self.S_a)
         self.mode = mode
         self.enabled = bool(enabled)

@@ -27,8 +27,9 @@ from typing import Any
 
 import numpy as np
 
+from blocks.arrays import flat_float64
+
 from .. import _native
-from .arrays import flat_float64
 
 __all__ = ["sigmoid", "suppress", "finger_shares", "MODES"]
 

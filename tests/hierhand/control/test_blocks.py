@@ -211,3 +211,17 @@ def test_suppresser_adds_the_feedforward_unsuppressed():
     out = s.output(0, None, {"tau_g": np.full(9, 0.3), "tau_m": big, "tau_ff": tau_ff})
     np.testing.assert_allclose(out["tau"], big + tau_ff, atol=1e-30)
     assert s.input_defaults["tau_ff"].tolist() == [0.0] * 9
+
+
+@pytest.mark.parametrize("make, message", [
+    (lambda: ManipulationPD(hand=Hand.default(), kp=[1.0, 2.0]), "parameter 'kp' must have width 9 (or be a scalar)"),
+    (lambda: ManipulationPD(hand=Hand.default(), kd=float("nan")), "parameter 'kd' must be finite"),
+    (lambda: ManipulationPD(hand=Hand.default(), kp=-1.0), "kp and kd must be non-negative"),
+    (lambda: Suppresser(S_b="soft"), "parameter 'S_b' must be numeric"),
+    (lambda: Suppresser(S_a=[1.0] * 8), "parameter 'S_a' must have width 9 (or be a scalar)"),
+])
+def test_per_joint_gains_are_a_scalar_or_nine_finite_values(make, message):
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        make()
+    assert np.array_equal(Suppresser(S_a=3.0).S_a, np.full(9, 3.0))
+    assert np.array_equal(ManipulationPD(hand=Hand.default(), kd=list(range(9))).kd, np.arange(9.0))
