@@ -109,9 +109,6 @@ class Block:
     """
 
     type_name: ClassVar[str | None] = None
-    param_docs: ClassVar[dict[str, str]] = {}
-    """Parameter -> description: the older way to document parameters, still honoured
-    (its entries win over the docstring's); write a ``Parameters`` section instead."""
     path_params: ClassVar[tuple[str, ...]] = ()
     """Parameters holding file paths: the loader resolves relative ones against the
     diagram's folder, as it does ``params_file``."""

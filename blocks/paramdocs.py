@@ -14,8 +14,7 @@ class docstring::
 
 ``parameter_docs`` reads that section (a small reader, no docstring library) for
 ``hierhand blocks``; the defaults come from the signature of ``__init__``, so the
-docstring does not repeat them. A ``param_docs`` mapping (parameter -> text), the older
-way, is still honoured: its entries win over the same class's docstring.
+docstring does not repeat them. A mixin may document a parameter its blocks share.
 """
 
 from __future__ import annotations
@@ -72,14 +71,12 @@ def parse_parameters(doc: str | None) -> dict[str, ParamDoc]:
 
 
 def parameter_docs(cls: type) -> dict[str, ParamDoc]:
-    """The documented parameters of a block class: the ``Parameters`` section and
-    ``param_docs`` of each class of its MRO, the nearest class first (so a subclass
+    """The documented parameters of a block class: the ``Parameters`` section of each
+    class of its MRO, the nearest class first (so a subclass or a block using a mixin
     documents only what it adds or changes)."""
     docs: dict[str, ParamDoc] = {}
     for klass in cls.__mro__:
-        own = parse_parameters(vars(klass).get("__doc__"))
-        own.update({name: ParamDoc("", str(text)) for name, text in (vars(klass).get("param_docs") or {}).items()})
-        for name, doc in own.items():
+        for name, doc in parse_parameters(vars(klass).get("__doc__")).items():
             docs.setdefault(name, doc)
     return docs
 

@@ -76,17 +76,20 @@ class FMUState:
 
 
 class FMU(Block):
-    """An FMI 2.0 / 3.0 co-simulation FMU; its period is the communication step."""
+    """An FMI 2.0 / 3.0 co-simulation FMU; its period is the communication step.
 
-    param_docs = {
-        "path": "the .fmu file; in a diagram a relative path is resolved against the diagram's "
-                "folder (from Python, against the current directory)",
-        "start_values": "mapping of FMU variable names to start values (parameters, inputs, "
-                        "variables with an exact/approx start); a vector 'x' for x[1], x[2], ... "
-                        "or an FMI 3 array takes a list",
-        "tolerance": "relative tolerance passed to the FMU's solver; default: the FMU's "
-                     "DefaultExperiment tolerance, if any",
-    }
+    Parameters
+    ----------
+    path : str or path
+        the .fmu file; in a diagram a relative path is resolved against the diagram's
+        folder (from Python, against the current directory)
+    start_values : mapping
+        FMU variable names to start values (parameters, inputs, variables with an
+        exact/approx start); a vector 'x' for x[1], x[2], ... or an FMI 3 array takes a list
+    tolerance : float
+        relative tolerance passed to the FMU's solver; default: the FMU's
+        DefaultExperiment tolerance, if any
+    """
     time_varying = True
     path_params = ("path",)
 

@@ -53,7 +53,7 @@ import numpy as np
 
 from blocks import Block
 
-from ..model.hand_source import HAND_DOC, ModelsTheHand, hand_of
+from ..model.hand_source import ModelsTheHand, hand_of
 from .reflex_kernel import (
     N_OUT,
     WHOLE_SHARE,
@@ -85,23 +85,33 @@ class GraspReflex(ModelsTheHand, Block):
 
     Its hand (finger geometry for the tip Jacobians, finger names) is the plant's:
     ``hand: plant`` names the block that simulates the hand (see ``hand_of``).
+
+    Parameters
+    ----------
+    grasp : list of finger names
+        fingers that close on the object at the start, e.g. [thumb, fore]
+    ki : float
+        integral gain of the fingertip force loop, 1/s (30-100 gives a 10-30 ms recovery)
+    safety_ratio : float
+        largest |f_t|/f_n the reflex allows (the paper's 0.6)
+    margin : float
+        the loop aims at safety_ratio / (1 + margin), so that it settles below the safety
+        ratio
+    min_force : float
+        smallest normal force per contact, N, even without tangential load
+    max_force : float
+        largest commanded force per fingertip, N (anti-windup limit)
+    approach_force : float
+        force, N, that pushes a 'grasp' finger towards the others until it touches
+    contact_threshold : float
+        normal force, N, above which a finger counts as in contact
+    release_share : float
+        a finger whose actuator command keeps less than this share of its grasping torque
+        (input 'share', from the suppresser) is left to voluntary motion: its force no
+        longer drives the integrator (never more than leaves two fingers held)
     """
 
     type_name = "GraspReflex"
-    param_docs = {
-        "hand": HAND_DOC,
-        "grasp": "fingers that close on the object at the start, e.g. [thumb, fore]",
-        "ki": "integral gain of the fingertip force loop, 1/s (30-100 gives a 10-30 ms recovery)",
-        "safety_ratio": "largest |f_t|/f_n the reflex allows (the paper's 0.6)",
-        "margin": "the loop aims at safety_ratio / (1 + margin), so that it settles below the safety ratio",
-        "min_force": "smallest normal force per contact, N, even without tangential load",
-        "max_force": "largest commanded force per fingertip, N (anti-windup limit)",
-        "approach_force": "force, N, that pushes a 'grasp' finger towards the others until it touches",
-        "contact_threshold": "normal force, N, above which a finger counts as in contact",
-        "release_share": "a finger whose actuator command keeps less than this share of its grasping torque "
-                         "(input 'share', from the suppresser) is left to voluntary motion: its force need no "
-                         "longer drives the integrator (never more than leaves two fingers held)",
-    }
 
     def __init__(self, hand, grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,

@@ -31,7 +31,7 @@ import numpy as np
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
 
-from ..model.hand_source import HAND_DOC, ModelsTheHand, hand_of
+from ..model.hand_source import ModelsTheHand, hand_of
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
@@ -46,19 +46,26 @@ class ManipulationPD(ModelsTheHand, Block):
     Its hand (finger geometry and q0, gravity, the object's mass for the load
     feedforward) is the plant's: ``hand: plant`` names the block that simulates the hand
     (see ``hand_of``).
+
+    Parameters
+    ----------
+    trajectories : mapping
+        per finger name: {waypoints: [[t, x, y, phi], ...], interpolation: minjerk|linear}
+    kp : scalar or 9 values
+        joint stiffness, N m/rad
+    kd : scalar or 9 values
+        joint damping, N m s/rad
+    gravity_compensation : bool
+        add the fingers' own gravity torques
+    load_compensation : bool
+        add J^T of the object's load (weight plus input support) shared by the fingers in
+        contact
+    contact_threshold : float
+        normal force, N, above which a finger carries part of the object
     """
 
     type_name = "ManipulationPD"
     time_varying = True
-    param_docs = {
-        "hand": HAND_DOC,
-        "trajectories": "per finger name: {waypoints: [[t, x, y, phi], ...], interpolation: minjerk|linear}",
-        "kp": "joint stiffness, N m/rad (scalar or 9 values)",
-        "kd": "joint damping, N m s/rad (scalar or 9 values)",
-        "gravity_compensation": "add the fingers' own gravity torques",
-        "load_compensation": "add J^T of the object's load (weight plus input support) shared by the fingers in contact",
-        "contact_threshold": "normal force, N, above which a finger carries part of the object",
-    }
 
     def __init__(self, hand, trajectories: Mapping[str, Any] | None = None, kp: Any = 2.0, kd: Any = 0.01,
                  gravity_compensation: bool = True, load_compensation: bool = True,

@@ -39,15 +39,20 @@ class Suppresser(Block):
     passes tau_g through unchanged, for the paper's comparison run without suppression.
 
     The nine joints are done in one native call (``suppress_output``).
+
+    Parameters
+    ----------
+    S_a : scalar or 9 values
+        sigmoid steepness, 1/(N m)
+    S_b : scalar or 9 values
+        manipulation torque, N m, at which the grasping torque is halved
+    mode : str
+        'magnitude' (suppress by |tau_m|) or 'signed' (the paper's literal formula)
+    enabled : bool
+        false passes the grasping torque through unsuppressed
     """
 
     type_name = "Suppresser"
-    param_docs = {
-        "S_a": "sigmoid steepness, 1/(N m) (scalar or 9 values)",
-        "S_b": "manipulation torque, N m, at which the grasping torque is halved (scalar or 9 values)",
-        "mode": "'magnitude' (suppress by |tau_m|, default) or 'signed' (the paper's literal formula)",
-        "enabled": "false passes the grasping torque through unsuppressed",
-    }
 
     def __init__(self, S_a: Any = 100.0, S_b: Any = 0.1, mode: str = "magnitude", enabled: bool = True):
         code = mode_code(mode)

@@ -21,16 +21,24 @@ from .plant import HandPlant
 if TYPE_CHECKING:
     from blocks.fmu import FMU
 
-HAND_DOC = ("the block that simulates the hand, by name (hand: plant): a HandPlant or an FMU exported by "
-            "'hierhand fmu export'; the hand is given once, on that block (from Python: the block or a Hand)")
-"""``param_docs`` of a ``hand`` parameter."""
 EXPECTED = "expected a HandPlant or an FMU exported by 'hierhand fmu export'"
 EXPECTED_FROM_PYTHON = "expected a HandPlant, an FMU exported by 'hierhand fmu export', or a Hand"
 
 
 class ModelsTheHand:
     """Mixin of the blocks that model the hand they act on: the block-reference parameter
-    ``hand``, and a documentation instance on the default hand (``hierhand blocks``)."""
+    ``hand``, and a documentation instance on the default hand (``hierhand blocks``).
+
+    A block that says more about its ``hand`` documents it in its own docstring, which
+    wins (``blocks.paramdocs`` reads the nearest class first).
+
+    Parameters
+    ----------
+    hand : HandPlant or FMU
+        the block that simulates the hand (hand: plant); an FMU must be one exported by
+        'hierhand fmu export'; the hand is given once, on that block (from Python: the
+        block or a Hand)
+    """
 
     block_params = ("hand",)
 

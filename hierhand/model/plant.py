@@ -106,15 +106,21 @@ class HandPlant(Block):
     ``obj`` (x, y, theta), ``obj_vel``, ``normal`` (per finger the unit vector from the tip
     centre to its normal-force-weighted contact point: the direction of the normal force on
     the object, zero without contact). Summing per point keeps ``ratio <= mu_s`` exact.
+
+    Parameters
+    ----------
+    gravity : list of 2 floats
+        [gx, gy] in m/s^2 (default [0, -9.81])
+    fingers : list of 3 mappings
+        the three fingers, each with base, base_angle, links, damping, armature,
+        tip_radius, q0
+    object : mapping
+        mass, inertia, size, pos, angle, surface_spacing (keys not given keep the default)
+    contact : mapping
+        k_n, c_n, k_t, c_t, mu_s, mu_d (keys not given keep the default)
     """
 
     type_name = "HandPlant"
-    param_docs = {
-        "gravity": "[gx, gy] in m/s^2 (default [0, -9.81])",
-        "fingers": "list of three fingers: base, base_angle, links, damping, armature, tip_radius, q0",
-        "object": "mass, inertia, size, pos, angle, surface_spacing (keys not given keep the default)",
-        "contact": "k_n, c_n, k_t, c_t, mu_s, mu_d (keys not given keep the default)",
-    }
     feedthrough = False
 
     def __init__(self, gravity=None, fingers=None, object=None, contact=None):  # noqa: A002 - hand file name

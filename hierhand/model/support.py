@@ -15,7 +15,7 @@ import numpy as np
 
 from blocks import Block
 
-from .hand_source import HAND_DOC, ModelsTheHand, hand_of
+from .hand_source import ModelsTheHand, hand_of
 
 
 class ObjectSupport(ModelsTheHand, Block):
@@ -25,14 +25,20 @@ class ObjectSupport(ModelsTheHand, Block):
     centre): ``-m g`` with torque 0 while ``t < until``, zero from ``until`` on (as a
     ``Step`` switches). ``m`` and ``g`` are those of the hand of the block named by
     ``hand`` (``hand: plant``).
+
+    Parameters
+    ----------
+    hand : HandPlant or FMU
+        the block that simulates the hand (hand: plant); an FMU must be one exported by
+        'hierhand fmu export'; the hand is given once, on that block (from Python: the
+        block or a Hand); the support carries the weight of its object
+    until : float
+        time, s, from which the support is gone (the hand-over); the force is zero from
+        then on
     """
 
     type_name = "ObjectSupport"
     time_varying = True
-    param_docs = {
-        "hand": HAND_DOC + "; the support carries the weight of its object",
-        "until": "time, s, from which the support is gone (the hand-over); the force is zero from then on",
-    }
 
     def __init__(self, hand, until: float = 0.1):
         self.hand = hand_of(hand)

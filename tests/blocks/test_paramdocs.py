@@ -7,6 +7,7 @@ import pytest
 from blocks import Block
 from blocks.library import LIBRARY
 from blocks.paramdocs import ParamDoc, parameter_docs, parse_parameters
+from blocks.registry import block_types
 from blocks.typeinfo import describe_type
 
 
@@ -38,18 +39,26 @@ class Documented(Block):
         self.inputs, self.outputs = {"u": 1}, {"y": 1}
 
 
-class Legacy(Block):
-    """A block with the older ``param_docs``, which wins over its docstring.
+class Shared:
+    """A mixin documenting a parameter its blocks share.
 
     Parameters
     ----------
     a : int
-        from the docstring
+        from the mixin
     b : int
-        from the docstring too
+        from the mixin too
     """
 
-    param_docs = {"a": "from param_docs"}
+
+class UsesShared(Shared, Block):
+    """A block that documents ``a`` itself, which wins over the mixin's text.
+
+    Parameters
+    ----------
+    a : int
+        from the block
+    """
 
     def __init__(self, a: int = 1, b: int = 2):
         self.inputs, self.outputs = {}, {"y": 1}
@@ -86,9 +95,9 @@ def test_the_section_ends_at_a_line_that_is_no_entry():
     assert parse_parameters(doc) == {"k": ParamDoc("float", "the gain")}
 
 
-def test_param_docs_still_win_and_subclasses_inherit_what_they_do_not_document():
-    assert parameter_docs(Legacy) == {"a": ParamDoc("", "from param_docs"),
-                                      "b": ParamDoc("int", "from the docstring too")}
+def test_the_nearest_class_wins_and_subclasses_inherit_what_they_do_not_document():
+    assert parameter_docs(UsesShared) == {"a": ParamDoc("int", "from the block"),
+                                          "b": ParamDoc("int", "from the mixin too")}
     refined = parameter_docs(Refined)
     assert refined["gain"] == ParamDoc("int", "a whole gain")
     assert refined["lo"] == ParamDoc("scalar or vector", "the limits")
@@ -100,9 +109,26 @@ def test_hierhand_blocks_shows_type_default_and_text_from_the_docstring():
     assert "    mode (default 'a')\n" in text
 
 
-@pytest.mark.parametrize("cls", LIBRARY, ids=lambda cls: cls.registered_name())
-def test_every_library_block_documents_exactly_its_parameters_in_its_docstring(cls):
-    assert "param_docs" not in vars(cls), "document the parameters in the docstring's Parameters section"
-    docs = parse_parameters(cls.__doc__)
-    assert list(docs) == list(cls.parameters())
-    assert all(doc.text for doc in docs.values())
+def test_the_registered_types_are_the_library_and_the_installed_entry_points():
+    from blocks import registry
+
+    types = block_types()
+    assert registry._load_errors == {}
+    assert {cls.registered_name() for cls in LIBRARY} <= set(types)
+    assert {"FMU", "HandPlant", "GraspReflex", "ManipulationPD", "ObjectSupport", "Suppresser"} <= set(types)
+
+
+@pytest.mark.parametrize("name", sorted(block_types()))
+def test_every_registered_block_documents_exactly_its_parameters(name):
+    """Every type ``hierhand blocks`` lists (the library and every ``blocks.types`` entry
+    point, hierhand's included): each ``__init__`` parameter documented with a text, in
+    its own docstring or a base class's / mixin's, and nothing documented it does not take."""
+    cls = block_types()[name]
+    docs = parameter_docs(cls)
+    params = list(cls.parameters())
+    assert sorted(docs) == sorted(params), (
+        f"{name}: undocumented {sorted(set(params) - set(docs))}, documented but no parameter "
+        f"{sorted(set(docs) - set(params))}; write them in the Parameters section of its docstring")
+    assert [n for n, doc in docs.items() if not doc.text] == []
+    own = list(parse_parameters(cls.__doc__))
+    assert own == [n for n in params if n in own], f"{name}: document the parameters in signature order"
