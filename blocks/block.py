@@ -252,7 +252,7 @@ class Block:
     @classmethod
     def accepts_any_parameter(cls) -> bool:
         """True when ``__init__`` takes ``**kwargs`` (parameters are then not checked by name)."""
-        return any(p.kind == p.VAR_KEYWORD for p in inspect.signature(cls.__init__).parameters.values())
+        return _accepts_any(cls.__init__)
 
     def is_stateful(self) -> bool:
         return self.initial_state() is not None
@@ -287,3 +287,8 @@ def _init_parameters(init) -> dict[str, inspect.Parameter]:
     return {name: p for name, p in sig.parameters.items()
             if name != "self" and p.kind in (p.POSITIONAL_OR_KEYWORD, p.KEYWORD_ONLY)}
 
+
+
+@functools.cache
+def _accepts_any(init) -> bool:
+    return any(p.kind == p.VAR_KEYWORD for p in inspect.signature(init).parameters.values())

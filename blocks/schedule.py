@@ -22,6 +22,7 @@ Everything that can be decided before a run is decided here, once:
 
 from __future__ import annotations
 
+import heapq
 import math
 import weakref
 from collections import deque
@@ -386,13 +387,32 @@ class _Planner:
     def order_outputs(self, nodes: set[str], initial: bool = False) -> tuple[Steps, tuple[HeldInput, ...]]:
         """Evaluation steps for ``nodes`` (block, ports or None for all) and the inputs held
         to break loops at tick 0 (``initial``); an algebraic loop is a DiagramError."""
-        graph = nx.DiGraph()
-        graph.add_nodes_from(nodes)
-        graph.add_edges_from((c.src_block, c.dst_block) for c in self.feeds(nodes, initial))
-        if nx.is_directed_acyclic_graph(graph):
-            order = nx.lexicographical_topological_sort(graph, key=self.order.get)
+        order = self.topological_order(nodes, {(c.src_block, c.dst_block) for c in self.feeds(nodes, initial)})
+        if order is not None:
             return tuple((n, None) for n in order), ()
         return self.order_ports(nodes, initial)
+
+    def topological_order(self, nodes: set[str], edges: set[tuple[str, str]]) -> list[str] | None:
+        """``nodes`` in dependency order, among the ready ones always the first in diagram
+        order (as ``networkx.lexicographical_topological_sort`` keyed by it); None when
+        ``edges`` close a cycle."""
+        waiting = dict.fromkeys(nodes, 0)
+        after: dict[str, list[str]] = {}
+        for src, dst in edges:
+            waiting[dst] += 1
+            after.setdefault(src, []).append(dst)
+        rank = self.order
+        ready = [(rank[n], n) for n, count in waiting.items() if count == 0]
+        heapq.heapify(ready)
+        order = []
+        while ready:
+            _, n = heapq.heappop(ready)
+            order.append(n)
+            for m in after.get(n, ()):
+                waiting[m] -= 1
+                if waiting[m] == 0:
+                    heapq.heappush(ready, (rank[m], m))
+        return order if len(order) == len(waiting) else None
 
     def order_ports(self, nodes: set[str], initial: bool) -> tuple[Steps, tuple[HeldInput, ...]]:
         """Port-level order for blocks whose outputs have different feedthrough, dropping

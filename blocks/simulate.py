@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import platform
+import re
 import time
 from fractions import Fraction
 from importlib import metadata
@@ -147,6 +148,82 @@ class _Logger:
         self.hits += n
 
 
+class _ProgramCode:
+    """An event program written out as Python functions ``run(k, next_k)``.
+
+    Each step (a block's outputs, an update, a sample, an advance) is a few lines of
+    source with its own ``try``, which costs nothing unless something is raised, so a
+    failure is reported with its block, phase and tick as a step of closures would be.
+    The source names no object and holds no text from the diagram: every block method,
+    mapping, port name and block name is a variable ``vN`` of an enclosing factory,
+    called with the objects themselves. Source of the same shape is compiled once
+    (``_factory``): the programs of repeated runs, and the segments of a long program
+    (``SEGMENT`` steps each, so a program of many blocks never makes one huge function),
+    share their code.
+    """
+
+    SEGMENT = 64
+
+    def __init__(self, base_tick: Fraction):
+        self.objects: list[Any] = []
+        self.ids: dict[int, str] = {}
+        self.steps: list[list[str]] = []
+        self.tick = (base_tick.numerator, base_tick.denominator)
+
+    def bind(self, obj: Any) -> str:
+        """The variable that holds ``obj`` in the generated source."""
+        name = self.ids.get(id(obj))
+        if name is None:
+            name = self.ids[id(obj)] = f"v{len(self.objects)}"
+            self.objects.append(obj)
+        return name
+
+    def step(self, *lines: str, handlers: list[str] | None = None) -> None:
+        """One step: ``lines``, in a ``try`` with ``handlers`` (except clauses) if given."""
+        if handlers:
+            lines = ("try:", *("    " + line for line in lines), *handlers)
+        self.steps.append(list(lines))
+
+    def function(self) -> Callable[[int, int], None]:
+        num, den = (self.bind(x) for x in self.tick)
+        size = self.SEGMENT
+        segments = [self.segment(self.steps[j:j + size], num, den)
+                    for j in range(0, max(len(self.steps), 1), size)]
+        if len(segments) == 1:
+            return segments[0]
+
+        def run(k: int, next_k: int) -> None:
+            for segment in segments:
+                segment(k, next_k)
+
+        return run
+
+    def segment(self, steps: list[list[str]], num: str, den: str) -> Callable[[int, int], None]:
+        """The steps as one function; its variables renumbered from v0 in order of use,
+        so that segments of the same shape have the same source."""
+        names: dict[str, str] = {}
+
+        def local(match: re.Match) -> str:
+            return names.setdefault(match.group(0), f"v{len(names)}")
+
+        body = [_VARIABLE.sub(local, line) for line in [f"t = k * {num} / {den}"] + sum(steps, [])]
+        source = (f"def factory({', '.join(names.values())}):\n"
+                  "    def run(k, next_k):\n" + "".join(f"        {line}\n" for line in body) +
+                  "    return run\n")
+        return _factory(source)(*(self.objects[int(name[1:])] for name in names))
+
+
+_VARIABLE = re.compile(r"\bv[0-9]+\b")
+
+
+@functools.lru_cache(maxsize=1024)
+def _factory(source: str) -> Callable[..., Callable[[int, int], None]]:
+    """Compile a ``_ProgramCode`` segment's source (generated, never from a user) once."""
+    namespace: dict[str, Any] = {}
+    exec(compile(source, "<event program>", "exec"), namespace)
+    return namespace["factory"]
+
+
 class _Run:
     """The mutable side of one run: states, input mappings, held outputs and logs."""
 
@@ -194,49 +271,40 @@ class _Run:
     # -- building the per-event programs ------------------------------------------------
 
     def compile(self, program: EventProgram) -> Callable[[int, int], None]:
-        tick = self.s.base_tick
-        num, den = tick.numerator, tick.denominator
+        """The program as one function ``run(k, next_k)``: its steps written out as Python
+        source (``_ProgramCode``), so an event costs no loop over closures."""
+        code = _ProgramCode(self.s.base_tick)
         last_step = {b: i for i, (b, _) in enumerate(program.evaluate)}
-        outputs = [self.output_op(b, ports, log=(b in program.firing and last_step[b] == i))
-                   for i, (b, ports) in enumerate(program.evaluate)]
-        updates = [self.update_op(b) for b in program.update]
-        samples = [self.sample_op(self.d.connections[i]) for i in program.sample]
-        advances = [self.advance_op(b, last=b == program.advance[-1]) for b in program.advance]
+        for i, (b, ports) in enumerate(program.evaluate):
+            self.output_step(code, b, ports, log=(b in program.firing and last_step[b] == i))
+        for b in program.update:
+            self.update_step(code, b)
+        for i in program.sample:
+            self.sample_step(code, self.d.connections[i])
+        for b in program.advance:
+            code.step(f"{code.bind(self.advance_op(b, last=b == program.advance[-1]))}(k, next_k)")
+        return code.function()
 
-        def run(k: int, next_k: int) -> None:
-            t = k * num / den
-            for op in outputs:
-                op(k, t)
-            for op in updates:
-                op(k, t)
-            for op in samples:
-                op()
-            for op in advances:
-                op(k, next_k)
-
-        return run
-
-    def output_op(self, name: str, ports: tuple[str, ...] | None, log: bool):
+    def output_step(self, code: "_ProgramCode", name: str, ports: tuple[str, ...] | None, log: bool) -> None:
+        """Compute ``name``'s outputs (``ports``, or all), check them the first time, pass
+        them by reference to their readers and log them when ``log``."""
         blk = self.d.blocks[name].block
-        output, i, inp, states = blk.output, self.index[name], self.inputs[name], self.states
         publish = tuple(blk.outputs) if ports is None else ports
         targets = self.hold_targets(name, publish) + [f for f in self.fanout[name] if f[2] in publish]
         loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]] if log else []
-        checked = self.checked
-
-        def op(k: int, t: float) -> None:
-            try:
-                out = output(t, states[i], inp)
-                if name not in checked:
-                    self.check_outputs(name, out, publish)
-                for d, dp, sp in targets:
-                    d[dp] = out[sp]
-                for lg, p in loggers:
-                    lg.add(out[p])
-            except Exception as exc:
-                raise _StepFailure(name, "output", k, exc) from exc
-
-        return op
+        v = code.bind
+        value: dict[str, str] = {}
+        lines = [f"out = {v(blk.output)}(t, {v(self.states)}[{v(self.index[name])}], {v(self.inputs[name])})",
+                 f"if {v(name)} not in {v(self.checked)}:",
+                 f"    {v(self.check_outputs)}({v(name)}, out, {v(publish)})"]
+        for port in [sp for _, _, sp in targets] + [p for _, p in loggers]:
+            if port not in value:
+                value[port] = f"o{len(value)}"
+                lines.append(f"{value[port]} = out[{v(port)}]")
+        lines += [f"{v(d)}[{v(dp)}] = {value[sp]}" for d, dp, sp in targets]
+        lines += [f"{v(lg.add)}({value[p]})" for lg, p in loggers]
+        code.step(*lines, handlers=["except Exception as exc:",
+                                    f"    raise {v(_StepFailure)}({v(name)}, 'output', k, exc) from exc"])
 
     def hold_targets(self, name: str, ports) -> list[tuple[dict, str, str]]:
         """Where a block's new outputs must also be kept: only the ports that delayed
@@ -244,20 +312,18 @@ class _Run:
         sampled = self.sampled[name]
         return [(self.held[name], p, p) for p in ports if p in sampled]
 
-    def update_op(self, name: str):
-        update, i, inp, states = self.d.blocks[name].block.update, self.index[name], self.inputs[name], self.states
-
-        def op(k: int, t: float) -> None:
-            try:
-                states[i] = update(t, states[i], inp)
-            except EndRun as end:
-                if end.has_state:
-                    states[i] = end.state
-                self.request_end(name, end.reason, k)
-            except Exception as exc:
-                raise _StepFailure(name, "update", k, exc) from exc
-
-        return op
+    def update_step(self, code: "_ProgramCode", name: str) -> None:
+        """Update ``name``'s state; an ``EndRun`` asks for the end and the tick goes on."""
+        v = code.bind
+        state = f"{v(self.states)}[{v(self.index[name])}]"
+        update = f"{v(self.d.blocks[name].block.update)}(t, {state}, {v(self.inputs[name])})"
+        code.step(f"{state} = {update}",
+                  handlers=[f"except {v(EndRun)} as end:",
+                            "    if end.has_state:",
+                            f"        {state} = end.state",
+                            f"    {v(self.request_end)}({v(name)}, end.reason, k)",
+                            "except Exception as exc:",
+                            f"    raise {v(_StepFailure)}({v(name)}, 'update', k, exc) from exc"])
 
     def request_end(self, name: str, reason: str, k: int) -> None:
         """Record a block's EndRun at tick ``k``: the run ends at the block's next hit, or
@@ -269,13 +335,10 @@ class _Run:
         if nxt is not None and nxt < self.end_tick:
             self.end_tick = nxt
 
-    def sample_op(self, c):
-        src, dst, sp, dp = self.held[c.src_block], self.inputs[c.dst_block], c.src_port, c.dst_port
-
-        def op() -> None:
-            dst[dp] = src[sp]
-
-        return op
+    def sample_step(self, code: "_ProgramCode", c) -> None:
+        """A delayed connection takes the value its source holds now."""
+        v = code.bind
+        code.step(f"{v(self.inputs[c.dst_block])}[{v(c.dst_port)}] = {v(self.held[c.src_block])}[{v(c.src_port)}]")
 
     def advance_op(self, name: str, last: bool):
         """Steps ``name`` to the next event in chunks, each from the time of its first
@@ -365,22 +428,21 @@ class _Run:
 
     # -- running ----------------------------------------------------------------------
 
-    def events(self):
-        """Event ticks after 0 with their programs, in order, without end."""
+    def spans(self) -> list[tuple[int, int, Callable[[int, int], None]]]:
+        """The events of one hyperperiod after tick 0 as ``(k, next_k, program)``: each
+        event's tick, the next event's tick and its compiled program; those of later
+        hyperperiods are these shifted by whole hyperperiods."""
         ticks = [int(x) for x in self.s.event_ticks]
         if not ticks:
-            return
+            return []
         compiled = [self.compile(p) for p in self.s.programs]
         progs = [compiled[j] for j in self.s.event_programs]
-        hyper, cycle = self.s.hyperperiod, 0
+        hyper = self.s.hyperperiod
         pairs = list(zip(ticks, progs))
         if ticks[0] == 0:
             pairs = pairs[1:] + [(ticks[0] + hyper, progs[0])]
-        while True:
-            base = cycle * hyper
-            for k, prog in pairs:
-                yield base + k, prog
-            cycle += 1
+        following = [k for k, _ in pairs[1:]] + [pairs[0][0] + hyper]
+        return [(k, nk, prog) for (k, prog), nk in zip(pairs, following)]
 
     def execute(self, progress: ProgressCallback | None) -> tuple[Results, SimulationError | None]:
         """Run ticks 0 .. end. Progress is the fraction of t_end reached, so a run that a
@@ -391,25 +453,27 @@ class _Run:
         interrupted: KeyboardInterrupt | None = None
         labels: dict[str, list[str]] = {}
         k = 0
-        stream = self.events()
         initial = self.compile(self.s.initial)
         try:
             labels = self.element_labels()
-            nk, nprog = next(stream, (n, None))
-            nk = min(nk, n)
-            initial(0, nk)
+            spans = self.spans()
+            initial(0, min(spans[0][0], n) if spans else n)
             n = self.end_tick
-            count = 0
-            while nk < n:
-                k, prog = nk, nprog
-                nk, nprog = next(stream)
-                if nk > n:
-                    nk = n
-                prog(k, nk)
-                n = self.end_tick
-                count += 1
-                if progress is not None and count & 255 == 0:
-                    progress(k / total, time.perf_counter() - wall0)
+            count = base = 0
+            running = bool(spans)
+            while running:
+                for first, following, prog in spans:
+                    k = base + first
+                    if k >= n:
+                        running = False
+                        break
+                    nk = base + following
+                    prog(k, nk if nk < n else n)
+                    n = self.end_tick
+                    count += 1
+                    if progress is not None and count & 255 == 0:
+                        progress(k / total, time.perf_counter() - wall0)
+                base += self.s.hyperperiod
             k = n
             final = self.s.final if n == total else final_program(self.d, self.s, n)
             self.compile(final)(n, n)
