@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import functools
 import platform
-import re
 import time
 from fractions import Fraction
 from importlib import metadata
@@ -165,32 +164,42 @@ class _ProgramCode:
     SEGMENT = 64
 
     def __init__(self, base_tick: Fraction):
+        self.tick = (base_tick.numerator, base_tick.denominator)
+        self.segments: list[tuple[list[str], list[Any]]] = []
+        self.count = 0
+        self.start_segment()
+
+    def start_segment(self) -> None:
+        """Bind from now on into a new segment, whose variables count from v0."""
+        self.lines: list[str] = []
         self.objects: list[Any] = []
         self.ids: dict[int, str] = {}
-        self.steps: list[list[str]] = []
-        self.tick = (base_tick.numerator, base_tick.denominator)
+        self.segments.append((self.lines, self.objects))
+        num, den = (self.bind(x) for x in self.tick)
+        self.lines.append(f"t = k * {num} / {den}")
 
     def bind(self, obj: Any) -> str:
-        """The variable that holds ``obj`` in the generated source."""
+        """The variable that holds ``obj`` in the current segment's source."""
         name = self.ids.get(id(obj))
         if name is None:
             name = self.ids[id(obj)] = f"v{len(self.objects)}"
             self.objects.append(obj)
         return name
 
-    def step(self, *lines: str, handlers: list[str] | None = None) -> None:
-        """One step: ``lines``, in a ``try`` with ``handlers`` (except clauses) if given."""
+    def step(self, *lines: str, handlers: tuple[str, ...] = (), setup: tuple[str, ...] = ()) -> None:
+        """One step: ``setup``, then ``lines`` in a ``try`` with ``handlers`` (except
+        clauses) if given. The variables it uses must be bound before."""
         if handlers:
             lines = ("try:", *("    " + line for line in lines), *handlers)
-        self.steps.append(list(lines))
+        self.lines += setup + lines
+        self.count += 1
+        if self.count % self.SEGMENT == 0:
+            self.start_segment()
 
     def function(self) -> Callable[[int, int], None]:
-        num, den = (self.bind(x) for x in self.tick)
-        size = self.SEGMENT
-        segments = [self.segment(self.steps[j:j + size], num, den)
-                    for j in range(0, max(len(self.steps), 1), size)]
-        if len(segments) == 1:
-            return segments[0]
+        segments = [self.compiled(lines, objects) for lines, objects in self.segments if len(lines) > 1]
+        if len(segments) <= 1:
+            return segments[0] if segments else self.compiled(*self.segments[0])
 
         def run(k: int, next_k: int) -> None:
             for segment in segments:
@@ -198,22 +207,12 @@ class _ProgramCode:
 
         return run
 
-    def segment(self, steps: list[list[str]], num: str, den: str) -> Callable[[int, int], None]:
-        """The steps as one function; its variables renumbered from v0 in order of use,
-        so that segments of the same shape have the same source."""
-        names: dict[str, str] = {}
-
-        def local(match: re.Match) -> str:
-            return names.setdefault(match.group(0), f"v{len(names)}")
-
-        body = [_VARIABLE.sub(local, line) for line in [f"t = k * {num} / {den}"] + sum(steps, [])]
-        source = (f"def factory({', '.join(names.values())}):\n"
-                  "    def run(k, next_k):\n" + "".join(f"        {line}\n" for line in body) +
+    @staticmethod
+    def compiled(lines: list[str], objects: list[Any]) -> Callable[[int, int], None]:
+        source = (f"def factory({', '.join(f'v{j}' for j in range(len(objects)))}):\n"
+                  "    def run(k, next_k):\n" + "".join(f"        {line}\n" for line in lines) +
                   "    return run\n")
-        return _factory(source)(*(self.objects[int(name[1:])] for name in names))
-
-
-_VARIABLE = re.compile(r"\bv[0-9]+\b")
+        return _factory(source)(*objects)
 
 
 @functools.lru_cache(maxsize=1024)
@@ -282,7 +281,7 @@ class _Run:
         for i in program.sample:
             self.sample_step(code, self.d.connections[i])
         for b in program.advance:
-            code.step(f"{code.bind(self.advance_op(b, last=b == program.advance[-1]))}(k, next_k)")
+            self.advance_step(code, b, last=b == program.advance[-1])
         return code.function()
 
     def output_step(self, code: "_ProgramCode", name: str, ports: tuple[str, ...] | None, log: bool) -> None:
@@ -303,8 +302,8 @@ class _Run:
                 lines.append(f"{value[port]} = out[{v(port)}]")
         lines += [f"{v(d)}[{v(dp)}] = {value[sp]}" for d, dp, sp in targets]
         lines += [f"{v(lg.add)}({value[p]})" for lg, p in loggers]
-        code.step(*lines, handlers=["except Exception as exc:",
-                                    f"    raise {v(_StepFailure)}({v(name)}, 'output', k, exc) from exc"])
+        code.step(*lines, handlers=("except Exception as exc:",
+                                    f"    raise {v(_StepFailure)}({v(name)}, 'output', k, exc) from exc"))
 
     def hold_targets(self, name: str, ports) -> list[tuple[dict, str, str]]:
         """Where a block's new outputs must also be kept: only the ports that delayed
@@ -318,12 +317,12 @@ class _Run:
         state = f"{v(self.states)}[{v(self.index[name])}]"
         update = f"{v(self.d.blocks[name].block.update)}(t, {state}, {v(self.inputs[name])})"
         code.step(f"{state} = {update}",
-                  handlers=[f"except {v(EndRun)} as end:",
+                  handlers=(f"except {v(EndRun)} as end:",
                             "    if end.has_state:",
                             f"        {state} = end.state",
                             f"    {v(self.request_end)}({v(name)}, end.reason, k)",
                             "except Exception as exc:",
-                            f"    raise {v(_StepFailure)}({v(name)}, 'update', k, exc) from exc"])
+                            f"    raise {v(_StepFailure)}({v(name)}, 'update', k, exc) from exc"))
 
     def request_end(self, name: str, reason: str, k: int) -> None:
         """Record a block's EndRun at tick ``k``: the run ends at the block's next hit, or
@@ -340,50 +339,48 @@ class _Run:
         v = code.bind
         code.step(f"{v(self.inputs[c.dst_block])}[{v(c.dst_port)}] = {v(self.held[c.src_block])}[{v(c.src_port)}]")
 
-    def advance_op(self, name: str, last: bool):
+    def advance_step(self, code: _ProgramCode, name: str, last: bool) -> None:
         """Steps ``name`` to the next event in chunks, each from the time of its first
-        tick (``tick * base_tick``, as at events, never a sum of periods). An interrupt in
-        the span records how far the last advanced block of the event got (the earlier
-        ones are further, the later ones still at the event): every block was computed
-        up to there."""
+        tick (``tick * base_tick``, as at events, never a sum of periods), logging each
+        chunk's rows (queued as ``_Logger.add_rows`` does) and passing on the last row.
+        An interrupt in the span records how far the last advanced block of the event got
+        (the earlier ones are further, the later ones still at the event): every block was
+        computed up to there."""
         blk = self.d.blocks[name].block
-        advance, i, inp, states = blk.advance, self.index[name], self.inputs[name], self.states
-        period = self.s.period_ticks[name]
-        num, den = self.s.base_tick.numerator, self.s.base_tick.denominator
+        v = code.bind
+        period = v(self.s.period_ticks[name])
+        num, den = (v(x) for x in code.tick)
+        state = f"{v(self.states)}[{v(self.index[name])}]"
         ports = tuple(blk.outputs)
         by_port: dict[str, list[tuple[dict, str]]] = {}
         for d, dp, sp in self.hold_targets(name, ports) + self.fanout[name]:
             by_port.setdefault(sp, []).append((d, dp))
-        targets = list(by_port.items())
         loggers = [(lg.add_rows, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
-        checked, key = self.checked, name + ":advance"
+        lines = ["while n > 0:",
+                 f"    m = n if n <= {v(ADVANCE_CHUNK)} else {v(ADVANCE_CHUNK)}",
+                 f"    {state}, rows = {v(blk.advance)}((k + done * {period}) * {num} / {den}, {state}, "
+                 f"{v(self.inputs[name])}, m)",
+                 f"    if {v(name + ':advance')} not in {v(self.checked)}:",
+                 f"        {v(self.check_rows)}({v(name)}, rows, {v(ports)}, m)"]
+        for lg in self.loggers[name]:
+            lines += [f"    {v(lg.pending)}.append(rows[{v(lg.name.split('.', 1)[1])}])",
+                      f"    if len({v(lg.pending)}) >= {v(lg.BATCH)}:",
+                      f"        {v(lg.flush)}()"]
+        lines += ["    n -= m", "    done += m"]
+        for p, dests in by_port.items():
+            lines.append(f"value = rows[{v(p)}][-1]")
+            lines += [f"{v(d)}[{v(dp)}] = value" for d, dp in dests]
+        code.step(*lines, setup=(f"n = (next_k - k) // {period}", "done = 0"), handlers=(
+            "except KeyboardInterrupt:",
+            *([f"    {v(self.interrupted_in_span)}({v(name)}, k + done * {period})"] if last else []),
+            "    raise",
+            "except Exception as exc:",
+            f"    done += {v(self.log_partial_rows)}({v(name)}, exc, {v(ports)}, {v(loggers)})",
+            f"    raise {v(_StepFailure)}({v(name)}, 'advance', k + done * {period}, exc) from exc"))
 
-        def op(k: int, next_k: int) -> None:
-            n = (next_k - k) // period
-            done = 0
-            try:
-                while n > 0:
-                    m = n if n <= ADVANCE_CHUNK else ADVANCE_CHUNK
-                    states[i], rows = advance((k + done * period) * num / den, states[i], inp, m)
-                    if key not in checked:
-                        self.check_rows(name, rows, ports, m)
-                    for add, p in loggers:
-                        add(rows[p])
-                    n -= m
-                    done += m
-                for p, dests in targets:
-                    value = rows[p][-1]
-                    for d, dp in dests:
-                        d[dp] = value
-            except KeyboardInterrupt:
-                if last:
-                    self.reached = self.logged_tick(name, k + done * period)
-                raise
-            except Exception as exc:
-                done += self.log_partial_rows(name, exc, ports, loggers)
-                raise _StepFailure(name, "advance", k + done * period, exc) from exc
-
-        return op
+    def interrupted_in_span(self, name: str, counted: int) -> None:
+        """An interrupt came while the event's last advanced block stepped its span."""
+        self.reached = self.logged_tick(name, counted)
 
     def logged_tick(self, name: str, counted: int) -> int:
         """The tick of the last hit of ``name`` that its logs hold, which is where its data

@@ -280,6 +280,27 @@ log: [acc.y, clk.y]
     np.testing.assert_array_equal(y[:, 0], np.arange(24.0))
 
 
+def test_a_program_longer_than_one_generated_segment_keeps_its_order_and_failures():
+    """A program of more steps than one generated function holds (``_ProgramCode.SEGMENT``)
+    runs its segments in order, and a failure in a later segment names its block."""
+    n = 150
+    gains = "\n".join(f"  g{i}: {{type: Gain, params: {{k: 2.0}}}}" for i in range(n))
+    wires = ", ".join(["clk.y -> g0.u"] + [f"g{i - 1}.y -> g{i}.u" for i in range(1, n)] + [f"g{n - 1}.y -> f.u"])
+    res = run(f"""
+time: {{t_end: 10 ms}}
+blocks:
+  clk: {{type: "{DEFS}:Clock", period: 1 ms}}
+{gains}
+  f: {{type: "{DEFS}:FailAfter", params: {{t_fail: 0.0045}}}}
+connections: [{wires}]
+log: [g{n - 1}.y, f.y]
+""")
+    assert res.status.startswith("failed at t=0.005 s: block 'f'") and "f.y output: value out of range" in res.status
+    t, y = res[f"g{n - 1}.y"]
+    np.testing.assert_array_equal(y[:, 0], t * 2.0 ** n)
+    np.testing.assert_array_equal(res["f.y"][1][:, 0], y[:5, 0])
+
+
 def test_failure_can_raise_with_results():
     diagram = loads_diagram(f"""
 time: {{t_end: 10 ms}}
