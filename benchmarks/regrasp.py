@@ -18,7 +18,8 @@ Reports, as medians of --repeat runs after one warm-up run:
 - the split of the full run: the plant (bare core, chunked) against the rest
   (controllers, executor, loader, logging).
 
-Target: at most 30 ms of wall time per simulated second through loader + scheduler.
+Targets (issue 15): at most 15 ms of wall time per simulated second through loader +
+scheduler, and at most 4 ms per simulated second above the bare plant core (chunked).
 Reference: MuJoCo stepping the same hand, controlled every 1 ms from Python, needs about
 71 ms per simulated second on this machine type.
 
@@ -42,7 +43,8 @@ ROOT = Path(__file__).resolve().parent.parent
 REGRASP = ROOT / "diagrams" / "regrasp.yaml"
 CHUNK = 10  # plant steps between 1 ms controller events
 SQUEEZE = 3.0  # N, inward on thumb and forefinger tips
-TARGET_MS = 30.0
+TARGET_MS = 15.0
+TARGET_ABOVE_CORE_MS = 4.0
 MUJOCO_MS = 71.0
 HOLD_STEPS = 2500  # the open-loop pinch holds about 0.4 s; restart every 0.25 s for the held variant
 
@@ -183,6 +185,8 @@ def main() -> None:
     print(f"  reference: MuJoCo stepping the same hand, controlled every 1 ms from Python: ~{MUJOCO_MS:g} ms per"
           f" simulated s; full run / MuJoCo = {ms_full / MUJOCO_MS:.2f}")
     print(f"target: <= {TARGET_MS:g} ms per simulated second: {'met' if ms_full <= TARGET_MS else 'NOT met'}")
+    print(f"target: <= {TARGET_ABOVE_CORE_MS:g} ms per simulated second above the bare core (chunked): "
+          f"{'met' if rest <= TARGET_ABOVE_CORE_MS else 'NOT met'} ({rest:.2f} ms)")
     if args.profile:
         profile_simulate(diagram, t_end)
 

@@ -2,7 +2,7 @@
 loader and the executor, against a hand-written Python loop of the same equations.
 
 Prints microseconds per base tick (0.1 ms) for both, median of several runs, and the
-ratio. Target: at most 1 us per base tick through the executor.
+ratio. Target (issue 15): loader + executor at most 5 times the hand-written loop.
 
 Then planning cost: chains ``src: Constant -> g0 -> ... -> g{n-1}`` of n Gain blocks,
 generated in memory, loaded and planned (``loads_diagram``) and run for 2 base ticks.
@@ -28,6 +28,8 @@ import numpy as np
 import blocks
 
 TOY = Path(__file__).resolve().parent.parent / "diagrams" / "toy.yaml"
+TARGET_RATIO = 5.0
+"""Issue 15: load + simulate of the toy diagram within this many times the hand loop."""
 
 
 def hand_loop(n_ticks: int) -> np.ndarray:
@@ -133,7 +135,8 @@ def main() -> None:
     print(f"blocks (load + simulate)   : {t_full * per:7.3f} us/tick   ratio to hand loop {t_full / t_hand:6.2f}")
     print(f"blocks (simulate only)     : {t_exec * per:7.3f} us/tick   ratio to hand loop {t_exec / t_hand:6.2f}")
     print(f"max |difference| to hand loop: {err:.2e}")
-    print(f"target: <= 1 us/tick through loader + scheduler: {'met' if t_full * per <= 1.0 else 'NOT met'}")
+    print(f"target: <= {TARGET_RATIO:g}x the hand-written loop through loader + scheduler: "
+          f"{'met' if t_full <= TARGET_RATIO * t_hand else 'NOT met'} ({t_full / t_hand:.2f}x)")
     sizes = [int(n) for n in args.chains.split(",") if n.strip()]
     if sizes:
         report_chains(sizes, args.chain_repeat, collect=not args.no_gc)
