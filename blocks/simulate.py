@@ -121,19 +121,27 @@ class _Logger:
         self.decimate = decimate
         self.pending: list[np.ndarray] = []
 
-    def add(self, value: np.ndarray) -> None:
-        if self.pending:
-            self.flush()
-        if self.hits % self.decimate == 0:
-            self.buf[self.pos] = value
-            self.pos += 1
-        self.hits += 1
+    def add_source(self, code: "_ProgramCode", value: str) -> list[str]:
+        """Source lines of a generated program that log the output ``value`` (the name of
+        a variable there): queued rows first, then every ``decimate``-th hit."""
+        v = code.bind
+        store = [f"{v(self.buf)}[{v(self)}.pos] = {value}", f"{v(self)}.pos += 1"]
+        if self.decimate != 1:
+            store = [f"if {v(self)}.hits % {v(self.decimate)} == 0:", *("    " + line for line in store)]
+        return [f"if {v(self.pending)}:", f"    {v(self.flush)}()", *store, f"{v(self)}.hits += 1"]
 
     def add_rows(self, rows: np.ndarray) -> None:
         pending = self.pending
         pending.append(rows)
         if len(pending) >= self.BATCH:
             self.flush()
+
+    def add_rows_source(self, code: "_ProgramCode", rows: str) -> list[str]:
+        """Source lines of a generated program that do ``add_rows(rows)``."""
+        v = code.bind
+        return [f"{v(self.pending)}.append({rows})",
+                f"if len({v(self.pending)}) >= {v(self.BATCH)}:",
+                f"    {v(self.flush)}()"]
 
     def flush(self) -> None:
         """Copy the queued rows into the buffer."""
@@ -301,7 +309,8 @@ class _Run:
                 value[port] = f"o{len(value)}"
                 lines.append(f"{value[port]} = out[{v(port)}]")
         lines += [f"{v(d)}[{v(dp)}] = {value[sp]}" for d, dp, sp in targets]
-        lines += [f"{v(lg.add)}({value[p]})" for lg, p in loggers]
+        for lg, p in loggers:
+            lines += lg.add_source(code, value[p])
         code.step(*lines, handlers=("except Exception as exc:",
                                     f"    raise {v(_StepFailure)}({v(name)}, 'output', k, exc) from exc"))
 
@@ -363,9 +372,8 @@ class _Run:
                  f"    if {v(name + ':advance')} not in {v(self.checked)}:",
                  f"        {v(self.check_rows)}({v(name)}, rows, {v(ports)}, m)"]
         for lg in self.loggers[name]:
-            lines += [f"    {v(lg.pending)}.append(rows[{v(lg.name.split('.', 1)[1])}])",
-                      f"    if len({v(lg.pending)}) >= {v(lg.BATCH)}:",
-                      f"        {v(lg.flush)}()"]
+            rows = f"rows[{v(lg.name.split('.', 1)[1])}]"
+            lines += ["    " + line for line in lg.add_rows_source(code, rows)]
         lines += ["    n -= m", "    done += m"]
         for p, dests in by_port.items():
             lines.append(f"value = rows[{v(p)}][-1]")
