@@ -2,7 +2,8 @@
 
 Per event tick the executor runs a precompiled program: outputs of the firing blocks in
 feedthrough order, then their updates, then the sampling of delayed connections, then
-the advanced blocks stepped to the next event. Outputs are passed by reference from a
+the advanced blocks stepped to the next event. Each program is written out as one Python
+function (``_ProgramCode``), so an event runs straight-line code. Outputs are passed by reference from a
 block's return value into the persistent input mappings of the blocks it feeds (no
 per-tick dictionaries or copies); between hits values hold. Time is ``k * base_tick``
 from the integer tick ``k``.
@@ -160,10 +161,9 @@ class _ProgramCode:
 
     Each step (a block's outputs, an update, a sample, an advance) is a few lines of
     source with its own ``try``, which costs nothing unless something is raised, so a
-    failure is reported with its block, phase and tick as a step of closures would be.
-    The source names no object and holds no text from the diagram: every block method,
-    mapping, port name and block name is a variable ``vN`` of an enclosing factory,
-    called with the objects themselves. Source of the same shape is compiled once
+    failure is reported with its block, phase and tick. The source names no object and
+    holds no text from the diagram: every block method, mapping, port name and block
+    name is a variable ``vN`` of an enclosing factory, called with the objects themselves. Source of the same shape is compiled once
     (``_factory``): the programs of repeated runs, and the segments of a long program
     (``SEGMENT`` steps each, so a program of many blocks never makes one huge function),
     share their code.
@@ -188,9 +188,10 @@ class _ProgramCode:
 
     def bind(self, obj: Any) -> str:
         """The variable that holds ``obj`` in the current segment's source."""
-        name = self.ids.get(id(obj))
+        key = id(obj)
+        name = self.ids.get(key)
         if name is None:
-            name = self.ids[id(obj)] = f"v{len(self.objects)}"
+            name = self.ids[key] = f"v{len(self.objects)}"
             self.objects.append(obj)
         return name
 
@@ -279,7 +280,7 @@ class _Run:
 
     def compile(self, program: EventProgram) -> Callable[[int, int], None]:
         """The program as one function ``run(k, next_k)``: its steps written out as Python
-        source (``_ProgramCode``), so an event costs no loop over closures."""
+        source (``_ProgramCode``)."""
         code = _ProgramCode(self.s.base_tick)
         last_step = {b: i for i, (b, _) in enumerate(program.evaluate)}
         for i, (b, ports) in enumerate(program.evaluate):
@@ -300,10 +301,11 @@ class _Run:
         targets = self.hold_targets(name, publish) + [f for f in self.fanout[name] if f[2] in publish]
         loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]] if log else []
         v = code.bind
+        block = v(name)
         value: dict[str, str] = {}
         lines = [f"out = {v(blk.output)}(t, {v(self.states)}[{v(self.index[name])}], {v(self.inputs[name])})",
-                 f"if {v(name)} not in {v(self.checked)}:",
-                 f"    {v(self.check_outputs)}({v(name)}, out, {v(publish)})"]
+                 f"if {block} not in {v(self.checked)}:",
+                 f"    {v(self.check_outputs)}({block}, out, {v(publish)})"]
         for port in [sp for _, _, sp in targets] + [p for _, p in loggers]:
             if port not in value:
                 value[port] = f"o{len(value)}"
@@ -312,7 +314,7 @@ class _Run:
         for lg, p in loggers:
             lines += lg.add_source(code, value[p])
         code.step(*lines, handlers=("except Exception as exc:",
-                                    f"    raise {v(_StepFailure)}({v(name)}, 'output', k, exc) from exc"))
+                                    f"    raise {v(_StepFailure)}({block}, 'output', k, exc) from exc"))
 
     def hold_targets(self, name: str, ports) -> list[tuple[dict, str, str]]:
         """Where a block's new outputs must also be kept: only the ports that delayed
