@@ -126,10 +126,11 @@ class _Logger:
         """Source lines of a generated program that log the output ``value`` (the name of
         a variable there): queued rows first, then every ``decimate``-th hit."""
         v = code.bind
-        store = [f"{v(self.buf)}[{v(self)}.pos] = {value}", f"{v(self)}.pos += 1"]
+        lg = v(self)
+        store = [f"{v(self.buf)}[{lg}.pos] = {value}", f"{lg}.pos += 1"]
         if self.decimate != 1:
-            store = [f"if {v(self)}.hits % {v(self.decimate)} == 0:", *("    " + line for line in store)]
-        return [f"if {v(self.pending)}:", f"    {v(self.flush)}()", *store, f"{v(self)}.hits += 1"]
+            store = [f"if {lg}.hits % {v(self.decimate)} == 0:", *("    " + line for line in store)]
+        return [f"if {v(self.pending)}:", f"    {lg}.flush()", *store, f"{lg}.hits += 1"]
 
     def add_rows(self, rows: np.ndarray) -> None:
         pending = self.pending
@@ -140,9 +141,8 @@ class _Logger:
     def add_rows_source(self, code: "_ProgramCode", rows: str) -> list[str]:
         """Source lines of a generated program that do ``add_rows(rows)``."""
         v = code.bind
-        return [f"{v(self.pending)}.append({rows})",
-                f"if len({v(self.pending)}) >= {v(self.BATCH)}:",
-                f"    {v(self.flush)}()"]
+        pending = v(self.pending)
+        return [f"{pending}.append({rows})", f"if len({pending}) >= {v(self.BATCH)}:", f"    {v(self)}.flush()"]
 
     def flush(self) -> None:
         """Copy the queued rows into the buffer."""
@@ -219,8 +219,7 @@ class _ProgramCode:
     @staticmethod
     def compiled(lines: list[str], objects: list[Any]) -> Callable[[int, int], None]:
         source = (f"def factory({', '.join(f'v{j}' for j in range(len(objects)))}):\n"
-                  "    def run(k, next_k):\n" + "".join(f"        {line}\n" for line in lines) +
-                  "    return run\n")
+                  "    def run(k, next_k):\n        " + "\n        ".join(lines) + "\n    return run\n")
         return _factory(source)(*objects)
 
 
