@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import types
 from fractions import Fraction
 from pathlib import Path
 
+import networkx as nx
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -12,6 +14,7 @@ from hypothesis import strategies as st
 
 import blocks
 from blocks import build_schedule, loads_diagram
+from blocks.schedule import _Planner
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -115,3 +118,23 @@ blocks:
 def test_huge_logs_are_refused_before_the_run():
     with pytest.raises(blocks.DiagramError, match="GiB"):
         blocks.simulate(toy(), t_end="1e6 s")
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(1, 12).flatmap(lambda n: st.tuples(
+    st.just(n), st.permutations(range(n)), st.sets(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1))))))
+def test_output_order_is_networkx_lexicographic_order(case):
+    """The planner's topological order of the outputs is networkx's lexicographical
+    topological sort keyed by diagram order, and None exactly when the graph has a cycle."""
+    n, rank, pairs = case
+    nodes = {f"b{i}" for i in range(n)}
+    edges = {(f"b{a}", f"b{b}") for a, b in pairs}
+    planner = types.SimpleNamespace(order={f"b{i}": rank[i] for i in range(n)})
+    graph = nx.DiGraph()
+    graph.add_nodes_from(nodes)
+    graph.add_edges_from(edges)
+    got = _Planner.topological_order(planner, nodes, edges)
+    if nx.is_directed_acyclic_graph(graph):
+        assert got == list(nx.lexicographical_topological_sort(graph, key=planner.order.get))
+    else:
+        assert got is None
