@@ -387,7 +387,8 @@ class _Planner:
     def order_outputs(self, nodes: set[str], initial: bool = False) -> tuple[Steps, tuple[HeldInput, ...]]:
         """Evaluation steps for ``nodes`` (block, ports or None for all) and the inputs held
         to break loops at tick 0 (``initial``); an algebraic loop is a DiagramError."""
-        order = self.topological_order(nodes, {(c.src_block, c.dst_block) for c in self.feeds(nodes, initial)})
+        edges = {(c.src_block, c.dst_block) for c in self.feeds(nodes, initial)}
+        order = self.topological_order(nodes, edges)
         if order is not None:
             return tuple((n, None) for n in order), ()
         return self.order_ports(nodes, initial)

@@ -2,11 +2,10 @@
 
 Per event tick the executor runs a precompiled program: outputs of the firing blocks in
 feedthrough order, then their updates, then the sampling of delayed connections, then
-the advanced blocks stepped to the next event. Each program is written out as one Python
-function (``_ProgramCode``), so an event runs straight-line code. Outputs are passed by reference from a
-block's return value into the persistent input mappings of the blocks it feeds (no
-per-tick dictionaries or copies); between hits values hold. Time is ``k * base_tick``
-from the integer tick ``k``.
+the advanced blocks stepped to the next event, each program written out as one Python
+function (``_ProgramCode``). Outputs are passed by reference from a block's return value
+into the persistent input mappings of the blocks it feeds (no per-tick dictionaries or
+copies); between hits values hold. Time is ``k * base_tick`` from the integer tick ``k``.
 
 A block ends a run early by raising ``EndRun`` from its ``update`` at tick k: the tick
 is finished, the ticks up to the block's next hit run as usual, and that hit (or t_end,
@@ -122,7 +121,7 @@ class _Logger:
         self.decimate = decimate
         self.pending: list[np.ndarray] = []
 
-    def add_source(self, code: "_ProgramCode", value: str) -> list[str]:
+    def add_source(self, code: _ProgramCode, value: str) -> list[str]:
         """Source lines of a generated program that log the output ``value`` (the name of
         a variable there): queued rows first, then every ``decimate``-th hit."""
         v = code.bind
@@ -138,11 +137,12 @@ class _Logger:
         if len(pending) >= self.BATCH:
             self.flush()
 
-    def add_rows_source(self, code: "_ProgramCode", rows: str) -> list[str]:
+    def add_rows_source(self, code: _ProgramCode, rows: str) -> list[str]:
         """Source lines of a generated program that do ``add_rows(rows)``."""
         v = code.bind
         pending = v(self.pending)
-        return [f"{pending}.append({rows})", f"if len({pending}) >= {v(self.BATCH)}:", f"    {v(self)}.flush()"]
+        return [f"{pending}.append({rows})", f"if len({pending}) >= {v(self.BATCH)}:",
+                f"    {v(self)}.flush()"]
 
     def flush(self) -> None:
         """Copy the queued rows into the buffer."""
@@ -163,10 +163,10 @@ class _ProgramCode:
     source with its own ``try``, which costs nothing unless something is raised, so a
     failure is reported with its block, phase and tick. The source names no object and
     holds no text from the diagram: every block method, mapping, port name and block
-    name is a variable ``vN`` of an enclosing factory, called with the objects themselves. Source of the same shape is compiled once
-    (``_factory``): the programs of repeated runs, and the segments of a long program
-    (``SEGMENT`` steps each, so a program of many blocks never makes one huge function),
-    share their code.
+    name is a variable ``vN`` of an enclosing factory, called with the objects
+    themselves. Source of the same shape is compiled once (``_factory``): the programs of
+    repeated runs, and the segments of a long program (``SEGMENT`` steps each, so a
+    program of many blocks never makes one huge function), share their code.
     """
 
     SEGMENT = 64
@@ -292,7 +292,7 @@ class _Run:
             self.advance_step(code, b, last=b == program.advance[-1])
         return code.function()
 
-    def output_step(self, code: "_ProgramCode", name: str, ports: tuple[str, ...] | None, log: bool) -> None:
+    def output_step(self, code: _ProgramCode, name: str, ports: tuple[str, ...] | None, log: bool) -> None:
         """Compute ``name``'s outputs (``ports``, or all), check them the first time, pass
         them by reference to their readers and log them when ``log``."""
         blk = self.d.blocks[name].block
@@ -321,7 +321,7 @@ class _Run:
         sampled = self.sampled[name]
         return [(self.held[name], p, p) for p in ports if p in sampled]
 
-    def update_step(self, code: "_ProgramCode", name: str) -> None:
+    def update_step(self, code: _ProgramCode, name: str) -> None:
         """Update ``name``'s state; an ``EndRun`` asks for the end and the tick goes on."""
         v = code.bind
         state = f"{v(self.states)}[{v(self.index[name])}]"
@@ -344,10 +344,11 @@ class _Run:
         if nxt is not None and nxt < self.end_tick:
             self.end_tick = nxt
 
-    def sample_step(self, code: "_ProgramCode", c) -> None:
+    def sample_step(self, code: _ProgramCode, c) -> None:
         """A delayed connection takes the value its source holds now."""
         v = code.bind
-        code.step(f"{v(self.inputs[c.dst_block])}[{v(c.dst_port)}] = {v(self.held[c.src_block])}[{v(c.src_port)}]")
+        source = f"{v(self.held[c.src_block])}[{v(c.src_port)}]"
+        code.step(f"{v(self.inputs[c.dst_block])}[{v(c.dst_port)}] = {source}")
 
     def advance_step(self, code: _ProgramCode, name: str, last: bool) -> None:
         """Steps ``name`` to the next event in chunks, each from the time of its first

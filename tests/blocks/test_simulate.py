@@ -285,7 +285,8 @@ def test_a_program_longer_than_one_generated_segment_keeps_its_order_and_failure
     runs its segments in order, and a failure in a later segment names its block."""
     n = 150
     gains = "\n".join(f"  g{i}: {{type: Gain, params: {{k: 2.0}}}}" for i in range(n))
-    wires = ", ".join(["clk.y -> g0.u"] + [f"g{i - 1}.y -> g{i}.u" for i in range(1, n)] + [f"g{n - 1}.y -> f.u"])
+    chain = [f"g{i - 1}.y -> g{i}.u" for i in range(1, n)]
+    wires = ", ".join(["clk.y -> g0.u", *chain, f"g{n - 1}.y -> f.u"])
     res = run(f"""
 time: {{t_end: 10 ms}}
 blocks:
@@ -295,7 +296,8 @@ blocks:
 connections: [{wires}]
 log: [g{n - 1}.y, f.y]
 """)
-    assert res.status.startswith("failed at t=0.005 s: block 'f'") and "f.y output: value out of range" in res.status
+    assert res.status.startswith("failed at t=0.005 s: block 'f'")
+    assert "f.y output: value out of range" in res.status
     t, y = res[f"g{n - 1}.y"]
     np.testing.assert_array_equal(y[:, 0], t * 2.0 ** n)
     np.testing.assert_array_equal(res["f.y"][1][:, 0], y[:5, 0])
