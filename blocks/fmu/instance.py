@@ -37,7 +37,7 @@ from ..block import BlockError, Signal
 from . import interrupt
 from .log_messages import ERROR_LOG_LINES, LOG_LINES, fmi2_buffers, fmi2_logger, log, record
 from .model import import_fmpy
-from .port_types import EXACT_INTEGERS, KINDS, PortKind
+from .port_types import EXACT_INTEGERS, KINDS, PortKind, float64_holds
 from .ports import Group
 from .start_values import Assignment
 
@@ -215,7 +215,7 @@ class Instance:
         big = np.flatnonzero(np.abs(values) >= EXACT_INTEGERS)
         for i in big:
             exact = int(x.view[i])
-            if int(values[i]) != exact:
+            if not float64_holds(exact):
                 name, a, b = next(sl for sl in x.slices if sl[1] <= i < sl[2])
                 element = f" element {i - a}" if b - a > 1 else ""
                 raise BlockError(f"{self.model.shown}: output '{name}'{element} ({x.kind.name}) is {exact} at "

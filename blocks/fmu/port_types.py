@@ -17,6 +17,11 @@ EXACT_INTEGERS = 2**53
 stops the run rather than change its value."""
 
 
+def float64_holds(value: int) -> bool:
+    """Whether the integer ``value`` survives the trip through a float64 port unchanged."""
+    return int(float(value)) == value
+
+
 @dataclass(frozen=True)
 class PortKind:
     """How values of one FMI variable type travel as float64 port values.

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from .port_types import KINDS
+from .port_types import KINDS, float64_holds
 from .model import Model, settable
 from .ports import variable_width
 
@@ -129,7 +129,7 @@ def _check_port_exact(name: str, values: list) -> None:
     """ValueError if an input's start value would change on its way through a float64 port
     (the block writes its inputs' values, so an unconnected input passes its start through one)."""
     for x in values:
-        if isinstance(x, int) and not isinstance(x, bool) and int(float(x)) != x:
+        if isinstance(x, int) and not isinstance(x, bool) and not float64_holds(x):
             raise ValueError(f"start value of '{name}' is {x}, which its float64 port cannot hold exactly "
                              "(integers are exact up to 2^53); use a value a float64 holds")
 
