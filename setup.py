@@ -2,7 +2,8 @@
 
 Metadata lives in pyproject.toml; this file only declares what is compiled, because
 setuptools' extension support is the build path every pip and every Python install
-already has (no CMake, no code generator). Besides the extension ``hierhand._native``
+already has (no CMake, no code generator). The framework's extension ``blocks._native``
+runs the compiled parts of event programs (``blocks/csrc``). Besides the extension ``hierhand._native``
 the build links two plain shared libraries from the same C sources,
 ``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so``, that ``hierhand fmu export`` copies
 into FMUs, so exporting needs no compiler. They link libc and libm only; their FMI
@@ -64,13 +65,23 @@ class BuildNative(build_ext):
         return outputs
 
 
+BLOCKS_CSRC = "blocks/csrc"
+
 setup(
     ext_modules=[
+        Extension(
+            "blocks._native",
+            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c"],
+            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h"],
+            extra_compile_args=CFLAGS + ["-std=c11"],
+            libraries=["m"],
+        ),
         Extension(
             "hierhand._native",
             sources=EXTENSION_SOURCES,
             depends=EXTENSION_DEPENDS,
             define_macros=[("HH_SOURCES_DIGEST", f'"{sources_digest(ROOT)}"')],
+            include_dirs=[BLOCKS_CSRC],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         )

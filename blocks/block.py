@@ -13,9 +13,12 @@ import copy
 import functools
 import inspect
 from fractions import Fraction
-from typing import Any, ClassVar, Mapping
+from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .kernel import Kernel
 
 Signal = np.ndarray
 """A port value: a 1-D float64 array of the port's declared width."""
@@ -187,6 +190,12 @@ class Block:
             for p in rows:
                 rows[p].append(out[p])
         return state, {p: np.asarray(v, dtype=float).reshape(n, self.outputs[p]) for p, v in rows.items()}
+
+    def kernel(self) -> Kernel | None:
+        """The block's compiled step functions (``blocks.kernel.Kernel``), which the
+        executor calls in C instead of ``output`` / ``update`` / ``advance``; None (the
+        default) runs the Python methods. Called once per run, after ``bind``."""
+        return None
 
     # -- introspection helpers used by the loader, the scheduler and the CLI --------
 

@@ -1,0 +1,400 @@
+/* blocks._native: runs the compiled parts of event programs, and calls single kernels.
+ *
+ * A Runner holds one piece of an event program in which every step belongs to a block
+ * with a kernel (blocks_kernel.h): its outputs, updates, advances and the copies of
+ * delayed connections, for one event or for a stretch of consecutive events. The
+ * executor (blocks/simulate.py) builds it from flat int64 tables and calls
+ * ``run(k, next_k)``: the events at tick k + offset before next_k, each one's advances
+ * stepping to the following event (or next_k). Kernels read their inputs through
+ * pointers into the output buffers of the blocks that feed them, so passing a value on
+ * costs nothing; logged outputs are copied into the loggers' buffers here, honouring
+ * their decimation.
+ *
+ * Time is k * num / den in double, as the Python executor computes it: both are exact
+ * integers below 2^53 (the executor checks), so the division rounds the same way.
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <stdint.h>
+#include <string.h>
+
+#include "blocks_kernel.h"
+#include "library.h"
+
+/* -- the tables a Runner is built from (int64 rows; pointers stored as integers) -------- */
+enum { OP_OUTPUT = 0, OP_UPDATE = 1, OP_ADVANCE = 2, OP_COPY = 3 };
+/* op row: [op, slot, a, b]: output/advance log the entries a..b-1 of the log table;
+   copy: [OP_COPY, width, destination, source] */
+enum { OP_CODE, OP_SLOT, OP_A, OP_B, OP_N };
+/* slot row: one per block with a kernel */
+enum { S_OUTPUT, S_UPDATE, S_ADVANCE, S_CTX, S_STATE, S_INPUTS, S_OUT, S_WIDTH, S_ROWS, S_ROWS_CAP, S_PERIOD, S_N };
+/* event row: [tick offset from the first event, first op, end of ops] */
+enum { E_OFFSET, E_START, E_END, E_N };
+/* log row: [buffer, width, first column in the block's outputs, capacity (rows), decimate];
+   counter row: [rows written, hits seen] */
+enum { L_BUF, L_WIDTH, L_COLUMN, L_CAPACITY, L_DECIMATE, L_N };
+enum { C_POS, C_HITS, C_N };
+
+typedef struct {
+    PyObject_HEAD
+    const int64_t *slots;
+    const int64_t *ops;
+    const int64_t *events;
+    const int64_t *logs;
+    int64_t *counters;
+    Py_ssize_t n_events;
+    int64_t num, den;
+    int64_t reached; /* the tick the last call completed to (its advances reach it) */
+    PyObject *owners; /* the arrays the tables and pointers live in */
+} RunnerObject;
+
+static double tick_time(const RunnerObject *r, int64_t k)
+{
+    return (double)(k * r->num) / (double)r->den;
+}
+
+static void log_row(const RunnerObject *r, Py_ssize_t entry, const double *outputs)
+{
+    const int64_t *lg = r->logs + entry * L_N;
+    int64_t *c = r->counters + entry * C_N;
+    if (c[C_HITS] % lg[L_DECIMATE] == 0 && c[C_POS] < lg[L_CAPACITY]) {
+        double *dst = (double *)(intptr_t)lg[L_BUF] + c[C_POS] * lg[L_WIDTH];
+        memcpy(dst, outputs + lg[L_COLUMN], (size_t)lg[L_WIDTH] * sizeof(double));
+        c[C_POS]++;
+    }
+    c[C_HITS]++;
+}
+
+/* A failure: (code, which, op index, tick). */
+static PyObject *failure(int code, int which, Py_ssize_t op, int64_t tick)
+{
+    return Py_BuildValue("(iinL)", code, which, op, (long long)tick);
+}
+
+/* Step a block from tick ke to tick next in chunks of at most its rows capacity. */
+static PyObject *advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int64_t ke, int64_t next)
+{
+    const int64_t *s = r->slots + op[OP_SLOT] * S_N;
+    blk_advance_fn fn = (blk_advance_fn)(intptr_t)s[S_ADVANCE];
+    double *state = (double *)(intptr_t)s[S_STATE];
+    const double *const *inputs = (const double *const *)(intptr_t)s[S_INPUTS];
+    double *rows = (double *)(intptr_t)s[S_ROWS];
+    double *out = (double *)(intptr_t)s[S_OUT];
+    int64_t width = s[S_WIDTH], period = s[S_PERIOD], cap = s[S_ROWS_CAP];
+    int64_t n = (next - ke) / period, stepped = 0;
+    while (n > 0) {
+        int m = (int)(n < cap ? n : cap), done = 0, which = 0;
+        int code = fn((const void *)(intptr_t)s[S_CTX], tick_time(r, ke + stepped * period), state, inputs, m, rows,
+                      &done, &which);
+        int logged = code ? (done < 0 ? 0 : done > m ? m : done) : m;
+        for (int i = 0; i < logged; i++)
+            for (int64_t e = op[OP_A]; e < op[OP_B]; e++)
+                log_row(r, (Py_ssize_t)e, rows + i * width);
+        if (code)
+            return failure(code, which, index, ke + (stepped + logged) * period);
+        memcpy(out, rows + (m - 1) * width, (size_t)width * sizeof(double));
+        n -= m;
+        stepped += m;
+    }
+    return NULL;
+}
+
+/* One op at event tick ke whose advances reach next; a failure tuple or NULL. */
+static PyObject *run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next)
+{
+    const int64_t *op = r->ops + index * OP_N;
+    if (op[OP_CODE] == OP_COPY) {
+        memcpy((double *)(intptr_t)op[OP_A], (const double *)(intptr_t)op[OP_B], (size_t)op[OP_SLOT] * sizeof(double));
+        return NULL;
+    }
+    if (op[OP_CODE] == OP_ADVANCE)
+        return advance(r, op, index, ke, next);
+    const int64_t *s = r->slots + op[OP_SLOT] * S_N;
+    const void *ctx = (const void *)(intptr_t)s[S_CTX];
+    double *state = (double *)(intptr_t)s[S_STATE];
+    const double *const *inputs = (const double *const *)(intptr_t)s[S_INPUTS];
+    int which = 0, code;
+    if (op[OP_CODE] == OP_OUTPUT) {
+        double *out = (double *)(intptr_t)s[S_OUT];
+        code = ((blk_output_fn)(intptr_t)s[S_OUTPUT])(ctx, tick_time(r, ke), state, inputs, out, &which);
+        if (!code)
+            for (int64_t e = op[OP_A]; e < op[OP_B]; e++)
+                log_row(r, (Py_ssize_t)e, out);
+    } else {
+        code = ((blk_update_fn)(intptr_t)s[S_UPDATE])(ctx, tick_time(r, ke), state, inputs, &which);
+    }
+    return code ? failure(code, which, index, ke) : NULL;
+}
+
+/* run(k, next_k): None, or (code, which, op index, tick) of the first failure. */
+static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t nargs)
+{
+    if (nargs != 2) {
+        PyErr_SetString(PyExc_TypeError, "run(k, next_k) takes 2 arguments");
+        return NULL;
+    }
+    long long k = PyLong_AsLongLong(args[0]), next_k = PyLong_AsLongLong(args[1]);
+    if ((k == -1 || next_k == -1) && PyErr_Occurred())
+        return NULL;
+    for (Py_ssize_t e = 0; e < r->n_events; e++) {
+        const int64_t *ev = r->events + e * E_N;
+        int64_t ke = k + ev[E_OFFSET];
+        if (ke >= next_k)
+            break;
+        int64_t next = e + 1 < r->n_events ? k + ev[E_N + E_OFFSET] : next_k;
+        if (next > next_k)
+            next = next_k;
+        for (int64_t i = ev[E_START]; i < ev[E_END]; i++) {
+            PyObject *failed = run_op(r, (Py_ssize_t)i, ke, next);
+            if (failed != NULL) {
+                r->reached = ke;
+                return failed;
+            }
+        }
+        r->reached = next;
+    }
+    Py_RETURN_NONE;
+}
+
+static PyObject *runner_reached(RunnerObject *r, void *closure)
+{
+    (void)closure;
+    return PyLong_FromLongLong(r->reached);
+}
+
+/* The data pointer of a C-contiguous int64 array argument, which the Runner keeps alive. */
+static int64_t *int64_table(PyObject *obj, Py_ssize_t row, const char *what)
+{
+    Py_buffer view;
+    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) != 0)
+        return NULL;
+    int ok = view.itemsize == 8 && view.format != NULL && (strcmp(view.format, "q") == 0 || strcmp(view.format, "l") == 0) &&
+             view.len % (row * 8) == 0;
+    int64_t *data = view.buf;
+    PyBuffer_Release(&view);
+    if (!ok) {
+        PyErr_Format(PyExc_TypeError, "Runner: %s must be a writable C-contiguous int64 array of rows of %zd", what, row);
+        return NULL;
+    }
+    return data;
+}
+
+static int runner_init(RunnerObject *r, PyObject *args, PyObject *kwds)
+{
+    PyObject *slots, *ops, *events, *logs, *counters, *owners;
+    long long num, den;
+    static char *names[] = {"slots", "ops", "events", "logs", "counters", "num", "den", "owners", NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOLLO", names, &slots, &ops, &events, &logs, &counters, &num,
+                                     &den, &owners))
+        return -1;
+    if (num <= 0 || den <= 0) {
+        PyErr_SetString(PyExc_ValueError, "Runner: num and den must be positive");
+        return -1;
+    }
+    r->slots = int64_table(slots, S_N, "slots");
+    r->ops = r->slots ? int64_table(ops, OP_N, "ops") : NULL;
+    r->events = r->ops ? int64_table(events, E_N, "events") : NULL;
+    r->logs = r->events ? int64_table(logs, L_N, "logs") : NULL;
+    r->counters = r->logs ? int64_table(counters, C_N, "counters") : NULL;
+    if (r->counters == NULL)
+        return -1;
+    r->n_events = PyObject_Length(events);
+    if (r->n_events < 0)
+        return -1;
+    r->num = num;
+    r->den = den;
+    r->reached = -1;
+    Py_INCREF(owners);
+    Py_XSETREF(r->owners, Py_BuildValue("(OOOOOO)", slots, ops, events, logs, counters, owners));
+    Py_DECREF(owners);
+    return r->owners == NULL ? -1 : 0;
+}
+
+static void runner_dealloc(RunnerObject *r)
+{
+    Py_XDECREF(r->owners);
+    Py_TYPE(r)->tp_free((PyObject *)r);
+}
+
+static PyMethodDef runner_methods[] = {
+    {"run", (PyCFunction)(void (*)(void))runner_run, METH_FASTCALL,
+     "run(k, next_k): the events from tick k before next_k; None, or (code, which, op, tick) of a failure."},
+    {NULL, NULL, 0, NULL},
+};
+
+static PyGetSetDef runner_getset[] = {
+    {"reached", (getter)runner_reached, NULL, "the tick the last run completed to (-1 before any)", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+static PyTypeObject runner_type = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "blocks._native.Runner",
+    .tp_basicsize = sizeof(RunnerObject),
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "Runner(slots, ops, events, logs, counters, num, den, owners): compiled steps of event programs.",
+    .tp_new = PyType_GenericNew,
+    .tp_init = (initproc)runner_init,
+    .tp_dealloc = (destructor)runner_dealloc,
+    .tp_methods = runner_methods,
+    .tp_getset = runner_getset,
+};
+
+/* -- single kernel calls, for tests and tools ------------------------------------------ */
+
+#define MAX_INPUTS 64
+
+/* Pointers to the float64 arrays of the sequence ``inputs``; the buffers are held in
+   ``views`` (released by release_views). -1 with an exception on error. */
+static int hold_inputs(PyObject *inputs, Py_buffer *views, const double **pointers, Py_ssize_t *count)
+{
+    PyObject *seq = PySequence_Fast(inputs, "inputs must be a sequence of float64 arrays");
+    if (seq == NULL)
+        return -1;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    *count = 0;
+    if (n > MAX_INPUTS) {
+        Py_DECREF(seq);
+        PyErr_Format(PyExc_ValueError, "at most %d inputs", MAX_INPUTS);
+        return -1;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (PyObject_GetBuffer(PySequence_Fast_GET_ITEM(seq, i), &views[i], PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) != 0) {
+            Py_DECREF(seq);
+            return -1;
+        }
+        *count = i + 1;
+        if (views[i].itemsize != 8 || views[i].format == NULL || strcmp(views[i].format, "d") != 0) {
+            Py_DECREF(seq);
+            PyErr_Format(PyExc_TypeError, "input %zd must be a float64 array", i);
+            return -1;
+        }
+        pointers[i] = views[i].buf;
+    }
+    Py_DECREF(seq);
+    return 0;
+}
+
+static void release_views(Py_buffer *views, Py_ssize_t count)
+{
+    for (Py_ssize_t i = 0; i < count; i++)
+        PyBuffer_Release(&views[i]);
+}
+
+/* A writable float64 buffer, or None (NULL pointer) where allowed. */
+static int hold_doubles(PyObject *obj, Py_buffer *view, double **data, int none_ok, const char *what)
+{
+    if (obj == Py_None && none_ok) {
+        view->obj = NULL;
+        *data = NULL;
+        return 0;
+    }
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | PyBUF_WRITABLE) != 0)
+        return -1;
+    if (view->itemsize != 8 || view->format == NULL || strcmp(view->format, "d") != 0) {
+        PyBuffer_Release(view);
+        PyErr_Format(PyExc_TypeError, "%s must be a writable C-contiguous float64 array", what);
+        return -1;
+    }
+    *data = view->buf;
+    return 0;
+}
+
+static void release_doubles(Py_buffer *view)
+{
+    if (view->obj != NULL)
+        PyBuffer_Release(view);
+}
+
+/* call(kind, function, context, t, state, inputs, out, n): one kernel call.
+   kind 'output': out receives the outputs, returns (code, which);
+   'update': returns (code, which); 'advance': out receives n rows, returns (code, done, which). */
+static PyObject *call_kernel(PyObject *module, PyObject *args)
+{
+    (void)module;
+    const char *kind;
+    unsigned long long function, context;
+    double t;
+    PyObject *state_obj, *inputs_obj, *out_obj;
+    int n = 0;
+    if (!PyArg_ParseTuple(args, "sKKdOOO|i", &kind, &function, &context, &t, &state_obj, &inputs_obj, &out_obj, &n))
+        return NULL;
+    if (function == 0) {
+        PyErr_SetString(PyExc_ValueError, "no function (address 0)");
+        return NULL;
+    }
+    Py_buffer views[MAX_INPUTS], state_view, out_view;
+    const double *pointers[MAX_INPUTS];
+    Py_ssize_t count = 0;
+    double *state, *out;
+    if (hold_doubles(state_obj, &state_view, &state, 1, "state") != 0)
+        return NULL;
+    if (hold_doubles(out_obj, &out_view, &out, 1, "out") != 0) {
+        release_doubles(&state_view);
+        return NULL;
+    }
+    PyObject *result = NULL;
+    if (hold_inputs(inputs_obj, views, pointers, &count) == 0) {
+        const void *ctx = (const void *)(uintptr_t)context;
+        int which = 0, done = 0, code;
+        if (strcmp(kind, "output") == 0) {
+            code = ((blk_output_fn)(uintptr_t)function)(ctx, t, state, pointers, out, &which);
+            result = Py_BuildValue("(ii)", code, which);
+        } else if (strcmp(kind, "update") == 0) {
+            code = ((blk_update_fn)(uintptr_t)function)(ctx, t, state, pointers, &which);
+            result = Py_BuildValue("(ii)", code, which);
+        } else if (strcmp(kind, "advance") == 0) {
+            code = ((blk_advance_fn)(uintptr_t)function)(ctx, t, state, pointers, n, out, &done, &which);
+            result = Py_BuildValue("(iii)", code, done, which);
+        } else {
+            PyErr_Format(PyExc_ValueError, "kind must be 'output', 'update' or 'advance', not '%s'", kind);
+        }
+    }
+    release_views(views, count);
+    release_doubles(&state_view);
+    release_doubles(&out_view);
+    return result;
+}
+
+/* library(): {name: address} of the library blocks' kernels. */
+static PyObject *library(PyObject *module, PyObject *unused)
+{
+    (void)module;
+    (void)unused;
+    PyObject *found = PyDict_New();
+    for (const blk_library_entry *e = blk_library; found != NULL && e->name != NULL; e++) {
+        PyObject *address = PyLong_FromVoidPtr((void *)e->function);
+        if (address == NULL || PyDict_SetItemString(found, e->name, address) != 0)
+            Py_CLEAR(found);
+        Py_XDECREF(address);
+    }
+    return found;
+}
+
+static PyMethodDef module_methods[] = {
+    {"call", call_kernel, METH_VARARGS,
+     "call(kind, function, context, t, state, inputs, out, n=0): one kernel call ('output', 'update', 'advance')."},
+    {"library", library, METH_NOARGS, "library(): {name: address} of the library blocks' kernels."},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module_def = {
+    PyModuleDef_HEAD_INIT, "_native", "Compiled event programs and kernel calls (see blocks/csrc).", -1,
+    module_methods, NULL, NULL, NULL, NULL,
+};
+
+PyMODINIT_FUNC PyInit__native(void)
+{
+    if (PyType_Ready(&runner_type) < 0)
+        return NULL;
+    PyObject *module = PyModule_Create(&module_def);
+    if (module == NULL)
+        return NULL;
+    Py_INCREF(&runner_type);
+    if (PyModule_AddObject(module, "Runner", (PyObject *)&runner_type) != 0 ||
+        PyModule_AddIntConstant(module, "ABI", BLK_KERNEL_ABI) != 0) {
+        Py_DECREF(module);
+        return NULL;
+    }
+    return module;
+}

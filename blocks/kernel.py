@@ -1,0 +1,39 @@
+"""Compiled kernels: how a block offers C versions of its step functions to the executor.
+
+A block whose ``output`` / ``update`` / ``advance`` exist as C functions of the calling
+convention in ``blocks/csrc/blocks_kernel.h`` returns a ``Kernel`` from
+``Block.kernel()``. The executor then calls them directly, and runs a stretch of events
+whose blocks all have kernels in one C call (no Python between the 1 ms hits of a
+controller and a plant, say). A block without a kernel runs through its Python methods
+as before; both kinds mix freely in one diagram.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+ErrorFactory = Callable[[int, int, float, str], BaseException]
+"""``error(code, which, t, phase)``: the exception for a kernel's failure code at time
+``t`` in ``phase`` ('output', 'update' or 'advance')."""
+
+
+@dataclass(frozen=True)
+class Kernel:
+    """The addresses of a block's C functions and of the constants they read.
+
+    ``output``, ``update`` and ``advance`` are function addresses (0 where the block has
+    none; it then runs in Python wherever the schedule needs the missing one).
+    ``context`` is the pointer passed to them as ``ctx``; ``owners`` keeps alive the
+    objects whose memory it and the functions use. The block's state must be a flat
+    C-contiguous float64 array (or None for a stateless block), which the kernel updates
+    in place. The functions compute exactly what the Python methods compute. ``error``
+    makes the exception for a failure code (None: a generic message with the code).
+    """
+
+    context: int
+    output: int = 0
+    update: int = 0
+    advance: int = 0
+    owners: tuple[Any, ...] = field(default=(), repr=False)
+    error: ErrorFactory | None = field(default=None, repr=False)
