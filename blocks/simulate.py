@@ -20,11 +20,12 @@ import platform
 import time
 from fractions import Fraction
 from importlib import metadata
-from typing import Any, Callable
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
 from .block import BlockError, EndRun
+from .compiled import CompiledSide, Runner
 from .diagram import Diagram
 from .issues import DiagramError
 from .results import Results
@@ -231,6 +232,15 @@ def _factory(source: str) -> Callable[..., Callable[[int, int], None]]:
     return namespace["factory"]
 
 
+class _Compiled(NamedTuple):
+    """An event program ready to run: ``function(k, next_k)``, and when every step of it
+    is a compiled block's, those steps as ``(op, (block, phase))`` for fusing with the
+    programs of the following events into one C call."""
+
+    function: Callable[[int, int], None]
+    kernel_steps: list[tuple[list[int], tuple[str, str]]] | None
+
+
 class _Run:
     """The mutable side of one run: states, input mappings, held outputs and logs."""
 
@@ -267,6 +277,15 @@ class _Run:
             lg = _Logger(e.signal, diagram.blocks[e.block].block.outputs[e.port], count, e.decimate)
             self.loggers[e.block].append(lg)
             self.all_loggers.append(lg)
+        self.owner = {id(self.inputs[n]): n for n in self.names}
+        """The block whose input mapping a fan-out target is (held outputs are no block's)."""
+        self.compiled = CompiledSide(diagram, schedule, self.states, self.index, self.inputs, self.loggers,
+                                     ADVANCE_CHUNK)
+        self.kernel_sources = {n: [(c.dst_port, self.compiled.blocks[c.src_block].views[c.src_port])
+                                   for c in diagram.connections
+                                   if c.dst_block == n and not c.delay and c.src_block in self.compiled.blocks]
+                               for n in self.names if n not in self.compiled.blocks}
+        """Per Python block, its inputs fed by compiled blocks: (port, the source's buffer view)."""
         self.checked: set[str] = set()
         self.reached: int | None = None
         """The tick an interrupted advance span had logged, when the interrupt came in one."""
@@ -277,20 +296,90 @@ class _Run:
 
     # -- building the per-event programs ------------------------------------------------
 
-    def compile(self, program: EventProgram) -> Callable[[int, int], None]:
+    def compile(self, program: EventProgram) -> _Compiled:
         """The program as one function ``run(k, next_k)``: its steps written out as Python
-        source (``_ProgramCode``)."""
+        source (``_ProgramCode``), each stretch of compiled blocks' steps one C call."""
         code = _ProgramCode(self.s.base_tick)
+        kernel = self.compiled.blocks
         last_step = {b: i for i, (b, _) in enumerate(program.evaluate)}
+        last = program.advance[-1] if program.advance else None
+        pending: list[tuple[list[int], tuple[str, str]]] = []
+        python = False
+
+        def flush() -> None:
+            if pending:
+                ops, steps = [op for op, _ in pending], [step for _, step in pending]
+                self.runner_step(code, self.compiled.runner([(0, ops, steps)]), last in {b for b, _ in steps})
+                pending.clear()
+
         for i, (b, ports) in enumerate(program.evaluate):
-            self.output_step(code, b, ports, log=(b in program.firing and last_step[b] == i))
+            log = b in program.firing and last_step[b] == i
+            if b in kernel:
+                pending.append((self.compiled.output_op(b, log), (b, "output")))
+            else:
+                flush()
+                python = True
+                self.output_step(code, b, ports, log)
         for b in program.update:
-            self.update_step(code, b)
+            if b in kernel:
+                pending.append((self.compiled.update_op(b), (b, "update")))
+            else:
+                flush()
+                python = True
+                self.update_step(code, b)
         for i in program.sample:
-            self.sample_step(code, self.d.connections[i])
+            c = self.d.connections[i]
+            if c.src_block in kernel and c.dst_block in kernel:
+                pending.append((self.compiled.copy_op(c), (c.dst_block, "sample")))
+            else:
+                flush()
+                python = True
+                self.sample_step(code, c)
         for b in program.advance:
-            self.advance_step(code, b, last=b == program.advance[-1])
-        return code.function()
+            if b in kernel:
+                pending.append((self.compiled.advance_op(b), (b, "advance")))
+            else:
+                flush()
+                python = True
+                self.advance_step(code, b, last=b == last)
+        steps = None if python else list(pending)
+        flush()
+        return _Compiled(code.function(), steps)
+
+    def runner_step(self, code: _ProgramCode, runner: Runner, has_last_advance: bool) -> None:
+        """One C call running a stretch of compiled steps; a failure raises its step's
+        ``_StepFailure``. With the event's last advance in it, an interrupt records how far
+        it got."""
+        v = code.bind
+        handlers = ("except KeyboardInterrupt:", f"    {v(self.interrupted_in_runner)}({v(runner)}, k)",
+                    "    raise") if has_last_advance else ()
+        code.step(f"r = {v(runner.run)}(k, next_k)", handlers=handlers)
+        code.step("if r is not None:", f"    raise {v(self.kernel_failure)}({v(runner)}, r)")
+
+    def kernel_failure(self, runner: Runner, result) -> _StepFailure:
+        name, phase, tick, error = runner.failure(result)
+        return _StepFailure(name, phase, tick, error)
+
+    def interrupted_in_runner(self, runner: Runner, k: int) -> None:
+        """An interrupt came during or right after a C call holding an event's last advance."""
+        reached = runner.native.reached
+        if reached >= k:
+            self.reached = reached
+
+    def reader_lines(self, code: _ProgramCode, name: str) -> list[str]:
+        """Lines giving a Python block copies of the compiled blocks' outputs it reads."""
+        v = code.bind
+        inputs = v(self.inputs[name])
+        return [f"{inputs}[{v(port)}] = {v(view)}.copy()" for port, view in self.kernel_sources[name]]
+
+    def target_line(self, code: _ProgramCode, d: dict, dp: str, value: str) -> str:
+        """Pass ``value`` to input ``dp`` of the mapping ``d``: by reference to a Python
+        block, copied into the input buffer of a compiled one."""
+        v = code.bind
+        owner = self.owner.get(id(d))
+        if owner in self.compiled.blocks:
+            return f"{v(self.compiled.buffers[owner, dp])}[:] = {value}"
+        return f"{v(d)}[{v(dp)}] = {value}"
 
     def output_step(self, code: _ProgramCode, name: str, ports: tuple[str, ...] | None, log: bool) -> None:
         """Compute ``name``'s outputs (``ports``, or all), check them the first time, pass
@@ -302,14 +391,15 @@ class _Run:
         v = code.bind
         block = v(name)
         value: dict[str, str] = {}
-        lines = [f"out = {v(blk.output)}(t, {v(self.states)}[{v(self.index[name])}], {v(self.inputs[name])})",
+        lines = [*self.reader_lines(code, name),
+                 f"out = {v(blk.output)}(t, {v(self.states)}[{v(self.index[name])}], {v(self.inputs[name])})",
                  f"if {block} not in {v(self.checked)}:",
                  f"    {v(self.check_outputs)}({block}, out, {v(publish)})"]
         for port in [sp for _, _, sp in targets] + [p for _, p in loggers]:
             if port not in value:
                 value[port] = f"o{len(value)}"
                 lines.append(f"{value[port]} = out[{v(port)}]")
-        lines += [f"{v(d)}[{v(dp)}] = {value[sp]}" for d, dp, sp in targets]
+        lines += [self.target_line(code, d, dp, value[sp]) for d, dp, sp in targets]
         for lg, p in loggers:
             lines += lg.add_source(code, value[p])
         code.step(*lines, handlers=("except Exception as exc:",
@@ -326,7 +416,7 @@ class _Run:
         v = code.bind
         state = f"{v(self.states)}[{v(self.index[name])}]"
         update = f"{v(self.d.blocks[name].block.update)}(t, {state}, {v(self.inputs[name])})"
-        code.step(f"{state} = {update}",
+        code.step(f"{state} = {update}", setup=tuple(self.reader_lines(code, name)),
                   handlers=(f"except {v(EndRun)} as end:",
                             "    if end.has_state:",
                             f"        {state} = end.state",
@@ -345,10 +435,15 @@ class _Run:
             self.end_tick = nxt
 
     def sample_step(self, code: _ProgramCode, c) -> None:
-        """A delayed connection takes the value its source holds now."""
+        """A delayed connection takes the value its source holds now (a copy, from a
+        compiled block's buffer)."""
         v = code.bind
-        source = f"{v(self.held[c.src_block])}[{v(c.src_port)}]"
-        code.step(f"{v(self.inputs[c.dst_block])}[{v(c.dst_port)}] = {source}")
+        compiled = self.compiled.blocks
+        if c.src_block in compiled:
+            source = f"{v(compiled[c.src_block].views[c.src_port])}.copy()"
+        else:
+            source = f"{v(self.held[c.src_block])}[{v(c.src_port)}]"
+        code.step(self.target_line(code, self.inputs[c.dst_block], c.dst_port, source))
 
     def advance_step(self, code: _ProgramCode, name: str, last: bool) -> None:
         """Steps ``name`` to the next event in chunks, each from the time of its first
@@ -379,8 +474,9 @@ class _Run:
         lines += ["    n -= m", "    done += m"]
         for p, dests in by_port.items():
             lines.append(f"value = rows[{v(p)}][-1]")
-            lines += [f"{v(d)}[{v(dp)}] = value" for d, dp in dests]
-        code.step(*lines, setup=(f"n = (next_k - k) // {period}", "done = 0"), handlers=(
+            lines += [self.target_line(code, d, dp, "value") for d, dp in dests]
+        code.step(*lines, setup=(*self.reader_lines(code, name), f"n = (next_k - k) // {period}", "done = 0"),
+                  handlers=(
             "except KeyboardInterrupt:",
             *([f"    {v(self.interrupted_in_span)}({v(name)}, k + done * {period})"] if last else []),
             "    raise",
@@ -449,7 +545,29 @@ class _Run:
         if ticks[0] == 0:
             pairs = pairs[1:] + [(ticks[0] + hyper, progs[0])]
         following = [k for k, _ in pairs[1:]] + [pairs[0][0] + hyper]
-        return [(k, nk, prog) for (k, prog), nk in zip(pairs, following)]
+        spans = []
+        i = 0
+        while i < len(pairs):
+            j = i + 1
+            if pairs[i][1].kernel_steps is not None:
+                while j < len(pairs) and pairs[j][1].kernel_steps is not None:
+                    j += 1
+            if j - i > 1:
+                spans.append((pairs[i][0], following[j - 1], self.fused(pairs[i:j])))
+            else:
+                spans.append((pairs[i][0], following[i], pairs[i][1].function))
+            i = j
+        return spans
+
+    def fused(self, pairs: list[tuple[int, _Compiled]]) -> Callable[[int, int], None]:
+        """Consecutive events whose steps are all compiled, as one C call from the first
+        event's tick: each event at its offset, its advances stepping to the next one."""
+        first = pairs[0][0]
+        events = [(k - first, [op for op, _ in c.kernel_steps], [step for _, step in c.kernel_steps])
+                  for k, c in pairs]
+        code = _ProgramCode(self.s.base_tick)
+        self.runner_step(code, self.compiled.runner(events), has_last_advance=True)
+        return code.function()
 
     def execute(self, progress: ProgressCallback | None) -> tuple[Results, SimulationError | None]:
         """Run ticks 0 .. end. Progress is the fraction of t_end reached, so a run that a
@@ -460,7 +578,7 @@ class _Run:
         interrupted: KeyboardInterrupt | None = None
         labels: dict[str, list[str]] = {}
         k = 0
-        initial = self.compile(self.s.initial)
+        initial = self.compile(self.s.initial).function
         try:
             labels = self.element_labels()
             spans = self.spans()
@@ -483,13 +601,15 @@ class _Run:
                 base += self.s.hyperperiod
             k = n
             final = self.s.final if n == total else final_program(self.d, self.s, n)
-            self.compile(final)(n, n)
+            self.compile(final).function(n, n)
         except _StepFailure as exc:
             failure = exc
         except KeyboardInterrupt as exc:
             interrupted = exc
+            self.compiled.sync_logs()
             if self.reached is not None:
                 k = max(k, self.reached)
+        self.compiled.sync_logs()
         wall = time.perf_counter() - wall0
         if progress is not None and failure is None and interrupted is None:
             progress(n / total, wall)
