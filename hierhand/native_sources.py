@@ -17,7 +17,8 @@ CORE = ["hand_params.c", "contact.c", "plant.c"]
 CORE_HEADERS = ["hand.h", "kinematics.h", "dynamics.h", "contact.h"]
 CONTROL = ["reflex.c", "manipulation.c", "suppresser.c"]
 CONTROL_HEADERS = ["control.h", "float_ops.h"]
-BINDING = ["python/module.c", "python/py_common.c", "python/py_model.c", "python/py_plant.c", "python/py_control.c"]
+BINDING = ["python/module.c", "python/py_common.c", "python/py_model.c", "python/py_plant.c", "python/py_control.c",
+           "python/py_kernels.c"]
 FMU_COMMON = ["fmu_instance.c"]
 FMU_HEADERS = ["fmu_instance.h"]
 FMI_WRAPPERS = {2: "fmi2_functions.c", 3: "fmi3_functions.c"}
@@ -31,7 +32,9 @@ def _paths(names: list[str]) -> list[str]:
 
 
 EXTENSION_SOURCES = _paths(CORE + CONTROL + BINDING)
-EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + FMU_HEADERS + ["python/py_common.h"])
+EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + FMU_HEADERS + ["python/py_common.h"]) + [
+    "blocks/csrc/blocks_kernel.h"  # the calling convention of py_kernels.c
+]
 """Headers whose change must rebuild the extension."""
 FMI_LIBRARIES = {fmi: _paths(CORE + FMU_COMMON + [wrapper]) for fmi, wrapper in FMI_WRAPPERS.items()}
 FMI_DEPENDS = _paths(CORE_HEADERS + FMU_HEADERS)

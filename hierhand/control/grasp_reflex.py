@@ -52,7 +52,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
+from blocks.kernel import Kernel
 
+from ..kernels import KERNELS, address_of, context, data_address, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
 from .reflex_kernel import (
     N_OUT,
@@ -63,6 +65,7 @@ from .reflex_kernel import (
     P_DT,
     pack_params,
     reflex_directions,
+    reflex_failure,
     reflex_forces,
     reflex_output,
     reflex_update,
@@ -150,6 +153,21 @@ class GraspReflex(ModelsTheHand, Block):
         self.dt = float(period)
         self._params[P_DT] = self.dt
 
+    def kernel(self) -> Kernel | None:
+        """``output`` and ``update`` in C (the same reflex law, hierhand/csrc/reflex.c),
+        reading the hand's model and the packed parameters; None before ``bind``."""
+        if not self._params[P_DT] > 0:
+            return None
+        model, params = self.hand.native, self._params
+        ctx = context(model_address(model), data_address(params))
+        return Kernel(
+            context=address_of(ctx),
+            output=KERNELS["GraspReflex.output"],
+            update=KERNELS["GraspReflex.update"],
+            owners=(ctx, model, params),
+            error=_kernel_error,
+        )
+
     def initial_state(self) -> np.ndarray:
         """[grasp force scale s (N), per finger the scale it was handed to voluntary motion at when
         it last touched, 0 while the reflex holds it (3)]."""
@@ -187,3 +205,8 @@ class GraspReflex(ModelsTheHand, Block):
         """The integral step of the grasp force scale and the hand-over scales (a fresh array)."""
         return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"],
                              inputs.get("share", WHOLE_SHARE))
+
+
+def _kernel_error(code: int, which: int, t: float, phase: str) -> BaseException:
+    """The kernel's failure as the Python methods raise it (the native calls' exception)."""
+    return reflex_failure(code)

@@ -30,7 +30,9 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
+from blocks.kernel import Kernel
 
+from ..kernels import KERNELS, address_of, context, data_address, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
@@ -136,6 +138,23 @@ class ManipulationPD(ModelsTheHand, Block):
         if status != OK:
             raise self.unreachable(status - UNREACHABLE, t)
         return {"tau_m": out[0], "tau_ff": out[1], "q_ref": out[2]}
+
+    def kernel(self) -> Kernel | None:
+        """``output`` in C: the same native call on the arrays packed in ``__init__``
+        (stateless; the period does not enter)."""
+        model, params, waypoints, meta = self._model, self._params, self._waypoints, self._meta
+        ctx = context(model_address(model), data_address(params), data_address(waypoints), data_address(meta),
+                      waypoints.shape[1])
+        return Kernel(
+            context=address_of(ctx),
+            output=KERNELS["ManipulationPD.output"],
+            owners=(ctx, model, params, waypoints, meta),
+            error=self._kernel_error,
+        )
+
+    def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BaseException:
+        """The kernel's failure (a target out of reach) as ``output`` raises it."""
+        return self.unreachable(code - UNREACHABLE, t)
 
     def unreachable(self, finger: int, t: float) -> UnreachableError:
         """The error of the first target of ``finger`` out of reach at time t: its pose at

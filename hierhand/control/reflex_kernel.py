@@ -52,6 +52,10 @@ _forces = _native.reflex_forces
 _output = _native.reflex_output
 _update = _native.reflex_update
 
+reflex_failure = _native.reflex_failure
+"""``reflex_failure(code)``: the exception (not raised) that the native reflex calls raise
+for a failure status: the error of ``GraspReflex``'s kernel."""
+
 WHOLE_SHARE = np.ones(3)
 """The ``share`` input when nothing overrides the reflex: every finger's command keeps its whole grasping torque."""
 

@@ -11,6 +11,9 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
+from blocks.kernel import Kernel
+
+from ..kernels import KERNELS, data_address
 
 from .suppresser_kernel import (
     N_OUT,
@@ -80,3 +83,8 @@ class Suppresser(Block):
             suppress_output(self._params, flat_float64(tau_g), flat_float64(tau_m), flat_float64(tau_ff), out)
         return {"tau": out[O_TAU:O_TAU + 9], "tau_g_eff": out[O_TAU_G_EFF:O_TAU_G_EFF + 9],
                 "share": out[O_SHARE:O_SHARE + 3]}
+
+    def kernel(self) -> Kernel | None:
+        """``output`` in C: the same native law on the parameters packed in ``__init__``
+        (stateless, no period needed)."""
+        return Kernel(context=data_address(self._params), output=KERNELS["Suppresser.output"], owners=(self._params,))

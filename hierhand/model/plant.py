@@ -17,8 +17,10 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, BlockError
+from blocks.kernel import Kernel
 
 from .. import _native
+from ..kernels import KERNELS, model_address
 from .hand import Hand
 from .handfile import SECTIONS, default_hand_dict, merge_with_default, parse_hand
 from .layout import (
@@ -229,6 +231,28 @@ class HandPlant(Block):
             error.rows = {name: rows[:written][index] for name, index in _PORT_COLUMNS}
             raise error
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
+
+    def kernel(self) -> Kernel | None:
+        """The C step functions (``hierhand/csrc/python/py_kernels.c``): the native calls of
+        ``output``, ``update`` and ``advance`` on the bound model, whose scratch they use;
+        None before ``bind``. The output row's ports lie one after the other in the order
+        of ``outputs``, and the inputs are ``tau``, ``f_ext``, as the kernel convention wants."""
+        model = self._model
+        if model is None:
+            return None
+        return Kernel(
+            context=model_address(model),
+            output=KERNELS["HandPlant.output"],
+            update=KERNELS["HandPlant.update"],
+            advance=KERNELS["HandPlant.advance"],
+            owners=(model,),
+            error=self._kernel_error,
+        )
+
+    def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BlockError:
+        """The kernel's failure as the Python methods raise it (``t``: the failing step's
+        time, for an advance the executor's, which counts the rows completed)."""
+        return self._error(code, which, t, step=phase in ("update", "advance"))
 
     def _arguments(self, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """(tau, f_ext) as the native calls take them; a state they cannot take, or an

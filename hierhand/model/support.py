@@ -14,7 +14,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
+from blocks.kernel import Kernel
 
+from ..kernels import KERNELS, data_address
 from .hand_source import ModelsTheHand, hand_of
 
 
@@ -55,3 +57,8 @@ class ObjectSupport(ModelsTheHand, Block):
 
     def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         return {"y": self.force.copy() if t < self.until else np.zeros(3)}
+
+    def kernel(self) -> Kernel | None:
+        """``output`` in C: the force while ``t < until``, zero from then on."""
+        ctx = np.concatenate((self.force, [self.until]))
+        return Kernel(context=data_address(ctx), output=KERNELS["ObjectSupport.output"], owners=(ctx,))

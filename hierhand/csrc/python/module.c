@@ -74,7 +74,8 @@ static struct PyModuleDef module_def = {
 
 static int collect_methods(void)
 {
-    const PyMethodDef *tables[] = {hh_py_model_methods, hh_py_plant_methods, hh_py_control_methods};
+    const PyMethodDef *tables[] = {hh_py_model_methods, hh_py_plant_methods, hh_py_control_methods,
+                                   hh_py_kernel_methods};
     size_t n = 0;
     for (size_t t = 0; t < sizeof tables / sizeof tables[0]; t++)
         for (const PyMethodDef *d = tables[t]; d->ml_name != NULL; d++) {

@@ -53,6 +53,7 @@ int hh_py_nargs(Py_ssize_t nargs, Py_ssize_t expected, const char *function);
 extern PyMethodDef hh_py_model_methods[]; /* py_model.c: the hand vector, queries */
 extern PyMethodDef hh_py_plant_methods[]; /* py_plant.c: stepping */
 extern PyMethodDef hh_py_control_methods[]; /* py_control.c: the controllers */
+extern PyMethodDef hh_py_kernel_methods[]; /* py_kernels.c: the blocks' compiled kernels */
 
 /* Add the controllers' layout constants to ``layout`` (py_control.c); -1 on error. */
 int hh_py_control_layout(PyObject *layout);

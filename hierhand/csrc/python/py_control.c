@@ -29,6 +29,28 @@ static PyObject *reflex_error(int code)
     return NULL;
 }
 
+/* reflex_failure(code): the exception the reflex functions raise for a status code (for
+ * the error factory of GraspReflex's kernel, so that each message has one definition). */
+static PyObject *py_reflex_failure(PyObject *module, PyObject *arg)
+{
+    (void)module;
+    int overflow;
+    long code = PyLong_AsLongAndOverflow(arg, &overflow);
+    if (code == -1 && PyErr_Occurred())
+        return NULL;
+    if (overflow || code < INT_MIN || code > INT_MAX || code == HH_REFLEX_OK) {
+        PyErr_Format(PyExc_ValueError, "reflex_failure: %R is not a failure code", arg);
+        return NULL;
+    }
+    PyObject *type, *value, *traceback;
+    reflex_error((int)code);
+    PyErr_Fetch(&type, &value, &traceback);
+    PyErr_NormalizeException(&type, &value, &traceback);
+    Py_XDECREF(type);
+    Py_XDECREF(traceback);
+    return value;
+}
+
 /* An input port of the reflex, of ``width`` values. */
 static const double *reflex_input(held_buffers *h, PyObject *obj, Py_ssize_t width, const char *port)
 {
@@ -540,6 +562,8 @@ PyMethodDef hh_py_control_methods[] = {
     {"reflex_output", FASTCALL(py_reflex_output),
      "reflex_output(model, params, state, tip, normal, fn, q, out): tau_g (9), |f_i| (3), grasp flags (3) "
      "into out (REFLEX_N_OUT)."},
+    {"reflex_failure", py_reflex_failure, METH_O,
+     "reflex_failure(code): the exception (not raised) the reflex functions raise for a failure status."},
     {"reflex_update", FASTCALL(py_reflex_update),
      "reflex_update(params, state, tip, normal, fn, ft, share, next): the next state (4) into next."},
     {"project_internal", FASTCALL(py_project_internal),
