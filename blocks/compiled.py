@@ -104,9 +104,11 @@ class CompiledSide:
     def wire(self, chunk: int) -> None:
         """Point every compiled block's inputs at the values they read."""
         feeds = {(c.dst_block, c.dst_port): c for c in self.d.connections}
-        gaps = np.diff(np.concatenate(([0], self.s.event_ticks, [self.s.hyperperiod + (
-            self.s.event_ticks[0] if len(self.s.event_ticks) else 0)])))
-        longest = int(gaps.max()) if gaps.size else 1
+        ticks = self.s.event_ticks
+        if len(ticks):  # from t = 0 to the first event, between events, around the hyperperiod
+            longest = int(np.diff(np.concatenate(([0], ticks, [self.s.hyperperiod + ticks[0]]))).max())
+        else:  # no events: one span from t = 0 to the end
+            longest = max(self.s.n_ticks, 1)
         for cb in self.blocks.values():
             for i, port in enumerate(cb.block.inputs):
                 c = feeds.get((cb.name, port))

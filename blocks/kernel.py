@@ -23,11 +23,12 @@ class Kernel:
     """The addresses of a block's C functions and of the constants they read.
 
     ``output``, ``update`` and ``advance`` are function addresses (0 where the block has
-    none; it then runs in Python wherever the schedule needs the missing one).
+    none; a block whose schedule needs a function its kernel lacks runs in Python).
     ``context`` is the pointer passed to them as ``ctx``; ``owners`` keeps alive the
     objects whose memory it and the functions use. The block's state must be a flat
     C-contiguous float64 array (or None for a stateless block), which the kernel updates
-    in place. The functions compute exactly what the Python methods compute. ``error``
+    in place. The functions compute what the Python methods compute (to round-off; a run
+    uses one or the other for all of a block's hits). ``error``
     makes the exception for a failure code (None: a generic message with the code).
     """
 

@@ -3,7 +3,9 @@
 Per event tick the executor runs a precompiled program: outputs of the firing blocks in
 feedthrough order, then their updates, then the sampling of delayed connections, then
 the advanced blocks stepped to the next event, each program written out as one Python
-function (``_ProgramCode``). Outputs are passed by reference from a block's return value
+function (``_ProgramCode``). Blocks with compiled kernels run in C (``blocks.compiled``):
+each stretch of their steps is one call, and consecutive events made only of such steps
+are one call together. Outputs are passed by reference from a block's return value
 into the persistent input mappings of the blocks it feeds (no per-tick dictionaries or
 copies); between hits values hold. Time is ``k * base_tick`` from the integer tick ``k``.
 

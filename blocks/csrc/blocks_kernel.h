@@ -20,8 +20,11 @@
  *   (a joint, a finger) and advance sets *done to the number of rows it completed before
  *   the failing update. Kernel.error(code, which, t, phase) in Python turns these into
  *   the block's exception, so messages have one definition.
- * - Results must equal the block's Python methods' to the last bit: the executor may run
- *   some hits through Python and others in C.
+ * - A kernel computes what the block's Python methods compute. Within a run the executor
+ *   uses a block's kernel for all of its hits or for none, so the two need not round
+ *   alike; a block whose Python methods call the same C code (the hand's blocks) matches
+ *   to the last bit, and one whose Python side uses numpy's matrix products matches to
+ *   round-off.
  */
 #ifndef BLOCKS_KERNEL_H
 #define BLOCKS_KERNEL_H

@@ -4,8 +4,8 @@
  * with a kernel (blocks_kernel.h): its outputs, updates, advances and the copies of
  * delayed connections, for one event or for a stretch of consecutive events. The
  * executor (blocks/simulate.py) builds it from flat int64 tables and calls
- * ``run(k, next_k)``: the events at tick k + offset before next_k, each one's advances
- * stepping to the following event (or next_k). Kernels read their inputs through
+ * ``run(k, next_k)``: the event at tick k and those at k + offset before next_k, each
+ * one's advances stepping to the following event (or next_k). Kernels read their inputs through
  * pointers into the output buffers of the blocks that feed them, so passing a value on
  * costs nothing; logged outputs are copied into the loggers' buffers here, honouring
  * their decimation.
@@ -66,14 +66,24 @@ static void log_row(const RunnerObject *r, Py_ssize_t entry, const double *outpu
     c[C_HITS]++;
 }
 
-/* A failure: (code, which, op index, tick). */
-static PyObject *failure(int code, int which, Py_ssize_t op, int64_t tick)
+/* What an op ended with: done, a block's failure (a tuple to return), or an exception set
+   (an interrupt between the chunks of an advance). */
+typedef struct {
+    PyObject *failure;
+    int raised;
+} op_end;
+
+static op_end failure(int code, int which, Py_ssize_t op, int64_t tick)
 {
-    return Py_BuildValue("(iinL)", code, which, op, (long long)tick);
+    PyObject *t = Py_BuildValue("(iinL)", code, which, op, (long long)tick);
+    return (op_end){t, t == NULL};
 }
 
-/* Step a block from tick ke to tick next in chunks of at most its rows capacity. */
-static PyObject *advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int64_t ke, int64_t next)
+static const op_end DONE = {NULL, 0};
+
+/* Step a block from tick ke to tick next in chunks of at most its rows capacity; Ctrl-C
+   is looked for between chunks (r->reached then says how far the block got). */
+static op_end advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int64_t ke, int64_t next)
 {
     const int64_t *s = r->slots + op[OP_SLOT] * S_N;
     blk_advance_fn fn = (blk_advance_fn)(intptr_t)s[S_ADVANCE];
@@ -96,17 +106,21 @@ static PyObject *advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, i
         memcpy(out, rows + (m - 1) * width, (size_t)width * sizeof(double));
         n -= m;
         stepped += m;
+        if (n > 0 && PyErr_CheckSignals() != 0) {
+            r->reached = ke + stepped * period;
+            return (op_end){NULL, 1};
+        }
     }
-    return NULL;
+    return DONE;
 }
 
-/* One op at event tick ke whose advances reach next; a failure tuple or NULL. */
-static PyObject *run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next)
+/* One op at event tick ke whose advances reach next. */
+static op_end run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next)
 {
     const int64_t *op = r->ops + index * OP_N;
     if (op[OP_CODE] == OP_COPY) {
         memcpy((double *)(intptr_t)op[OP_A], (const double *)(intptr_t)op[OP_B], (size_t)op[OP_SLOT] * sizeof(double));
-        return NULL;
+        return DONE;
     }
     if (op[OP_CODE] == OP_ADVANCE)
         return advance(r, op, index, ke, next);
@@ -124,10 +138,12 @@ static PyObject *run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t n
     } else {
         code = ((blk_update_fn)(intptr_t)s[S_UPDATE])(ctx, tick_time(r, ke), state, inputs, &which);
     }
-    return code ? failure(code, which, index, ke) : NULL;
+    return code ? failure(code, which, index, ke) : DONE;
 }
 
-/* run(k, next_k): None, or (code, which, op index, tick) of the first failure. */
+/* run(k, next_k): None, or (code, which, op index, tick) of the first failure. Ctrl-C is
+   looked for between events and between the chunks of long advances; it raises
+   KeyboardInterrupt with ``reached`` saying how far the run got. */
 static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t nargs)
 {
     if (nargs != 2) {
@@ -140,19 +156,23 @@ static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t n
     for (Py_ssize_t e = 0; e < r->n_events; e++) {
         const int64_t *ev = r->events + e * E_N;
         int64_t ke = k + ev[E_OFFSET];
-        if (ke >= next_k)
+        if (e > 0 && ke >= next_k) /* the first event always runs: a final one has k == next_k */
             break;
         int64_t next = e + 1 < r->n_events ? k + ev[E_N + E_OFFSET] : next_k;
         if (next > next_k)
             next = next_k;
         for (int64_t i = ev[E_START]; i < ev[E_END]; i++) {
-            PyObject *failed = run_op(r, (Py_ssize_t)i, ke, next);
-            if (failed != NULL) {
+            op_end end = run_op(r, (Py_ssize_t)i, ke, next);
+            if (end.raised)
+                return NULL;
+            if (end.failure != NULL) {
                 r->reached = ke;
-                return failed;
+                return end.failure;
             }
         }
         r->reached = next;
+        if (e + 1 < r->n_events && PyErr_CheckSignals() != 0)
+            return NULL;
     }
     Py_RETURN_NONE;
 }

@@ -1,0 +1,104 @@
+/* Test kernels of the calling convention in blocks/csrc/blocks_kernel.h.
+ *
+ * Leak: state x (width w), update x = a x + b u elementwise, outputs y = x and
+ * sum = x[0] + ... + x[w-1]; an update whose new |x[i]| exceeds the limit fails with code 7
+ * and which = i, leaving x as it was. Scale: y = k u (feedthrough, no state).
+ * ctx: Leak [a, b, limit, w]; Scale [k, w].
+ */
+#include <math.h>
+
+#include "blocks_kernel.h"
+
+static int leak_step(const double *p, double *x, const double *u, int *which)
+{
+    int w = (int)p[3];
+    for (int i = 0; i < w; i++)
+        if (fabs(p[0] * x[i] + p[1] * u[i]) > p[2]) {
+            *which = i;
+            return 7;
+        }
+    for (int i = 0; i < w; i++)
+        x[i] = p[0] * x[i] + p[1] * u[i];
+    return 0;
+}
+
+static void leak_out(const double *p, const double *x, double *out)
+{
+    int w = (int)p[3];
+    double sum = 0.0;
+    for (int i = 0; i < w; i++) {
+        out[i] = x[i];
+        sum += x[i];
+    }
+    out[w] = sum;
+}
+
+int leak_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out, int *which)
+{
+    (void)t;
+    (void)inputs;
+    (void)which;
+    leak_out(ctx, state, out);
+    return 0;
+}
+
+int leak_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
+{
+    (void)t;
+    return leak_step(ctx, state, inputs[0], which);
+}
+
+int leak_advance(const void *ctx, double t, double *state, const double *const *inputs, int n, double *rows,
+                 int *done, int *which)
+{
+    (void)t;
+    const double *p = ctx;
+    int w = (int)p[3];
+    for (int i = 0; i < n; i++) {
+        int code = leak_step(p, state, inputs[0], which);
+        if (code) {
+            *done = i;
+            return code;
+        }
+        leak_out(p, state, rows + i * (w + 1));
+    }
+    *done = n;
+    return 0;
+}
+
+int scale_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out, int *which)
+{
+    (void)t;
+    (void)state;
+    (void)which;
+    const double *p = ctx;
+    for (int i = 0; i < (int)p[1]; i++)
+        out[i] = p[0] * inputs[0][i];
+    return 0;
+}
+
+/* Ticker: state [count]; each update adds one, and the update that brings the count to
+   ctx[0] sends this process SIGINT (as Ctrl-C would, in the middle of a C call). */
+#include <signal.h>
+
+int ticker_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                  int *which)
+{
+    (void)ctx, (void)t, (void)inputs, (void)which;
+    out[0] = state[0];
+    return 0;
+}
+
+int ticker_advance(const void *ctx, double t, double *state, const double *const *inputs, int n, double *rows,
+                   int *done, int *which)
+{
+    (void)t, (void)inputs, (void)which;
+    for (int i = 0; i < n; i++) {
+        state[0] += 1.0;
+        if (state[0] == ((const double *)ctx)[0])
+            raise(SIGINT);
+        rows[i] = state[0];
+    }
+    *done = n;
+    return 0;
+}
