@@ -17,7 +17,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .block import BlockError
-from .kernel import Kernel
+from .kernel import Kernel, address
 
 try:
     from ._native import Runner as NativeRunner
@@ -30,11 +30,6 @@ destination, source]``)."""
 
 EXACT_TICKS = 2**53
 """Tick times are exact in C while ``tick * numerator`` stays below this."""
-
-
-def address(array: np.ndarray) -> int:
-    """The address of an array's first element."""
-    return array.__array_interface__["data"][0]
 
 
 class CompiledBlock:

@@ -13,9 +13,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
+import numpy as np
+
 ErrorFactory = Callable[[int, int, float, str], BaseException]
 """``error(code, which, t, phase)``: the exception for a kernel's failure code at time
 ``t`` in ``phase`` ('output', 'update' or 'advance')."""
+
+
+def address(array: np.ndarray) -> int:
+    """The address of a C-contiguous array's first element, for a kernel's context (keep
+    the array alive in ``Kernel.owners``)."""
+    if not (isinstance(array, np.ndarray) and array.flags.c_contiguous):
+        raise TypeError("a kernel reads C-contiguous arrays; got "
+                        + (f"a non-contiguous {array.dtype} array" if isinstance(array, np.ndarray)
+                           else type(array).__name__))
+    return array.__array_interface__["data"][0]
 
 
 @dataclass(frozen=True)

@@ -52,9 +52,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
-from blocks.kernel import Kernel
+from blocks.kernel import Kernel, address
 
-from ..kernels import KERNELS, address_of, context, data_address, model_address
+from ..kernels import KERNELS, context, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
 from .reflex_kernel import (
     N_OUT,
@@ -159,9 +159,9 @@ class GraspReflex(ModelsTheHand, Block):
         if not self._params[P_DT] > 0:
             return None
         model, params = self.hand.native, self._params
-        ctx = context(model_address(model), data_address(params))
+        ctx = context(model_address(model), address(params))
         return Kernel(
-            context=address_of(ctx),
+            context=address(ctx),
             output=KERNELS["GraspReflex.output"],
             update=KERNELS["GraspReflex.update"],
             owners=(ctx, model, params),

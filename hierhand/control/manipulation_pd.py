@@ -30,9 +30,9 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
-from blocks.kernel import Kernel
+from blocks.kernel import Kernel, address
 
-from ..kernels import KERNELS, address_of, context, data_address, model_address
+from ..kernels import KERNELS, context, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
@@ -143,10 +143,10 @@ class ManipulationPD(ModelsTheHand, Block):
         """``output`` in C: the same native call on the arrays packed in ``__init__``
         (stateless; the period does not enter)."""
         model, params, waypoints, meta = self._model, self._params, self._waypoints, self._meta
-        ctx = context(model_address(model), data_address(params), data_address(waypoints), data_address(meta),
+        ctx = context(model_address(model), address(params), address(waypoints), address(meta),
                       waypoints.shape[1])
         return Kernel(
-            context=address_of(ctx),
+            context=address(ctx),
             output=KERNELS["ManipulationPD.output"],
             owners=(ctx, model, params, waypoints, meta),
             error=self._kernel_error,

@@ -11,9 +11,9 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
-from blocks.kernel import Kernel
+from blocks.kernel import Kernel, address
 
-from ..kernels import KERNELS, data_address
+from ..kernels import KERNELS
 
 from .suppresser_kernel import (
     N_OUT,
@@ -87,4 +87,4 @@ class Suppresser(Block):
     def kernel(self) -> Kernel | None:
         """``output`` in C: the same native law on the parameters packed in ``__init__``
         (stateless, no period needed)."""
-        return Kernel(context=data_address(self._params), output=KERNELS["Suppresser.output"], owners=(self._params,))
+        return Kernel(context=address(self._params), output=KERNELS["Suppresser.output"], owners=(self._params,))

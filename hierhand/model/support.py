@@ -14,9 +14,9 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
-from blocks.kernel import Kernel
+from blocks.kernel import Kernel, address
 
-from ..kernels import KERNELS, data_address
+from ..kernels import KERNELS
 from .hand_source import ModelsTheHand, hand_of
 
 
@@ -61,4 +61,4 @@ class ObjectSupport(ModelsTheHand, Block):
     def kernel(self) -> Kernel | None:
         """``output`` in C: the force while ``t < until``, zero from then on."""
         ctx = np.concatenate((self.force, [self.until]))
-        return Kernel(context=data_address(ctx), output=KERNELS["ObjectSupport.output"], owners=(ctx,))
+        return Kernel(context=address(ctx), output=KERNELS["ObjectSupport.output"], owners=(ctx,))
