@@ -18,6 +18,7 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, BlockError, Signal
+from blocks.library import _kernels
 
 METHODS = ("zoh", "tustin")
 """Discretisation methods accepted by ``method`` (python-control names)."""
@@ -222,6 +223,22 @@ class _LinearBlock(Block):
             self._chunks[c] = maps
         return maps
 
+    def _all_chunks(self) -> tuple[np.ndarray, list[np.ndarray]]:
+        """``_chunk(CHUNK)``'s output map and every ``_chunk(c)``'s state map, c = 1..CHUNK,
+        by the very operations ``_chunk`` does (its products for c are the first c of
+        those for CHUNK), in CHUNK steps instead of CHUNK (CHUNK + 1) / 2."""
+        n, m = self._n, self._m
+        step = np.zeros((n + m, n + m))
+        step[:n] = self._AB
+        step[n:, n:] = np.eye(m)
+        power = np.eye(n + m)
+        rows, xmaps = [], []
+        for _ in range(CHUNK):
+            power = step @ power
+            rows.append(self._CD @ power)
+            xmaps.append(np.ascontiguousarray(power[:n]))
+        return np.ascontiguousarray(np.vstack(rows)), xmaps
+
     def advance(self, t: float, state: Any, inputs: Mapping[str, Signal], n: int):
         """Closed form for a held input: x_{k+i} = A^i x + (sum_{j<i} A^j) B u, in chunks."""
         u = inputs["u"]
@@ -248,6 +265,53 @@ class _LinearBlock(Block):
             z[:nx] = x
             done += c
         return x, {"y": out}
+
+    def kernel(self):
+        """C output, update and advance (blocks/csrc/library.c, ``lti_*``), reading the
+        matrices in use and every ``_chunk`` map; None for a continuous model not yet
+        bound, or where the products would not reproduce ``ndarray.dot``: more than
+        ``MATVEC_MAX_L`` states plus inputs (see ``blocks.library._kernels``)."""
+        if self.A is None:
+            return None
+        return _kernels.cached(self, (id(self._AB), self.period), self._build_kernel)
+
+    def _build_kernel(self):
+        n, m, p = self._n, self._m, self._p
+        L = n + m
+        if L > _kernels.MATVEC_MAX_L:
+            return None
+        shapes = {(p, m)} if n == 0 else {(n, L), (p, L) if self._ft_path else (p, n)}
+        if n:
+            shapes |= {(c * p, L) for c in (1, 2)} | {(n, L)}
+        if not all(_kernels.matvec_exact(r, c) for r, c in shapes):
+            return None
+        header = np.zeros(14 + 2 * CHUNK)
+        scalar = self._scalar
+        header[:9] = (n, m, p, scalar, self._ft_path,
+                      self._a if scalar else 0.0, self._b if scalar else 0.0,
+                      self._c if scalar else 0.0, self._d if scalar else 0.0)
+        header[13] = CHUNK
+        parts = [header]
+        size = header.size
+
+        def place(matrix: np.ndarray) -> int:
+            nonlocal size
+            offset = size
+            parts.append(np.ascontiguousarray(matrix, dtype=float).ravel())
+            size += parts[-1].size
+            return offset
+
+        header[12] = place(self._AB)
+        header[11] = place(self.D)
+        if n:
+            header[9] = place(self._CD)
+            header[10] = place(self._C)
+            # chunk c's output map is the first c * p rows of chunk CHUNK's
+            ymap, xmaps = self._all_chunks()
+            header[14:14 + CHUNK] = place(ymap)
+            for c in range(1, CHUNK + 1):
+                header[13 + CHUNK + c] = place(xmaps[c - 1])
+        return _kernels.make_kernel(np.concatenate(parts), "lti_output", "lti_update", "lti_advance", self._AB)
 
 
 class DiscreteStateSpace(_LinearBlock):
