@@ -29,7 +29,7 @@ DDOT_MAX_L = 15
 def functions() -> dict[str, int]:
     """{name: address} of the library kernels; empty when blocks._native is missing."""
     try:
-        from blocks import _native
+        import blocks._native as _native
     except ImportError:
         return {}
     return dict(_native.library())
@@ -73,7 +73,7 @@ def _checked(single: bool, cols: int) -> bool:
     table = functions()
     if "gain_output" not in table:
         return False
-    from blocks import _native
+    import blocks._native as _native  # not "from blocks import": no cycle
 
     rng = random.Random(20240601 + cols)  # not numpy.random: importing it costs 10 ms
 

@@ -311,7 +311,8 @@ class _LinearBlock(Block):
             header[14:14 + CHUNK] = place(ymap)
             for c in range(1, CHUNK + 1):
                 header[13 + CHUNK + c] = place(xmaps[c - 1])
-        return _kernels.make_kernel(np.concatenate(parts), "lti_output", "lti_update", "lti_advance", self._AB)
+        return _kernels.make_kernel(np.concatenate(parts), "lti_output", "lti_update", "lti_advance",
+                                    self._AB)
 
 
 class DiscreteStateSpace(_LinearBlock):

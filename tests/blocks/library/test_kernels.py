@@ -62,7 +62,8 @@ def out_width(block):
 def c_output(block, t, state, inputs):
     kernel = kernel_of(block)
     out = np.full(out_width(block), np.nan)
-    code, _ = _native.call("output", kernel.output, kernel.context, t, state, port_list(block, inputs), out)
+    code, _ = _native.call("output", kernel.output, kernel.context, t, state, port_list(block, inputs),
+                           out)
     assert code == 0
     return out
 
@@ -79,8 +80,8 @@ def c_advance(block, t, state, inputs, n):
     kernel = kernel_of(block)
     state = None if state is None else state.copy()
     rows = np.full((max(n, 0), out_width(block)), np.nan)
-    code, done, _ = _native.call("advance", kernel.advance, kernel.context, t, state, port_list(block, inputs),
-                                 rows, n)
+    ports = port_list(block, inputs)
+    code, done, _ = _native.call("advance", kernel.advance, kernel.context, t, state, ports, rows, n)
     assert code == 0 and done == max(n, 0)
     return state, rows
 
@@ -146,7 +147,8 @@ def test_gain(k, width, seed):
         assert_outputs_equal(block, None, {"u": u})
 
 
-@pytest.mark.parametrize("signs", ["+", "-", "++", "+-", "-+", "--", "+++", "++-", "+--", "-+-", "---", "-++-+"])
+@pytest.mark.parametrize("signs", ["+", "-", "++", "+-", "-+", "--", "+++", "++-", "+--", "-+-", "---",
+                                   "-++-+"])
 @pytest.mark.parametrize("width", [1, 3])
 def test_sum(signs, width):
     rng = np.random.default_rng(len(signs) * 10 + width)
