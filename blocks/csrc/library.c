@@ -2,71 +2,36 @@
  *
  * Every kernel reads a flat float64 context that the block's kernel() builds
  * (blocks/library/_kernels.py): sizes first, stored as doubles, then the parameters.
- * Each computes exactly what the block's Python method computes, operation for
- * operation, so results agree to the last bit (compiled with -ffp-contract=off: a
- * fused multiply-add appears only where fma() is written, to match one in numpy's BLAS).
+ * Each computes the quantity the block's Python method computes. Elementwise arithmetic
+ * (sources, gains by a scalar or a vector, sums, saturation, delays, holds, and the LTI
+ * blocks of one state, one input and one output) does the same operations in the same
+ * order as the Python side, so it agrees to the last bit. Compiled with -ffp-contract=off:
+ * no fused multiply-add anywhere, every product and sum is rounded on its own.
  *
- * Matrix-vector products: the Python blocks call ndarray.dot, which numpy hands to
- * OpenBLAS. matvec() below reproduces what that does for short rows (the dot length L):
- * - L == 1: one product per row (numpy's scalar path: a multiply, or an axpy into 0);
- * - one row, L < 16: ddot's sequential sum from 0;
- * - several rows, L <= 7: dgemv_t: the first 4 terms (when L >= 4) summed pairwise as
- *   (p0 + p2) + (p1 + p3), the rest added by its C tail, which the compiler fused.
- * That is OpenBLAS's Haswell kernel; the Python side checks matvec against numpy on
- * random matrices before offering a kernel that uses it (another BLAS build, another
- * kernel: the block then runs in Python).
+ * Matrix-vector products (matvec) have one definition of their own, independent of any
+ * BLAS: each row is summed in column order starting from its first product,
+ *     y_i = ((M_i0 v_0 + M_i1 v_1) + M_i2 v_2) + ... + M_i,L-1 v_L-1.
+ * A row of a single term is that one product, as numpy's is; longer rows equal numpy's
+ * ndarray.dot to round-off, not bit for bit (BLAS sums in its own order). That is enough:
+ * within a run the executor uses a block's kernel for all of its hits or for none.
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "library.h"
 
-#define MATVEC_MAX_L 7
-
-/* y = 0 + (sum of the first four products) in the order of OpenBLAS's 4-wide kernels. */
-static double dot4(const double *a, const double *x)
-{
-    double p0 = 0.0 + a[0] * x[0], p1 = 0.0 + a[1] * x[1], p2 = 0.0 + a[2] * x[2], p3 = 0.0 + a[3] * x[3];
-    return 0.0 + ((p0 + p2) + (p1 + p3));
-}
-
-/* dgemv_t's tail for the last m3 (< 4) terms, added to y. */
-static double gemv_tail(double y, const double *a, const double *x, int m3)
-{
-    switch (m3) {
-    case 1:
-        return fma(a[0], x[0], y);
-    case 2:
-        return y + fma(a[0], x[0], a[1] * x[1]);
-    case 3:
-        return y + fma(a[2], x[2], fma(a[0], x[0], a[1] * x[1]));
-    default:
-        return y;
-    }
-}
-
-/* y (r) = M (r x L, row-major) . v (L), as numpy's ndarray.dot computes it (see above). */
+/* y (r) = M (r x L, row-major, L >= 1) . v (L), each row summed in order (see above).
+   y must not overlap M or v. */
 static void matvec(const double *M, int r, int L, const double *v, double *y)
 {
-    if (L == 1) {
-        if (r == 1)
-            y[0] = M[0] * v[0];
-        else
-            for (int i = 0; i < r; i++)
-                y[i] = 0.0 + M[i] * v[0];
-        return;
-    }
-    if (r == 1) {
-        double d = 0.0;
-        for (int j = 0; j < L; j++)
-            d = d + M[j] * v[j];
-        y[0] = d;
-        return;
-    }
     for (int i = 0; i < r; i++) {
         const double *a = M + (size_t)i * L;
-        y[i] = L >= 4 ? gemv_tail(dot4(a, v), a + 4, v + 4, L - 4) : gemv_tail(0.0, a, v, L);
+        double s = a[0] * v[0];
+        for (int j = 1; j < L; j++)
+            s += a[j] * v[j];
+        y[i] = s;
     }
 }
 
@@ -244,9 +209,34 @@ static int zero_order_hold_output(const void *ctx, double t, const double *state
     off_Y[1..chunk_max], off_X[1..chunk_max]]
    scalar (n = m = p = 1): output and update on the four numbers as Python floats do;
    chunk c's maps, as _LinearBlock._chunk(c): Y (c p x (n + m)) at off_Y[c], X (n x (n + m))
-   at off_X[c] (the Y's all start at one offset: each is the first c p rows of the last). */
+   at off_X[c] (the Y's all start at one offset: each is the first c p rows of the last).
+   Any sizes: the vectors z = [x; u] of the products live on the stack up to LTI_STACK
+   doubles, in memory from malloc beyond (LTI_NOMEM when there is none). */
 enum { LTI_N, LTI_M, LTI_P, LTI_SCALAR, LTI_FT, LTI_A, LTI_B, LTI_C, LTI_D, LTI_OFF_CD, LTI_OFF_C, LTI_OFF_D,
        LTI_OFF_AB, LTI_CHUNK, LTI_HEADER };
+
+#define LTI_STACK 256
+
+enum { LTI_NOMEM = 1 }; /* failure code: no memory for the scratch (_kernels.NOMEM) */
+
+/* count doubles of scratch: local (LTI_STACK of them) or malloc's; NULL when out of memory. */
+static double *lti_scratch(double *local, size_t count)
+{
+    return count <= LTI_STACK ? local : malloc(count * sizeof(double));
+}
+
+static void lti_release(double *scratch, const double *local)
+{
+    if (scratch != local)
+        free(scratch);
+}
+
+/* z = [x; u] */
+static void lti_stack(double *z, const double *x, int n, const double *u, int m)
+{
+    memcpy(z, x, (size_t)n * sizeof(double));
+    memcpy(z + n, u, (size_t)m * sizeof(double));
+}
 
 static int lti_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
                       int *which)
@@ -267,10 +257,12 @@ static int lti_output(const void *ctx, double t, const double *state, const doub
         matvec(c + (size_t)c[LTI_OFF_D], p, m, u, out);
         return 0;
     }
-    double z[2 * MATVEC_MAX_L];
-    memcpy(z, state, (size_t)n * sizeof(double));
-    memcpy(z + n, u, (size_t)m * sizeof(double));
+    double local[LTI_STACK], *z = lti_scratch(local, (size_t)n + m);
+    if (z == NULL)
+        return LTI_NOMEM;
+    lti_stack(z, state, n, u, m);
     matvec(c + (size_t)c[LTI_OFF_CD], p, n + m, z, out);
+    lti_release(z, local);
     return 0;
 }
 
@@ -284,13 +276,18 @@ static int lti_update(const void *ctx, double t, double *state, const double *co
         state[0] = c[LTI_A] * state[0] + c[LTI_B] * u[0];
         return 0;
     }
-    double z[2 * MATVEC_MAX_L];
-    memcpy(z, state, (size_t)n * sizeof(double));
-    memcpy(z + n, u, (size_t)m * sizeof(double));
+    double local[LTI_STACK], *z = lti_scratch(local, (size_t)n + m);
+    if (z == NULL)
+        return LTI_NOMEM;
+    lti_stack(z, state, n, u, m);
     matvec(c + (size_t)c[LTI_OFF_AB], n, n + m, z, state);
+    lti_release(z, local);
     return 0;
 }
 
+/* The closed form of _LinearBlock.advance: per chunk of at most chunk_max steps, the rows
+   Y z and the new state X z. For the scalar model these products are the two-term sums
+   its Python advance writes out, (first * x) + (second * u), so they match to the bit. */
 static int lti_advance(const void *ctx, double t, double *state, const double *const *inputs, int count,
                        double *rows, int *done, int *which)
 {
@@ -299,19 +296,22 @@ static int lti_advance(const void *ctx, double t, double *state, const double *c
     int n = (int)c[LTI_N], m = (int)c[LTI_M], p = (int)c[LTI_P], chunk = (int)c[LTI_CHUNK];
     const double *u = inputs[0];
     const double *off_y = c + LTI_HEADER - 1, *off_x = c + LTI_HEADER + chunk - 1; /* indexed by c = 1..chunk */
-    *done = count > 0 ? count : 0;
+    *done = 0;
     if (count <= 0)
         return 0;
     if (n == 0) { /* a stateless gain: D u on every row */
         matvec(c + (size_t)c[LTI_OFF_D], p, m, u, rows);
         for (int i = 1; i < count; i++)
             memcpy(rows + (size_t)i * p, rows, (size_t)p * sizeof(double));
+        *done = count;
         return 0;
     }
     int L = n + m;
-    double z[2 * MATVEC_MAX_L], x[2 * MATVEC_MAX_L];
-    memcpy(z, state, (size_t)n * sizeof(double));
-    memcpy(z + n, u, (size_t)m * sizeof(double));
+    double local[LTI_STACK], *z = lti_scratch(local, 2 * (size_t)L);
+    if (z == NULL)
+        return LTI_NOMEM;
+    double *x = z + L;
+    lti_stack(z, state, n, u, m);
     for (int k = 0; k < count;) {
         int step = count - k < chunk ? count - k : chunk;
         matvec(c + (size_t)off_y[step], step * p, L, z, rows + (size_t)k * p);
@@ -320,6 +320,8 @@ static int lti_advance(const void *ctx, double t, double *state, const double *c
         k += step;
     }
     memcpy(state, z, (size_t)n * sizeof(double));
+    lti_release(z, local);
+    *done = count;
     return 0;
 }
 

@@ -137,6 +137,7 @@ class _LinearBlock(Block):
         self._ft_path = True
         self._x0 = x0
         self._chunks: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._scalar_chunks: dict[int, tuple[np.ndarray, np.ndarray, float, float]] = {}
         # Until the period is known, assume the feedthrough a discretised model can have:
         # zoh keeps D; tustin adds a multiple of C (I - A T/2)^-1 B, which is zero for
         # every T only when all Markov parameters C A^k B are.
@@ -163,6 +164,7 @@ class _LinearBlock(Block):
             self._a, self._b = float(A[0, 0]), float(B[0, 0])
             self._c, self._d = float(C[0, 0]), float(D[0, 0])
         self._chunks = {}
+        self._scalar_chunks = {}
 
     def bind(self, period: Fraction | None) -> None:
         """Discretise a continuous model (``method`` given) at ``period``."""
@@ -247,11 +249,10 @@ class _LinearBlock(Block):
             return None, {"y": np.tile(self.D.dot(u), (max(n, 0), 1))}
         if n <= 0:
             return state, {"y": np.empty((0, p))}
-        nx = self._n
         if self._scalar:
-            z = np.array((state.item(), u.item()))
-        else:
-            z = np.concatenate((state, u))
+            return self._advance_scalar(state.item(), u.item(), n)
+        nx = self._n
+        z = np.concatenate((state, u))
         if n <= CHUNK:
             ymap, xmap = self._chunk(n)
             return xmap.dot(z), {"y": ymap.dot(z).reshape(n, p)}
@@ -266,25 +267,45 @@ class _LinearBlock(Block):
             done += c
         return x, {"y": out}
 
+    def _advance_scalar(self, x: float, u: float, n: int):
+        """``advance`` of the 1x1x1 model: each chunk's products written out as two-term
+        sums (first * x) + (second * u), elementwise, which the C kernel's products equal
+        to the bit (``ndarray.dot`` would leave the order and fusing to BLAS)."""
+        if n <= CHUNK:
+            yx, yu, xx, xu = self._scalar_chunk(n)
+            return np.array((xx * x + xu * u,)), {"y": yx * x + yu * u}
+        out = np.empty((n, 1))
+        done = 0
+        while done < n:
+            c = min(n - done, CHUNK)
+            yx, yu, xx, xu = self._scalar_chunk(c)
+            out[done:done + c] = yx * x + yu * u
+            x = xx * x + xu * u
+            done += c
+        return np.array((x,)), {"y": out}
+
+    def _scalar_chunk(self, c: int) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """``_chunk(c)`` of the 1x1x1 model split by column: the output map's x and u
+        columns (contiguous, c x 1) and the state map's two numbers."""
+        parts = self._scalar_chunks.get(c)
+        if parts is None:
+            ymap, xmap = self._chunk(c)
+            parts = (ymap[:, :1].copy(), ymap[:, 1:].copy(), float(xmap[0, 0]), float(xmap[0, 1]))
+            self._scalar_chunks[c] = parts
+        return parts
+
     def kernel(self):
         """C output, update and advance (blocks/csrc/library.c, ``lti_*``), reading the
         matrices in use and every ``_chunk`` map; None for a continuous model not yet
-        bound, or where the products would not reproduce ``ndarray.dot``: more than
-        ``MATVEC_MAX_L`` states plus inputs (see ``blocks.library._kernels``)."""
+        bound. The 1x1x1 model and a stateless 1x1 gain match the Python methods to the
+        bit (their products are the same float operations); larger ones compute the
+        same products to round-off (library.c's ``matvec``, see ``blocks.library._kernels``)."""
         if self.A is None:
             return None
         return _kernels.cached(self, (id(self._AB), self.period), self._build_kernel)
 
     def _build_kernel(self):
         n, m, p = self._n, self._m, self._p
-        L = n + m
-        if L > _kernels.MATVEC_MAX_L:
-            return None
-        shapes = {(p, m)} if n == 0 else {(n, L), (p, L) if self._ft_path else (p, n)}
-        if n:
-            shapes |= {(c * p, L) for c in (1, 2)} | {(n, L)}
-        if not all(_kernels.matvec_exact(r, c) for r, c in shapes):
-            return None
         header = np.zeros(14 + 2 * CHUNK)
         scalar = self._scalar
         header[:9] = (n, m, p, scalar, self._ft_path,
