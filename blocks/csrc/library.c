@@ -1,8 +1,345 @@
-/* Compiled kernels of the framework's library blocks (blocks/library). */
+/* Compiled kernels of the framework's library blocks (blocks/library).
+ *
+ * Every kernel reads a flat float64 context that the block's kernel() builds
+ * (blocks/library/_kernels.py): sizes first, stored as doubles, then the parameters.
+ * Each computes the quantity the block's Python method computes. Elementwise arithmetic
+ * (sources, gains by a scalar or a vector, sums, saturation, delays, holds, and the LTI
+ * blocks of one state, one input and one output) does the same operations in the same
+ * order as the Python side, so it agrees to the last bit. Compiled with -ffp-contract=off:
+ * no fused multiply-add anywhere, every product and sum is rounded on its own.
+ *
+ * Matrix-vector products (matvec) have one definition of their own, independent of any
+ * BLAS: each row is summed in column order starting from its first product,
+ *     y_i = ((M_i0 v_0 + M_i1 v_1) + M_i2 v_2) + ... + M_i,L-1 v_L-1.
+ * A row of a single term is that one product, as numpy's is; longer rows equal numpy's
+ * ndarray.dot to round-off, not bit for bit (BLAS sums in its own order). That is enough:
+ * within a run the executor uses a block's kernel for all of its hits or for none.
+ */
+#include <math.h>
 #include <stddef.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "library.h"
 
+/* y (r) = M (r x L, row-major, L >= 1) . v (L), each row summed in order (see above).
+   y must not overlap M or v. */
+static void matvec(const double *M, int r, int L, const double *v, double *y)
+{
+    for (int i = 0; i < r; i++) {
+        const double *a = M + (size_t)i * L;
+        double s = a[0] * v[0];
+        for (int j = 1; j < L; j++)
+            s += a[j] * v[j];
+        y[i] = s;
+    }
+}
+
+/* -- sources ------------------------------------------------------------------------ */
+
+/* constant: [w, value...] */
+static int constant_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                           int *which)
+{
+    (void)t, (void)state, (void)inputs, (void)which;
+    const double *c = ctx;
+    int w = (int)c[0];
+    memcpy(out, c + 1, (size_t)w * sizeof(double));
+    return 0;
+}
+
+/* step: [w, time, before..., after...] */
+static int step_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                       int *which)
+{
+    (void)state, (void)inputs, (void)which;
+    const double *c = ctx;
+    int w = (int)c[0];
+    memcpy(out, t < c[1] ? c + 2 : c + 2 + w, (size_t)w * sizeof(double));
+    return 0;
+}
+
+/* ramp: [w, start, slope..., initial...] */
+static int ramp_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                       int *which)
+{
+    (void)state, (void)inputs, (void)which;
+    const double *c = ctx;
+    int w = (int)c[0];
+    const double *slope = c + 2, *initial = c + 2 + w;
+    double elapsed = t - c[1];
+    if (elapsed <= 0.0) {
+        memcpy(out, initial, (size_t)w * sizeof(double));
+        return 0;
+    }
+    for (int i = 0; i < w; i++)
+        out[i] = initial[i] + slope[i] * elapsed;
+    return 0;
+}
+
+/* -- arithmetic --------------------------------------------------------------------- */
+
+/* gain: [mode, rows, cols, k...]: mode 0 elementwise (k has `rows` entries, or 1 for a
+   scalar applying to width cols), 1 matrix (rows x cols). */
+static int gain_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                       int *which)
+{
+    (void)t, (void)state, (void)which;
+    const double *c = ctx;
+    int mode = (int)c[0], rows = (int)c[1], cols = (int)c[2];
+    const double *k = c + 3, *u = inputs[0];
+    if (mode == 1) {
+        matvec(k, rows, cols, u, out);
+    } else if (rows == 1) {
+        for (int i = 0; i < cols; i++)
+            out[i] = u[i] * k[0];
+    } else {
+        for (int i = 0; i < rows; i++)
+            out[i] = u[i] * k[i];
+    }
+    return 0;
+}
+
+/* sum: [w, count, negate_sum, sign...] (sign +1 / -1 per input): the first '+' input,
+   then the other '+' ones added in order, then the '-' ones subtracted (minus the first
+   '-' to start when there is no '+'); negate_sum: "--", which is -(u0 + u1). */
+static int sum_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                      int *which)
+{
+    (void)t, (void)state, (void)which;
+    const double *c = ctx;
+    int w = (int)c[0], count = (int)c[1];
+    const double *sign = c + 3;
+    if (c[2] != 0.0) {
+        const double *a = inputs[0], *b = inputs[1];
+        for (int i = 0; i < w; i++)
+            out[i] = -(a[i] + b[i]);
+        return 0;
+    }
+    int first = -1;
+    for (int j = 0; j < count; j++)
+        if (sign[j] > 0) {
+            first = j;
+            break;
+        }
+    int skip = first;
+    if (first >= 0) {
+        memcpy(out, inputs[first], (size_t)w * sizeof(double));
+    } else {
+        skip = 0;
+        for (int i = 0; i < w; i++)
+            out[i] = -inputs[0][i];
+    }
+    for (int j = 0; j < count; j++)
+        if (sign[j] > 0 && j != skip)
+            for (int i = 0; i < w; i++)
+                out[i] += inputs[j][i];
+    for (int j = 0; j < count; j++)
+        if (sign[j] < 0 && j != skip)
+            for (int i = 0; i < w; i++)
+                out[i] -= inputs[j][i];
+    return 0;
+}
+
+/* saturation: [w, lower..., upper...]: np.minimum(np.maximum(u, lower), upper), NaN
+   passing through as in numpy. */
+static int saturation_output(const void *ctx, double t, const double *state, const double *const *inputs,
+                             double *out, int *which)
+{
+    (void)t, (void)state, (void)which;
+    const double *c = ctx;
+    int w = (int)c[0];
+    const double *lo = c + 1, *hi = c + 1 + w, *u = inputs[0];
+    for (int i = 0; i < w; i++) {
+        double v = u[i];
+        if (isnan(v)) {
+            out[i] = v;
+            continue;
+        }
+        v = v >= lo[i] ? v : lo[i];
+        out[i] = v <= hi[i] ? v : hi[i];
+    }
+    return 0;
+}
+
+/* -- discrete ----------------------------------------------------------------------- */
+
+/* unit delay and zero-order hold: [w] */
+static int unit_delay_output(const void *ctx, double t, const double *state, const double *const *inputs,
+                             double *out, int *which)
+{
+    (void)t, (void)inputs, (void)which;
+    memcpy(out, state, (size_t)((const double *)ctx)[0] * sizeof(double));
+    return 0;
+}
+
+static int unit_delay_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
+{
+    (void)t, (void)which;
+    memcpy(state, inputs[0], (size_t)((const double *)ctx)[0] * sizeof(double));
+    return 0;
+}
+
+static int unit_delay_advance(const void *ctx, double t, double *state, const double *const *inputs, int n,
+                              double *rows, int *done, int *which)
+{
+    (void)t, (void)which;
+    size_t w = (size_t)((const double *)ctx)[0];
+    if (n > 0) {
+        memcpy(state, inputs[0], w * sizeof(double));
+        for (int i = 0; i < n; i++)
+            memcpy(rows + (size_t)i * w, inputs[0], w * sizeof(double));
+    }
+    *done = n > 0 ? n : 0;
+    return 0;
+}
+
+static int zero_order_hold_output(const void *ctx, double t, const double *state, const double *const *inputs,
+                                  double *out, int *which)
+{
+    (void)t, (void)state, (void)which;
+    memcpy(out, inputs[0], (size_t)((const double *)ctx)[0] * sizeof(double));
+    return 0;
+}
+
+/* -- linear time-invariant ---------------------------------------------------------- */
+
+/* lti context: header, then the matrices at the offsets the header gives.
+   [n, m, p, scalar, ft_path, a, b, c, d, off_CD, off_C, off_D, off_AB, chunk_max,
+    off_Y[1..chunk_max], off_X[1..chunk_max]]
+   scalar (n = m = p = 1): output and update on the four numbers as Python floats do;
+   chunk c's maps, as _LinearBlock._chunk(c): Y (c p x (n + m)) at off_Y[c], X (n x (n + m))
+   at off_X[c] (the Y's all start at one offset: each is the first c p rows of the last).
+   Any sizes: the vectors z = [x; u] of the products live on the stack up to LTI_STACK
+   doubles, in memory from malloc beyond (LTI_NOMEM when there is none). */
+enum { LTI_N, LTI_M, LTI_P, LTI_SCALAR, LTI_FT, LTI_A, LTI_B, LTI_C, LTI_D, LTI_OFF_CD, LTI_OFF_C, LTI_OFF_D,
+       LTI_OFF_AB, LTI_CHUNK, LTI_HEADER };
+
+#define LTI_STACK 256
+
+enum { LTI_NOMEM = 1 }; /* failure code: no memory for the scratch (_kernels.NOMEM) */
+
+/* count doubles of scratch: local (LTI_STACK of them) or malloc's; NULL when out of memory. */
+static double *lti_scratch(double *local, size_t count)
+{
+    return count <= LTI_STACK ? local : malloc(count * sizeof(double));
+}
+
+static void lti_release(double *scratch, const double *local)
+{
+    if (scratch != local)
+        free(scratch);
+}
+
+/* z = [x; u] */
+static void lti_stack(double *z, const double *x, int n, const double *u, int m)
+{
+    memcpy(z, x, (size_t)n * sizeof(double));
+    memcpy(z + n, u, (size_t)m * sizeof(double));
+}
+
+static int lti_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                      int *which)
+{
+    (void)t, (void)which;
+    const double *c = ctx;
+    int n = (int)c[LTI_N], m = (int)c[LTI_M], p = (int)c[LTI_P];
+    const double *u = inputs[0];
+    if (c[LTI_SCALAR] != 0.0) {
+        out[0] = c[LTI_FT] != 0.0 ? c[LTI_C] * state[0] + c[LTI_D] * u[0] : c[LTI_C] * state[0];
+        return 0;
+    }
+    if (c[LTI_FT] == 0.0) {
+        matvec(c + (size_t)c[LTI_OFF_C], p, n, state, out);
+        return 0;
+    }
+    if (n == 0) {
+        matvec(c + (size_t)c[LTI_OFF_D], p, m, u, out);
+        return 0;
+    }
+    double local[LTI_STACK], *z = lti_scratch(local, (size_t)n + m);
+    if (z == NULL)
+        return LTI_NOMEM;
+    lti_stack(z, state, n, u, m);
+    matvec(c + (size_t)c[LTI_OFF_CD], p, n + m, z, out);
+    lti_release(z, local);
+    return 0;
+}
+
+static int lti_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
+{
+    (void)t, (void)which;
+    const double *c = ctx;
+    int n = (int)c[LTI_N], m = (int)c[LTI_M];
+    const double *u = inputs[0];
+    if (c[LTI_SCALAR] != 0.0) {
+        state[0] = c[LTI_A] * state[0] + c[LTI_B] * u[0];
+        return 0;
+    }
+    double local[LTI_STACK], *z = lti_scratch(local, (size_t)n + m);
+    if (z == NULL)
+        return LTI_NOMEM;
+    lti_stack(z, state, n, u, m);
+    matvec(c + (size_t)c[LTI_OFF_AB], n, n + m, z, state);
+    lti_release(z, local);
+    return 0;
+}
+
+/* The closed form of _LinearBlock.advance: per chunk of at most chunk_max steps, the rows
+   Y z and the new state X z. For the scalar model these products are the two-term sums
+   its Python advance writes out, (first * x) + (second * u), so they match to the bit. */
+static int lti_advance(const void *ctx, double t, double *state, const double *const *inputs, int count,
+                       double *rows, int *done, int *which)
+{
+    (void)t, (void)which;
+    const double *c = ctx;
+    int n = (int)c[LTI_N], m = (int)c[LTI_M], p = (int)c[LTI_P], chunk = (int)c[LTI_CHUNK];
+    const double *u = inputs[0];
+    const double *off_y = c + LTI_HEADER - 1, *off_x = c + LTI_HEADER + chunk - 1; /* indexed by c = 1..chunk */
+    *done = 0;
+    if (count <= 0)
+        return 0;
+    if (n == 0) { /* a stateless gain: D u on every row */
+        matvec(c + (size_t)c[LTI_OFF_D], p, m, u, rows);
+        for (int i = 1; i < count; i++)
+            memcpy(rows + (size_t)i * p, rows, (size_t)p * sizeof(double));
+        *done = count;
+        return 0;
+    }
+    int L = n + m;
+    double local[LTI_STACK], *z = lti_scratch(local, 2 * (size_t)L);
+    if (z == NULL)
+        return LTI_NOMEM;
+    double *x = z + L;
+    lti_stack(z, state, n, u, m);
+    for (int k = 0; k < count;) {
+        int step = count - k < chunk ? count - k : chunk;
+        matvec(c + (size_t)off_y[step], step * p, L, z, rows + (size_t)k * p);
+        matvec(c + (size_t)off_x[step], n, L, z, x);
+        memcpy(z, x, (size_t)n * sizeof(double));
+        k += step;
+    }
+    memcpy(state, z, (size_t)n * sizeof(double));
+    lti_release(z, local);
+    *done = count;
+    return 0;
+}
+
+#define ENTRY(f) {#f, (void (*)(void))f}
+
 const blk_library_entry blk_library[] = {
+    ENTRY(constant_output),
+    ENTRY(step_output),
+    ENTRY(ramp_output),
+    ENTRY(gain_output),
+    ENTRY(sum_output),
+    ENTRY(saturation_output),
+    ENTRY(unit_delay_output),
+    ENTRY(unit_delay_update),
+    ENTRY(unit_delay_advance),
+    ENTRY(zero_order_hold_output),
+    ENTRY(lti_output),
+    ENTRY(lti_update),
+    ENTRY(lti_advance),
     {NULL, NULL},
 };

@@ -9,6 +9,7 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, Signal
+from blocks.library import _kernels
 
 
 class UnitDelay(Block):
@@ -60,6 +61,13 @@ class UnitDelay(Block):
             return state, {"y": np.empty((0, state.size))}
         return u.copy(), {"y": np.tile(u, (n, 1))}
 
+    def kernel(self):
+        width = self.outputs["y"]
+        if width is None:
+            return None
+        return _kernels.cached(self, (width,), lambda: _kernels.make_kernel(
+            np.array([width], dtype=float), "unit_delay_output", "unit_delay_update", "unit_delay_advance"))
+
 
 class ZeroOrderHold(Block):
     """Samples its input at its own period and holds it in between (y = u at each hit)."""
@@ -71,3 +79,10 @@ class ZeroOrderHold(Block):
 
     def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         return {"y": inputs["u"].copy()}
+
+    def kernel(self):
+        width = self.outputs["y"]
+        if width is None:
+            return None
+        return _kernels.cached(self, (width,), lambda: _kernels.make_kernel(
+            np.array([width], dtype=float), "zero_order_hold_output"))

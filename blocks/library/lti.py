@@ -18,6 +18,7 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, BlockError, Signal
+from blocks.library import _kernels
 
 METHODS = ("zoh", "tustin")
 """Discretisation methods accepted by ``method`` (python-control names)."""
@@ -136,6 +137,7 @@ class _LinearBlock(Block):
         self._ft_path = True
         self._x0 = x0
         self._chunks: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+        self._scalar_chunks: dict[int, tuple[np.ndarray, np.ndarray, float, float]] = {}
         # Until the period is known, assume the feedthrough a discretised model can have:
         # zoh keeps D; tustin adds a multiple of C (I - A T/2)^-1 B, which is zero for
         # every T only when all Markov parameters C A^k B are.
@@ -162,6 +164,7 @@ class _LinearBlock(Block):
             self._a, self._b = float(A[0, 0]), float(B[0, 0])
             self._c, self._d = float(C[0, 0]), float(D[0, 0])
         self._chunks = {}
+        self._scalar_chunks = {}
 
     def bind(self, period: Fraction | None) -> None:
         """Discretise a continuous model (``method`` given) at ``period``."""
@@ -222,6 +225,22 @@ class _LinearBlock(Block):
             self._chunks[c] = maps
         return maps
 
+    def _all_chunks(self) -> tuple[np.ndarray, list[np.ndarray]]:
+        """``_chunk(CHUNK)``'s output map and every ``_chunk(c)``'s state map, c = 1..CHUNK,
+        by the very operations ``_chunk`` does (its products for c are the first c of
+        those for CHUNK), in CHUNK steps instead of CHUNK (CHUNK + 1) / 2."""
+        n, m = self._n, self._m
+        step = np.zeros((n + m, n + m))
+        step[:n] = self._AB
+        step[n:, n:] = np.eye(m)
+        power = np.eye(n + m)
+        rows, xmaps = [], []
+        for _ in range(CHUNK):
+            power = step @ power
+            rows.append(self._CD @ power)
+            xmaps.append(np.ascontiguousarray(power[:n]))
+        return np.ascontiguousarray(np.vstack(rows)), xmaps
+
     def advance(self, t: float, state: Any, inputs: Mapping[str, Signal], n: int):
         """Closed form for a held input: x_{k+i} = A^i x + (sum_{j<i} A^j) B u, in chunks."""
         u = inputs["u"]
@@ -230,11 +249,10 @@ class _LinearBlock(Block):
             return None, {"y": np.tile(self.D.dot(u), (max(n, 0), 1))}
         if n <= 0:
             return state, {"y": np.empty((0, p))}
-        nx = self._n
         if self._scalar:
-            z = np.array((state.item(), u.item()))
-        else:
-            z = np.concatenate((state, u))
+            return self._advance_scalar(state.item(), u.item(), n)
+        nx = self._n
+        z = np.concatenate((state, u))
         if n <= CHUNK:
             ymap, xmap = self._chunk(n)
             return xmap.dot(z), {"y": ymap.dot(z).reshape(n, p)}
@@ -248,6 +266,74 @@ class _LinearBlock(Block):
             z[:nx] = x
             done += c
         return x, {"y": out}
+
+    def _advance_scalar(self, x: float, u: float, n: int):
+        """``advance`` of the 1x1x1 model: each chunk's products written out as two-term
+        sums (first * x) + (second * u), elementwise, which the C kernel's products equal
+        to the bit (``ndarray.dot`` would leave the order and fusing to BLAS)."""
+        if n <= CHUNK:
+            yx, yu, xx, xu = self._scalar_chunk(n)
+            return np.array((xx * x + xu * u,)), {"y": yx * x + yu * u}
+        out = np.empty((n, 1))
+        done = 0
+        while done < n:
+            c = min(n - done, CHUNK)
+            yx, yu, xx, xu = self._scalar_chunk(c)
+            out[done:done + c] = yx * x + yu * u
+            x = xx * x + xu * u
+            done += c
+        return np.array((x,)), {"y": out}
+
+    def _scalar_chunk(self, c: int) -> tuple[np.ndarray, np.ndarray, float, float]:
+        """``_chunk(c)`` of the 1x1x1 model split by column: the output map's x and u
+        columns (contiguous, c x 1) and the state map's two numbers."""
+        parts = self._scalar_chunks.get(c)
+        if parts is None:
+            ymap, xmap = self._chunk(c)
+            parts = (ymap[:, :1].copy(), ymap[:, 1:].copy(), float(xmap[0, 0]), float(xmap[0, 1]))
+            self._scalar_chunks[c] = parts
+        return parts
+
+    def kernel(self):
+        """C output, update and advance (blocks/csrc/library.c, ``lti_*``), reading the
+        matrices in use and every ``_chunk`` map; None for a continuous model not yet
+        bound. The 1x1x1 model and a stateless 1x1 gain match the Python methods to the
+        bit (their products are the same float operations); larger ones compute the
+        same products to round-off (library.c's ``matvec``, see ``blocks.library._kernels``)."""
+        if self.A is None:
+            return None
+        return _kernels.cached(self, (id(self._AB), self.period), self._build_kernel)
+
+    def _build_kernel(self):
+        n, m, p = self._n, self._m, self._p
+        header = np.zeros(14 + 2 * CHUNK)
+        scalar = self._scalar
+        header[:9] = (n, m, p, scalar, self._ft_path,
+                      self._a if scalar else 0.0, self._b if scalar else 0.0,
+                      self._c if scalar else 0.0, self._d if scalar else 0.0)
+        header[13] = CHUNK
+        parts = [header]
+        size = header.size
+
+        def place(matrix: np.ndarray) -> int:
+            nonlocal size
+            offset = size
+            parts.append(np.ascontiguousarray(matrix, dtype=float).ravel())
+            size += parts[-1].size
+            return offset
+
+        header[12] = place(self._AB)
+        header[11] = place(self.D)
+        if n:
+            header[9] = place(self._CD)
+            header[10] = place(self._C)
+            # chunk c's output map is the first c * p rows of chunk CHUNK's
+            ymap, xmaps = self._all_chunks()
+            header[14:14 + CHUNK] = place(ymap)
+            for c in range(1, CHUNK + 1):
+                header[13 + CHUNK + c] = place(xmaps[c - 1])
+        return _kernels.make_kernel(np.concatenate(parts), "lti_output", "lti_update", "lti_advance",
+                                    self._AB)
 
 
 class DiscreteStateSpace(_LinearBlock):

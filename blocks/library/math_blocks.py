@@ -9,6 +9,7 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, Signal
+from blocks.library import _kernels
 
 # Python-float scalars cost an extra conversion inside every ufunc call; 0-d arrays
 # multiply and compare against a small vector about a third faster, so scalar
@@ -42,6 +43,22 @@ class Gain(Block):
         if self._matrix:
             return {"y": self.k.dot(inputs["u"])}
         return {"y": inputs["u"] * self.k}
+
+    def kernel(self):
+        """C output: elementwise (the same bits), or the matrix product (library.c's
+        ``matvec``: ``ndarray.dot`` to round-off where a row has several terms)."""
+        width = self.inputs["u"]
+        return _kernels.cached(self, (width, self.k.shape), lambda: self._build_kernel(width))
+
+    def _build_kernel(self, width):
+        if width is None:
+            return None
+        if self._matrix:
+            rows, cols = self.k.shape
+            header = (1.0, rows, cols)
+        else:
+            header = (0.0, self.k.size, width)
+        return _kernels.make_kernel(np.concatenate((header, self.k.ravel())), "gain_output")
 
 
 def _sum_p(i: Mapping[str, Signal]) -> Signal:
@@ -142,6 +159,14 @@ class Sum(Block):
     def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         return {"y": self._kernel(inputs)}
 
+    def kernel(self):
+        width = self.outputs["y"]
+        if width is None:
+            return None
+        signs = [1.0 if s == "+" else -1.0 for s in self.signs]
+        return _kernels.cached(self, (width, self.signs), lambda: _kernels.make_kernel(
+            np.concatenate(((width, len(signs), float(self.signs == "--")), signs)), "sum_output"))
+
 
 class Saturation(Block):
     """Clips the input to ``[lower, upper]`` elementwise.
@@ -177,3 +202,15 @@ class Saturation(Block):
 
     def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         return {"y": np.minimum(np.maximum(inputs["u"], self.lower), self.upper)}
+
+    def kernel(self):
+        width = self.outputs["y"]
+        if width is None:
+            return None
+
+        def build():
+            lo = np.broadcast_to(self.lower, (width,))
+            hi = np.broadcast_to(self.upper, (width,))
+            return _kernels.make_kernel(np.concatenate(((width,), lo, hi)), "saturation_output")
+
+        return _kernels.cached(self, (width,), build)

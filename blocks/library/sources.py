@@ -8,6 +8,7 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, Signal
+from blocks.library import _kernels
 
 
 def broadcast_vectors(**params: Any) -> dict[str, Signal]:
@@ -42,6 +43,10 @@ class Constant(Block):
     def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         return {"y": self.value.copy()}
 
+    def kernel(self):
+        return _kernels.cached(self, (self.value.size,), lambda: _kernels.make_kernel(
+            np.concatenate(((self.value.size,), self.value)), "constant_output"))
+
 
 class Step(Block):
     """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time).
@@ -67,6 +72,11 @@ class Step(Block):
 
     def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         return {"y": (self.before if t < self.time else self.after).copy()}
+
+    def kernel(self):
+        w = self.before.size
+        return _kernels.cached(self, (w, self.time), lambda: _kernels.make_kernel(
+            np.concatenate(((w, self.time), self.before, self.after)), "step_output"))
 
 
 class Ramp(Block):
@@ -96,3 +106,8 @@ class Ramp(Block):
         if elapsed <= 0.0:
             return {"y": self.initial.copy()}
         return {"y": self.initial + self.slope * elapsed}
+
+    def kernel(self):
+        w = self.slope.size
+        return _kernels.cached(self, (w, self.start), lambda: _kernels.make_kernel(
+            np.concatenate(((w, self.start), self.slope, self.initial)), "ramp_output"))

@@ -1,0 +1,69 @@
+"""The library blocks' compiled kernels (blocks/csrc/library.c): addresses and contexts.
+
+Each library block's ``kernel()`` packs its parameters into one flat float64 array, the
+context its C functions read (sizes first, as doubles), and returns a ``Kernel`` with
+the addresses from ``blocks._native.library()``. A kernel computes the quantity its
+block's Python method computes: elementwise arithmetic, in the same order, to the last
+bit; matrix-vector products by library.c's own definition (each row summed in column
+order from its first product, no fused multiply-add), which equals numpy's
+``ndarray.dot`` for single-term rows and to round-off otherwise. Kernels exist for any
+size: the context holds the matrices.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+import numpy as np
+
+from blocks.block import BlockError
+from blocks.kernel import Kernel
+
+NOMEM = 1
+"""library.c's failure code when a kernel gets no memory for its scratch vectors."""
+
+
+@functools.cache
+def functions() -> dict[str, int]:
+    """{name: address} of the library kernels; empty when blocks._native is missing."""
+    try:
+        import blocks._native as _native
+    except ImportError:
+        return {}
+    return dict(_native.library())
+
+
+def make_kernel(context: np.ndarray, output: str | None = None, update: str | None = None,
+                advance: str | None = None, *owners: Any) -> Kernel | None:
+    """A Kernel of the named library functions reading ``context``; None without them."""
+    table = functions()
+    names = [name for name in (output, update, advance) if name is not None]
+    if not names or any(name not in table for name in names):
+        return None
+    context = np.ascontiguousarray(context, dtype=np.float64)
+    return Kernel(
+        context=context.__array_interface__["data"][0],
+        output=table[output] if output else 0,
+        update=table[update] if update else 0,
+        advance=table[advance] if advance else 0,
+        owners=(context, *owners),
+        error=error,
+    )
+
+
+def error(code: int, which: int, t: float, phase: str) -> BaseException:
+    """The exception of a library kernel's failure code (``Kernel.error``)."""
+    if code == NOMEM:
+        return MemoryError(f"compiled {phase} at t={t:.10g} s: no memory for its scratch vectors")
+    return BlockError(f"compiled {phase} failed at t={t:.10g} s with code {code} (detail {which})")
+
+
+def cached(block: Any, key: tuple, build) -> Kernel | None:
+    """``build()``'s Kernel, kept on the block while ``key`` (period, widths, model) holds."""
+    held = getattr(block, "_kernel_cache", None)
+    if held is not None and held[0] == key:
+        return held[1]
+    kernel = build()
+    block._kernel_cache = (key, kernel)
+    return kernel
