@@ -32,6 +32,11 @@ EXACT_TICKS = 2**53
 """Tick times are exact in C while ``tick * numerator`` stays below this."""
 
 
+def failure(code: int, which: int, t: float, phase: str) -> BaseException:
+    """The exception of a failure code whose block names no ``Kernel.error``."""
+    return BlockError(f"compiled {phase} failed at t={t:.10g} s with code {code} (detail {which})")
+
+
 class CompiledBlock:
     """One block run through its kernel: its output buffer, input pointers and state."""
 
@@ -176,9 +181,7 @@ class CompiledSide:
         """The exception of a kernel's failure, from its block's error factory."""
         cb = self.blocks[name]
         t = tick * self.s.base_tick.numerator / self.s.base_tick.denominator
-        if cb.kernel.error is not None:
-            return cb.kernel.error(code, which, t, phase)
-        return BlockError(f"compiled {phase} failed at t={t:.10g} s with code {code} (detail {which})")
+        return (cb.kernel.error or failure)(code, which, t, phase)
 
 
 class Runner:

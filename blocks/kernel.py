@@ -41,7 +41,8 @@ class Kernel:
     C-contiguous float64 array (or None for a stateless block), which the kernel updates
     in place. The functions compute what the Python methods compute (to round-off; a run
     uses one or the other for all of a block's hits). ``error``
-    makes the exception for a failure code (None: a generic message with the code).
+    makes the exception for a failure code (None: ``blocks.compiled.failure``, a message
+    with the code).
     """
 
     context: int

@@ -283,11 +283,12 @@ class _Run:
         """The block whose input mapping a fan-out target is (held outputs are no block's)."""
         self.compiled = CompiledSide(diagram, schedule, self.states, self.index, self.inputs, self.loggers,
                                      ADVANCE_CHUNK)
-        self.kernel_sources = {n: [(c.dst_port, self.compiled.blocks[c.src_block].views[c.src_port])
-                                   for c in diagram.connections
-                                   if c.dst_block == n and not c.delay and c.src_block in self.compiled.blocks]
-                               for n in self.names if n not in self.compiled.blocks}
-        """Per Python block, its inputs fed by compiled blocks: (port, the source's buffer view)."""
+        self.python_readers: dict[str, list[tuple[dict, str, np.ndarray]]] = {n: [] for n in self.compiled.blocks}
+        """Per compiled block, the inputs of Python blocks it feeds: (mapping, port, its buffer's view)."""
+        for c in diagram.connections:
+            if c.src_block in self.compiled.blocks and c.dst_block not in self.compiled.blocks and not c.delay:
+                self.python_readers[c.src_block].append(
+                    (self.inputs[c.dst_block], c.dst_port, self.compiled.blocks[c.src_block].views[c.src_port]))
         self.checked: set[str] = set()
         self.reached: int | None = None
         """The tick an interrupted advance span had logged, when the interrupt came in one."""
@@ -351,12 +352,17 @@ class _Run:
     def runner_step(self, code: _ProgramCode, runner: Runner, has_last_advance: bool) -> None:
         """One C call running a stretch of compiled steps; a failure raises its step's
         ``_StepFailure``. With the event's last advance in it, an interrupt records how far
-        it got."""
+        it got. Then the Python blocks that read the outputs computed there get copies of
+        them (a copy: the buffers change in place, and a block may keep what it is given)."""
         v = code.bind
         handlers = ("except KeyboardInterrupt:", f"    {v(self.interrupted_in_runner)}({v(runner)}, k)",
                     "    raise") if has_last_advance else ()
         code.step(f"r = {v(runner.run)}(k, next_k)", handlers=handlers)
         code.step("if r is not None:", f"    raise {v(self.kernel_failure)}({v(runner)}, r)")
+        computed = dict.fromkeys(b for b, phase in runner.steps if phase in ("output", "advance"))
+        copies = [f"{v(d)}[{v(dp)}] = {v(view)}.copy()" for b in computed for d, dp, view in self.python_readers[b]]
+        if copies:
+            code.step(*copies)
 
     def kernel_failure(self, runner: Runner, result) -> _StepFailure:
         name, phase, tick, error = runner.failure(result)
@@ -367,12 +373,6 @@ class _Run:
         reached = runner.native.reached
         if reached >= k:
             self.reached = reached
-
-    def reader_lines(self, code: _ProgramCode, name: str) -> list[str]:
-        """Lines giving a Python block copies of the compiled blocks' outputs it reads."""
-        v = code.bind
-        inputs = v(self.inputs[name])
-        return [f"{inputs}[{v(port)}] = {v(view)}.copy()" for port, view in self.kernel_sources[name]]
 
     def target_line(self, code: _ProgramCode, d: dict, dp: str, value: str) -> str:
         """Pass ``value`` to input ``dp`` of the mapping ``d``: by reference to a Python
@@ -393,8 +393,7 @@ class _Run:
         v = code.bind
         block = v(name)
         value: dict[str, str] = {}
-        lines = [*self.reader_lines(code, name),
-                 f"out = {v(blk.output)}(t, {v(self.states)}[{v(self.index[name])}], {v(self.inputs[name])})",
+        lines = [f"out = {v(blk.output)}(t, {v(self.states)}[{v(self.index[name])}], {v(self.inputs[name])})",
                  f"if {block} not in {v(self.checked)}:",
                  f"    {v(self.check_outputs)}({block}, out, {v(publish)})"]
         for port in [sp for _, _, sp in targets] + [p for _, p in loggers]:
@@ -418,7 +417,7 @@ class _Run:
         v = code.bind
         state = f"{v(self.states)}[{v(self.index[name])}]"
         update = f"{v(self.d.blocks[name].block.update)}(t, {state}, {v(self.inputs[name])})"
-        code.step(f"{state} = {update}", setup=tuple(self.reader_lines(code, name)),
+        code.step(f"{state} = {update}",
                   handlers=(f"except {v(EndRun)} as end:",
                             "    if end.has_state:",
                             f"        {state} = end.state",
@@ -477,7 +476,7 @@ class _Run:
         for p, dests in by_port.items():
             lines.append(f"value = rows[{v(p)}][-1]")
             lines += [self.target_line(code, d, dp, "value") for d, dp in dests]
-        code.step(*lines, setup=(*self.reader_lines(code, name), f"n = (next_k - k) // {period}", "done = 0"),
+        code.step(*lines, setup=(f"n = (next_k - k) // {period}", "done = 0"),
                   handlers=(
             "except KeyboardInterrupt:",
             *([f"    {v(self.interrupted_in_span)}({v(name)}, k + done * {period})"] if last else []),

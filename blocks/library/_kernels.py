@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from blocks.block import BlockError
-from blocks.kernel import Kernel
+from blocks.compiled import failure
+from blocks.kernel import Kernel, address
 
 NOMEM = 1
 """library.c's failure code when a kernel gets no memory for its scratch vectors."""
@@ -43,7 +43,7 @@ def make_kernel(context: np.ndarray, output: str | None = None, update: str | No
         return None
     context = np.ascontiguousarray(context, dtype=np.float64)
     return Kernel(
-        context=context.__array_interface__["data"][0],
+        context=address(context),
         output=table[output] if output else 0,
         update=table[update] if update else 0,
         advance=table[advance] if advance else 0,
@@ -56,7 +56,7 @@ def error(code: int, which: int, t: float, phase: str) -> BaseException:
     """The exception of a library kernel's failure code (``Kernel.error``)."""
     if code == NOMEM:
         return MemoryError(f"compiled {phase} at t={t:.10g} s: no memory for its scratch vectors")
-    return BlockError(f"compiled {phase} failed at t={t:.10g} s with code {code} (detail {which})")
+    return failure(code, which, t, phase)
 
 
 def cached(block: Any, key: tuple, build) -> Kernel | None:

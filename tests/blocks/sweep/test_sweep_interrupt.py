@@ -15,14 +15,23 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[3]
-TOY = str(ROOT / "diagrams" / "toy.yaml")
+TOY = ROOT / "diagrams" / "toy.yaml"
 GRID = "prop.k=1,2,3,4,5,6,7,8"
 
 
+def _diagram(folder: Path) -> Path:
+    """The toy diagram over 2000 s, logging every 1000th sample: about 0.2 s of work per
+    point here, long enough to interrupt mid-sweep, in a few MB of logs."""
+    text = TOY.read_text().replace("log: [plant.y]", "log: [{signal: plant.y, decimate: 1000}]")
+    assert "decimate: 1000" in text
+    path = folder / "toy_long.yaml"
+    path.write_text(text)
+    return path
+
+
 def _command(out: Path, mode: list[str]) -> list[str]:
-    # 20 s of the toy diagram is about 0.2 s of work per point: long enough to interrupt mid-sweep.
-    return [sys.executable, "-m", "hierhand", "sweep", TOY, "-o", str(out), "--t-end", "20 s",
-            "--metric", "y=final(plant.y)", "--grid", GRID, "-q", *mode]
+    return [sys.executable, "-m", "hierhand", "sweep", str(_diagram(out.parent)), "-o", str(out),
+            "--t-end", "2000 s", "--metric", "y=final(plant.y)", "--grid", GRID, "-q", *mode]
 
 
 def _rows(out: Path) -> list[dict]:
