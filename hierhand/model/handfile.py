@@ -17,7 +17,6 @@ diagram loader does the same for a plant's params file through ``ParameterError`
 
 from __future__ import annotations
 
-import copy
 import functools
 import math
 import re
@@ -148,12 +147,18 @@ class HandParams:
                 link["com"] = [link.pop("com_along"), link.pop("com_across")]
         return _lists(d)
 
-    @functools.cached_property
+    @property
     def vector(self) -> np.ndarray:
-        """The hand's numbers in the C core's order (read-only; computed once)."""
-        vector = hand_vector(self.to_dict())
-        vector.flags.writeable = False
-        return vector
+        """The hand's numbers in the C core's order (read-only; computed once per hand,
+        shared by equal hands: every point of a sweep loads the same one)."""
+        return _hand_vector(self)
+
+
+@functools.lru_cache(maxsize=64)
+def _hand_vector(params: HandParams) -> np.ndarray:
+    vector = hand_vector(params.to_dict())
+    vector.flags.writeable = False
+    return vector
 
 
 def _lists(x: Any) -> Any:
@@ -176,7 +181,16 @@ def _default_hand() -> dict[str, Any]:
 
 def default_hand_dict() -> dict[str, Any]:
     """The shipped default hand file as a plain dict (a fresh copy; the file is read once)."""
-    return copy.deepcopy(_default_hand())
+    return _fresh(_default_hand())
+
+
+def _fresh(x: Any) -> Any:
+    """A copy of YAML data (mappings, lists, scalars), several times faster than deepcopy."""
+    if isinstance(x, dict):
+        return {k: _fresh(v) for k, v in x.items()}
+    if isinstance(x, list):
+        return [_fresh(v) for v in x]
+    return x
 
 
 def read_hand_file(path: str | Path) -> dict[str, Any]:
