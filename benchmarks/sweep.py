@@ -12,10 +12,10 @@ As a reference it also runs the same points on a bare process pool forked from t
 process (multiprocessing, no Dask, no CSV): the most that the worker processes get out of
 this machine for this work, so the gap to it is what Dask costs.
 
-At the diagram's own end time (1 s) a run costs about 18 ms, so the 256 points are about
-5 s of work and the cluster's fixed cost (importing distributed, starting and stopping
-the workers: about 0.25 s) is what stands between the sweep and 2x. ``--t-end 10
---points 16`` measures the longer runs for which a cluster is clearly worth it.
+At the diagram's own end time (1 s) a run costs about 9 ms, so the 256 points are about
+2.4 s of work and the cluster's fixed cost (importing distributed, starting and stopping
+the workers: about 0.24 s) is what stands between the sweep and 2x. ``--t-end 10``
+measures longer runs, for which the fixed cost weighs less.
 
     python benchmarks/sweep.py [--t-end 1] [--points 256] [--workers N] [--repeat 3]
 """
