@@ -65,14 +65,24 @@ class CompiledSide:
         self.blocks: dict[str, CompiledBlock] = {}
         self.owners: list[Any] = []
         self.logged: list = []
+        self.failure: tuple[str, BaseException] | None = None
+        """A block whose ``kernel()`` raised, and what: the run reports it as that block's failure."""
         if NativeRunner is None or not self.exact_ticks():
             return
         updated = {b for p in (*schedule.programs, schedule.initial) for b in p.update}
         for name, spec in diagram.blocks.items():
             block = spec.block
-            kernel = block.kernel()
+            try:
+                kernel = block.kernel()
+            except Exception as exc:
+                self.failure = (name, exc)
+                self.blocks.clear()
+                return
             if not isinstance(kernel, Kernel) or not kernel.output:
                 continue
+            if any(not (isinstance(v := inputs[name][p], np.ndarray) and v.shape == (w,) and v.dtype == np.float64)
+                   for p, w in block.inputs.items()):
+                continue  # an input default of another width: the Python methods meet it as they would
             state = states[index[name]]
             if state is not None:
                 if not (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.ndim == 1

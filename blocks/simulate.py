@@ -581,6 +581,9 @@ class _Run:
         k = 0
         initial = self.compile(self.s.initial).function
         try:
+            if self.compiled.failure is not None:
+                name, exc = self.compiled.failure
+                raise _StepFailure(name, "kernel", 0, exc)
             labels = self.element_labels()
             spans = self.spans()
             initial(0, min(spans[0][0], n) if spans else n)

@@ -333,3 +333,28 @@ log: [tick.y]
     assert r.interrupted and r.status == f"interrupted at t={reached * 1e-3:.9g} s", r.status
     t, y = r["tick.y"]
     assert len(t) == reached + 1 and y[-1, 0] == reached and t[-1] == pytest.approx(reached * 1e-3)
+
+
+def test_a_kernel_that_cannot_be_made_fails_the_run_naming_its_block(monkeypatch):
+    def broken(self):
+        raise RuntimeError("no such function in the library")
+
+    monkeypatch.setattr(Scale, "kernel", broken)
+    r = run_mixed(True, "10 ms")
+    assert r.status == ("failed at t=0 s: block 'lift' (TestScale) kernel: no such function in the library"), \
+        r.status
+
+
+def test_an_input_default_of_another_width_keeps_its_block_in_python(monkeypatch):
+    """A kernel reads as many values as the port is wide, so it never sees a default of
+    another width: the block runs in Python, which meets it as it always has."""
+    monkeypatch.setattr(Scale, "input_defaults", {"u": np.ones(1)})
+    text = """
+time: {t_end: 3 ms}
+blocks:
+  g: {type: TestScale, period: 1 ms, params: {k: 2.0}}
+log: [g.y]
+"""
+    r = simulate(loads_diagram(text, filename="default.yaml"))
+    assert CALLS.get("Scale.output", 0) >= 1  # through Python
+    assert np.array_equal(r["g.y"][1], np.full((4, 2), 2.0))
