@@ -267,7 +267,7 @@ class _Loader:
                        "run 'hierhand blocks' to list the registered types")
             return None
         try:
-            cls = resolve_type(type_name, self.trust)
+            cls = resolve_type(type_name, self.trust, self.base_dir)
         except RegistryError as exc:
             self.error(spec.line_of("type"), f"block '{name}': {exc}", exc.hint)
             return None

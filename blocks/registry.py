@@ -2,12 +2,18 @@
 
 A diagram can only name registered types. ``python:module:Class`` names arbitrary
 code and is refused unless the caller passes ``trust=True`` (``--trust`` on the CLI),
-because loading a diagram must never run code the user did not choose to run.
+because loading a diagram must never run code the user did not choose to run. Its module
+is looked up in the diagram's folder first (``module.py`` or a package ``module/``), then
+on the Python path.
 """
 
 from __future__ import annotations
 
+import hashlib
 import importlib
+import importlib.util
+import sys
+from pathlib import Path
 
 from .block import Block
 from .plugins import load_group
@@ -46,15 +52,16 @@ def _not_a_block(obj) -> str | None:
     return None if isinstance(obj, type) and issubclass(obj, Block) else "is not a Block subclass"
 
 
-def resolve_type(name: str, trust: bool = False) -> type[Block]:
-    """The Block class for a diagram's ``type:`` text."""
+def resolve_type(name: str, trust: bool = False, base_dir: str | Path | None = None) -> type[Block]:
+    """The Block class for a diagram's ``type:`` text; ``base_dir``, the diagram's folder,
+    is where a ``python:`` type's module is looked for first."""
     if name.startswith(PYTHON_PREFIX):
         if not trust:
             raise RegistryError(
                 f"type '{name}' imports Python code from the diagram",
                 "pass --trust (Python: trust=True) if you trust this file, or register the "
                 f"block through the '{ENTRY_POINT_GROUP}' entry point")
-        return _import_class(name[len(PYTHON_PREFIX):])
+        return _import_class(name[len(PYTHON_PREFIX):], base_dir)
     types = block_types()
     if name in types:
         return types[name]
@@ -69,14 +76,73 @@ def resolve_type(name: str, trust: bool = False) -> type[Block]:
     raise RegistryError(f"unknown block type '{name}'", hint)
 
 
-def _import_class(target: str) -> type[Block]:
+def _import_class(target: str, base_dir: str | Path | None = None) -> type[Block]:
     module_name, _, attr = target.partition(":")
     if not module_name or not attr:
         raise RegistryError(f"'{PYTHON_PREFIX}{target}' is not of the form python:module:Class")
     try:
-        obj = getattr(importlib.import_module(module_name), attr)
+        module = _local_module(module_name, Path(base_dir)) if base_dir is not None else None
+        if module is None:
+            module = _path_module(module_name, base_dir)
+        obj = getattr(module, attr)
+    except RegistryError:
+        raise
     except Exception as exc:
-        raise RegistryError(f"cannot import '{target}': {exc}") from None
+        raise RegistryError(f"cannot import '{target}': {type(exc).__name__}: {exc}") from None
     if not (isinstance(obj, type) and issubclass(obj, Block)):
         raise RegistryError(f"'{target}' is not a Block subclass")
     return obj
+
+
+def _local_module(module_name: str, base_dir: Path):
+    """The module ``module_name`` from the diagram's folder, or None if it has no such file.
+
+    The file is imported from its path under a name of its own (made from the file's path,
+    size and modification time), never by putting the folder on ``sys.path``: two
+    diagrams in different folders may each have a ``blocks_mine.py``, and neither may
+    shadow the other or an installed module. A package folder imports its submodules
+    relatively (``from . import helpers``).
+    """
+    top, _, rest = module_name.partition(".")
+    folder = base_dir.resolve()
+    package = folder / top / "__init__.py"
+    single = folder / f"{top}.py"
+    if package.is_file():
+        origin, search = package, [str(package.parent)]
+    elif single.is_file() and not rest:
+        origin, search = single, None
+    else:
+        return None
+    stat = origin.stat()
+    key = hashlib.sha256(f"{origin}\0{stat.st_size}\0{stat.st_mtime_ns}".encode()).hexdigest()[:16]
+    alias = f"_blocks_diagram_{key}_{top}"
+    module = sys.modules.get(alias)
+    if module is None:
+        spec = importlib.util.spec_from_file_location(alias, origin, submodule_search_locations=search)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[alias] = module  # as a normal import does: dataclasses, pickle look it up
+        try:
+            spec.loader.exec_module(module)
+        except BaseException:
+            del sys.modules[alias]
+            raise
+    return importlib.import_module(f"{alias}.{rest}") if rest else module
+
+
+def _path_module(module_name: str, base_dir: str | Path | None):
+    """The module ``module_name`` from ``sys.path``; not found there: a RegistryError
+    naming the places searched."""
+    try:
+        return importlib.import_module(module_name)
+    except ModuleNotFoundError as exc:
+        top = module_name.partition(".")[0]
+        if exc.name not in (module_name, top):
+            raise  # the module exists but imports something missing: that is the message
+    where = ""
+    if base_dir is not None:
+        where = (f"no {top}.py or {top}/__init__.py in the diagram's folder "
+                 f"{Path(base_dir).resolve()}, and ")
+    raise RegistryError(
+        f"cannot import 'python:{module_name}': {where}no module '{module_name}' on the Python "
+        f"path (sys.path: {', '.join(p or '.' for p in sys.path)})",
+        f"put {top}.py beside the diagram, or install the package that provides it")
