@@ -1,18 +1,150 @@
-"""The wiring of a diagram as DOT text or a rendered SVG/PNG (networkx + matplotlib)."""
+"""The wiring of a diagram as DOT text or a drawn SVG/PNG/PDF (networkx + matplotlib).
+
+Both show each block as a record: its name, type and rate on top, its input ports down
+the left edge and its output ports down the right edge, and every connection as a wire
+from an output port to an input port. Blocks stand in layers from left to right along
+the data flow; the wires that close a loop (into a block without feedthrough, or through
+a delay) run back right to left in a channel above or below the blocks. Delayed wires
+are dashed and marked ``z^-1``. Colours give the rates, as Simulink's sample-time
+colours do: one colour per distinct effective period (an inherited block takes the
+colour of the rate it resolves to), with a legend.
+
+The drawing needs no Graphviz: the layout is done here (longest-path layers, a few
+barycenter passes against crossings) and drawn with matplotlib. The DOT text is for
+those who have Graphviz.
+"""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import networkx as nx
+import numpy as np
 
-from .diagram import Diagram
+from .diagram import Connection, Diagram
 from .schedule import Schedule
+from .timebase import format_duration
+
+# ----------------------------------------------------------------------------- rates
+
+PALETTE = ("#d62728", "#2ca02c", "#1f77b4", "#17becf", "#8c564b", "#ff7f0e", "#9467bd",
+           "#7f7f7f", "#1a55a0", "#a0522d")
+"""Colours of the periodic rates, fastest first (Simulink: red, green, blue, ...)."""
+CONSTANT_COLOR = "#c2189b"
+"""Blocks that fire at t = 0 only (Simulink: magenta for constant)."""
+MIXED_COLOR = "#b8a000"
+"""Inherited blocks whose hits follow no single period (Simulink: yellow for hybrid)."""
+
+
+@dataclass(frozen=True)
+class Rate:
+    """A block's effective rate: ``period`` and ``offset`` in base ticks (None: none)."""
+
+    kind: str  # "periodic", "constant" or "mixed"
+    period: int | None = None
+    offset: int = 0
+
+    def sort_key(self) -> tuple:
+        return ({"periodic": 0, "mixed": 1, "constant": 2}[self.kind], self.period or 0, self.offset)
+
+    def text(self, schedule: Schedule) -> str:
+        if self.kind == "constant":
+            return "constant (t = 0 only)"
+        if self.kind == "mixed":
+            return "inherited, mixed rates"
+        text = format_duration(self.period * schedule.base_tick)
+        if self.offset:
+            text += f" + {format_duration(self.offset * schedule.base_tick)}"
+        return text
+
+
+def effective_rate(schedule: Schedule, block: str) -> Rate:
+    """The rate ``block`` runs at: its own period, or for an inherited block the period
+    its hits follow in the schedule (constant when it fires at t = 0 only)."""
+    p = schedule.period_ticks[block]
+    if p is not None:
+        return Rate("periodic", p, schedule.offset_ticks[block])
+    hits = np.flatnonzero(schedule.masks[block])
+    if hits.size == 0:
+        return Rate("constant")
+    steps = np.diff(np.append(hits, hits[0] + schedule.hyperperiod))
+    if np.all(steps == steps[0]):
+        return Rate("periodic", int(steps[0]), int(hits[0]))
+    return Rate("mixed")
+
+
+@dataclass
+class RateColors:
+    """Each block's rate and colour, and the legend: one entry per distinct rate."""
+
+    rates: dict[str, Rate]
+    colors: dict[str, str]
+    legend: list[tuple[str, str]]
+    """(label, colour) per distinct rate, fastest first."""
+
+
+def rate_colors(diagram: Diagram, schedule: Schedule) -> RateColors:
+    rates = {name: effective_rate(schedule, name) for name in diagram.blocks}
+    distinct = sorted(set(rates.values()), key=Rate.sort_key)
+    colour_of: dict[Rate, str] = {}
+    legend = []
+    periodic = 0
+    for rate in distinct:
+        if rate.kind == "constant":
+            colour = CONSTANT_COLOR
+        elif rate.kind == "mixed":
+            colour = MIXED_COLOR
+        else:
+            colour = PALETTE[periodic % len(PALETTE)]
+            periodic += 1
+        colour_of[rate] = colour
+        label = rate.text(schedule)
+        own = [n for n, r in rates.items() if r == rate and schedule.period_ticks[n] is not None]
+        if rate.kind == "periodic" and not own:
+            label = f"inherited ({label})"
+        legend.append((label, colour))
+    return RateColors(rates, {n: colour_of[r] for n, r in rates.items()}, legend)
+
+
+def rate_line(schedule: Schedule, rates: RateColors, name: str) -> str:
+    """The rate as a block shows it: its own, or ``inherited -> 1 ms``."""
+    if schedule.period_ticks[name] is not None:
+        return schedule.rate_text(name)
+    rate = rates.rates[name]
+    if rate.kind == "periodic":
+        return "inherited \u2192 " + rate.text(schedule) + (", lazy" if name in schedule.lazy else "")
+    return schedule.rate_text(name)
 
 
 def block_label(diagram: Diagram, schedule: Schedule, name: str) -> str:
     return f"{name}\n{diagram.blocks[name].type_name}\n{schedule.rate_text(name)}"
 
+
+# ----------------------------------------------------------------------------- ports
+
+def input_ports(diagram: Diagram, name: str) -> list[str]:
+    """The block's input ports in declared order, then any wired port it does not declare."""
+    ports = list(diagram.blocks[name].block.inputs)
+    ports += [c.dst_port for c in diagram.connections if c.dst_block == name and c.dst_port not in ports]
+    return list(dict.fromkeys(ports))
+
+
+def output_ports(diagram: Diagram, name: str) -> list[str]:
+    ports = list(diagram.blocks[name].block.outputs)
+    ports += [c.src_port for c in diagram.connections if c.src_block == name and c.src_port not in ports]
+    return list(dict.fromkeys(ports))
+
+
+def is_feedthrough(diagram: Diagram, c: Connection) -> bool:
+    """Whether the wire carries its value into an output of its target at the same hit."""
+    if c.delay:
+        return False
+    block = diagram.blocks[c.dst_block].block
+    return any(c.dst_port in block.reads(o) for o in block.outputs)
+
+
+# ----------------------------------------------------------------------------- DOT
 
 def dot_quoted(text: str) -> str:
     """``text`` as a DOT double-quoted string: backslashes and quotes escaped, line breaks
@@ -21,79 +153,523 @@ def dot_quoted(text: str) -> str:
     return f'"{escaped}"'
 
 
+def record_text(text: str) -> str:
+    """``text`` as a field of a record label: the record's own characters escaped."""
+    out = []
+    for ch in text.replace("\r", ""):
+        if ch in '{}|<>"\\':
+            out.append("\\" + ch)
+        elif ch == "\n":
+            out.append("\\n")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+def port_id(direction: str, port: str) -> str:
+    """The record field name of a port: ``in_q``, ``out_tau`` (odd characters as ``_``)."""
+    return f"{direction}_" + "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in port)
+
+
+def record_label(diagram: Diagram, schedule: Schedule, rates: RateColors, name: str) -> str:
+    """``{{<in_a> a|...}|name\\ntype\\nrate|{<out_y> y|...}}`` (a side without ports left
+    out): with ``rankdir=LR`` the outer braces lay the three parts side by side, the inner
+    ones stack the ports."""
+    def ports(direction, names):
+        fields = "|".join(f"<{port_id(direction, p)}> {record_text(p)}" for p in names)
+        return [f"{{{fields}}}"] if fields else []
+    middle = "\\n".join(record_text(t) for t in
+                        (name, diagram.blocks[name].type_name, rate_line(schedule, rates, name)))
+    parts = ports("in", input_ports(diagram, name)) + [middle] + ports("out", output_ports(diagram, name))
+    return "{" + "|".join(parts) + "}"
+
+
+def tint(colour: str, amount: float = 0.14) -> str:
+    """``colour`` mixed into white: ``amount`` of it."""
+    r, g, b = (int(colour[i:i + 2], 16) for i in (1, 3, 5))
+    mix = [round(255 - amount * (255 - v)) for v in (r, g, b)]
+    return "#" + "".join(f"{v:02x}" for v in mix)
+
+
 def to_dot(diagram: Diagram, schedule: Schedule) -> str:
-    """Graphviz DOT text: blocks as boxes with type and rate, wires labelled with ports."""
-    lines = [f"digraph {dot_quoted(diagram.name)} {{", "  rankdir=LR;", '  node [shape=box, fontname="Helvetica"];']
+    """Graphviz DOT text: blocks as records with their ports, wires port to port,
+    coloured by rate, with a legend node of the rates."""
+    rates = rate_colors(diagram, schedule)
+    layout = layered(diagram)
+    lines = [f"digraph {dot_quoted(diagram.name)} {{", "  rankdir=LR;", "  splines=true;", "  nodesep=0.4;",
+             '  node [shape=record, fontname="Helvetica", fontsize=10, style=filled];',
+             '  edge [fontname="Helvetica", fontsize=9, arrowsize=0.7];']
     for name in diagram.blocks:
-        label = block_label(diagram, schedule, name).replace("\n", "\\n")
-        lines.append(f'  "{name}" [label="{label}"];')
+        colour = rates.colors[name]
+        label = record_label(diagram, schedule, rates, name)
+        lines.append(f'  {dot_quoted(name)} [label="{label}", color="{colour}", fillcolor="{tint(colour)}", '
+                     "penwidth=1.6];")
+    feedback = set(layout.feedback)
     for c in diagram.connections:
-        style = ", style=dashed" if c.delay else ""
-        label = f"{c.src_port} → {c.dst_port}" + (" (z⁻¹)" if c.delay else "")
-        lines.append(f'  "{c.src_block}" -> "{c.dst_block}" [label="{label}"{style}];')
+        attrs = [f'color="{rates.colors[c.src_block]}"']
+        if c.delay:
+            attrs += ["style=dashed", 'label="z\u207b\u00b9"']
+        if c in feedback:
+            attrs.append("constraint=false")
+        lines.append(f"  {dot_quoted(c.src_block)}:{port_id('out', c.src_port)}:e -> "
+                     f"{dot_quoted(c.dst_block)}:{port_id('in', c.dst_port)}:w [{', '.join(attrs)}];")
+    rows = "".join(f'<tr><td bgcolor="{tint(colour, 0.35)}"><font color="{colour}">\u25a0</font> '
+                   f"{html_text(label)}</td></tr>" for label, colour in rates.legend)
+    legend_id = "rates (legend)"
+    while legend_id in diagram.blocks:
+        legend_id += " "
+    lines.append(f"  {dot_quoted(legend_id)} [shape=plaintext, style=solid, label=<<table border=\"0\" "
+                 f'cellborder="1" cellspacing="0"><tr><td><b>rates</b></td></tr>{rows}</table>>];')
     lines.append("}")
     return "\n".join(lines) + "\n"
 
 
-def layered_positions(diagram: Diagram) -> dict[str, tuple[float, float]]:
-    """Left-to-right layers by longest path, ignoring the edges that close feedback loops."""
-    graph = nx.DiGraph()
-    graph.add_nodes_from(diagram.blocks)
-    for c in diagram.connections:
-        graph.add_edge(c.src_block, c.dst_block)
+def html_text(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+
+
+# ----------------------------------------------------------------------------- layout
+
+@dataclass
+class Layered:
+    """Blocks in layers: ``layer`` per block, the wires that run back (``feedback``), and
+    ``columns``: each layer's items top to bottom, blocks and, for a wire that passes a
+    layer, a waypoint ``(connection index, layer)``."""
+
+    layer: dict[str, int]
+    feedback: list[Connection]
+    columns: list[list] = field(default_factory=list)
+
+
+def layered(diagram: Diagram, sweeps: int = 6) -> Layered:
+    """Longest-path layers over the wires, the loops broken at wires without feedthrough
+    (delayed ones last), then barycenter passes to order each layer against crossings."""
     order = {n: i for i, n in enumerate(diagram.blocks)}
     dag = nx.DiGraph()
-    dag.add_nodes_from(graph)
-    visited: set[str] = set()
-    for root in sorted(graph, key=lambda n: (graph.in_degree(n) > 0, order[n])):
-        if root in visited:
+    dag.add_nodes_from(diagram.blocks)
+    conns = diagram.connections
+    ranked = sorted(range(len(conns)), key=lambda i: (0 if is_feedthrough(diagram, conns[i])
+                                                      else 2 if conns[i].delay else 1, i))
+    for i in ranked:
+        c = conns[i]
+        if c.src_block == c.dst_block or dag.has_edge(c.src_block, c.dst_block):
             continue
-        for u, v, kind in nx.dfs_labeled_edges(graph, root):
-            if kind == "forward" and u != v:
-                dag.add_edge(u, v)
-        visited |= nx.descendants(graph, root) | {root}
-    layer = {}
-    for n in nx.topological_sort(dag):
+        if not nx.has_path(dag, c.dst_block, c.src_block):
+            dag.add_edge(c.src_block, c.dst_block)
+    feedback = [c for c in conns if c.src_block == c.dst_block or not dag.has_edge(c.src_block, c.dst_block)]
+    layer: dict[str, int] = {}
+    for n in nx.lexicographical_topological_sort(dag, key=order.get):
         layer[n] = max((layer[p] + 1 for p in dag.predecessors(n)), default=0)
-    columns: dict[int, list[str]] = {}
-    for n in sorted(layer, key=order.get):
-        columns.setdefault(layer[n], []).append(n)
-    return {n: (float(x), -float(i) + (len(col) - 1) / 2) for x, col in columns.items()
-            for i, n in enumerate(col)}
+    # a block fed by nothing stands just before the first block it feeds
+    for n in sorted(dag, key=lambda n: -order[n]):
+        if dag.in_degree(n) == 0 and dag.out_degree(n):
+            layer[n] = max(layer[n], min(layer[s] for s in dag.successors(n)) - 1)
+    n_layers = max(layer.values(), default=-1) + 1
+    columns: list[list] = [[] for _ in range(n_layers)]
+    for n in sorted(diagram.blocks, key=order.get):
+        columns[layer[n]].append(n)
+    fb = set(map(id, feedback))
+    for i, c in enumerate(conns):
+        if id(c) not in fb:
+            for k in range(layer[c.src_block] + 1, layer[c.dst_block]):
+                columns[k].append((i, k))
+    result = Layered(layer, feedback, columns)
+    order_layers(diagram, result, sweeps)
+    return result
+
+
+def segments(diagram: Diagram, lay: Layered) -> list[tuple[object, int, object, int, int]]:
+    """The forward wires between neighbouring layers: (left item, output row, right item,
+    input row, layer of the left item), a wire through waypoints cut into its pieces."""
+    fb = set(map(id, lay.feedback))
+    out = []
+    for i, c in enumerate(diagram.connections):
+        if id(c) in fb:
+            continue
+        a, b = lay.layer[c.src_block], lay.layer[c.dst_block]
+        items = [c.src_block] + [(i, k) for k in range(a + 1, b)] + [c.dst_block]
+        rows = ([output_ports(diagram, c.src_block).index(c.src_port)] + [0] * (b - a - 1)
+                + [input_ports(diagram, c.dst_block).index(c.dst_port)])
+        for k in range(len(items) - 1):
+            out.append((items[k], rows[k], items[k + 1], rows[k + 1], a + k))
+    return out
+
+
+def crossings(diagram: Diagram, lay: Layered, segs=None) -> int:
+    segs = segments(diagram, lay) if segs is None else segs
+    pos = {item: j for col in lay.columns for j, item in enumerate(col)}
+    total = 0
+    by_layer: dict[int, list] = {}
+    for s in segs:
+        by_layer.setdefault(s[4], []).append(((pos[s[0]], s[1]), (pos[s[2]], s[3])))
+    for wires in by_layer.values():
+        for i in range(len(wires)):
+            for j in range(i + 1, len(wires)):
+                (a0, b0), (a1, b1) = wires[i], wires[j]
+                if (a0 < a1 and b0 > b1) or (a0 > a1 and b0 < b1):
+                    total += 1
+    return total
+
+
+def order_layers(diagram: Diagram, lay: Layered, sweeps: int) -> None:
+    """Barycenter sweeps, right then left, keeping the order with the fewest crossings."""
+    segs = segments(diagram, lay)
+
+    def rank(item, row, n_rows):
+        return pos[item] + (row + 1) / (n_rows + 2)
+
+    def n_out(item):
+        return len(output_ports(diagram, item)) if isinstance(item, str) else 1
+
+    def n_in(item):
+        return len(input_ports(diagram, item)) if isinstance(item, str) else 1
+
+    best = [list(col) for col in lay.columns]
+    best_count = crossings(diagram, lay, segs)
+    for sweep in range(sweeps):
+        forward = sweep % 2 == 0
+        layers = range(1, len(lay.columns)) if forward else range(len(lay.columns) - 2, -1, -1)
+        for k in layers:
+            pos = {item: j for col in lay.columns for j, item in enumerate(col)}
+            sums: dict[object, list[float]] = {}
+            for left, lrow, right, rrow, at in segs:
+                if forward and at == k - 1:
+                    sums.setdefault(right, []).append(rank(left, lrow, n_out(left)))
+                elif not forward and at == k:
+                    sums.setdefault(left, []).append(rank(right, rrow, n_in(right)))
+            col = lay.columns[k]
+            lay.columns[k] = sorted(col, key=lambda it: (np.mean(sums[it]) if it in sums else pos[it], pos[it]))
+        count = crossings(diagram, lay, segs)
+        if count < best_count:
+            best, best_count = [list(col) for col in lay.columns], count
+    lay.columns = best
+
+
+def layered_positions(diagram: Diagram) -> dict[str, tuple[float, float]]:
+    """Each block's (layer, -row within its layer): left-to-right layers along the wires."""
+    lay = layered(diagram)
+    return {item: (float(k), -float(j)) for k, col in enumerate(lay.columns)
+            for j, item in enumerate(col) if isinstance(item, str)}
+
+
+# ----------------------------------------------------------------------------- geometry
+# All lengths in inches; y grows downwards while laying out (the axes are flipped).
+
+FONT = 9.0          # port names
+TITLE_FONT = 10.0   # block names
+SMALL_FONT = 8.0    # type and rate
+ROW = 0.25          # one port row
+HEADER = 0.62       # name, type and rate above the ports
+PAD = 0.1           # inside the box, left and right of the port names
+V_GAP = 0.45        # between boxes of a layer
+WAYPOINT = 0.16     # height a passing wire takes in a layer
+LANE = 0.14         # between the vertical runs of the wires that go back
+CHANNEL = 0.2       # between the horizontal runs of the wires that go back
+
+
+def text_width(text: str, size: float, bold: bool = False) -> float:
+    """Width in inches of ``text`` in the default font at ``size`` points."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    if not text:
+        return 0.0
+    path = TextPath((0, 0), text, size=size, prop=FontProperties(weight="bold" if bold else "normal"))
+    return path.get_extents().width / 72.0 + 0.02
+
+
+@dataclass
+class Box:
+    x: float
+    y: float
+    w: float
+    h: float
+    inputs: list[str]
+    outputs: list[str]
+
+    def in_anchor(self, port: str) -> tuple[float, float]:
+        return self.x, self.y + HEADER + (self.inputs.index(port) + 0.5) * ROW
+
+    def out_anchor(self, port: str) -> tuple[float, float]:
+        return self.x + self.w, self.y + HEADER + (self.outputs.index(port) + 0.5) * ROW
+
+
+@dataclass
+class Geometry:
+    boxes: dict[str, Box]
+    waypoints: dict[tuple[int, int], tuple[float, float, float]]
+    """(connection index, layer) -> (x left, x right, y) of a wire passing that layer."""
+    column_x: list[tuple[float, float]]
+    lanes: dict[tuple[int, str], float]
+    """(connection index, "src"|"dst") -> x of a returning wire's vertical run."""
+    channels: dict[int, float]
+    """connection index -> y of a returning wire's horizontal run."""
+    bounds: tuple[float, float, float, float]
+
+
+def geometry(diagram: Diagram, schedule: Schedule, lay: Layered, rates: RateColors) -> Geometry:
+    sizes = {}
+    for name in diagram.blocks:
+        ins, outs = input_ports(diagram, name), output_ports(diagram, name)
+        in_w = max((text_width(p, FONT) for p in ins), default=0.0)
+        out_w = max((text_width(p, FONT) for p in outs), default=0.0)
+        head = max(text_width(name, TITLE_FONT, bold=True), text_width(diagram.blocks[name].type_name, SMALL_FONT),
+                   text_width(rate_line(schedule, rates, name), SMALL_FONT))
+        w = max(head + 2 * PAD, in_w + out_w + 2 * PAD + 0.35, 1.0)
+        h = HEADER + max(len(ins), len(outs), 1) * ROW + 0.08
+        sizes[name] = (w, h, ins, outs)
+    conns = diagram.connections
+    index = {id(c): i for i, c in enumerate(conns)}
+    fb = [index[id(c)] for c in lay.feedback]
+    n_layers = len(lay.columns)
+    # returning wires: above or below, nested so the wider ones run outside
+    widths = [max((sizes[it][0] for it in col if isinstance(it, str)), default=0.6) for col in lay.columns]
+    gaps_src = [0] * (n_layers + 1)   # lanes right of layer k used by sources there
+    gaps_dst = [0] * (n_layers + 1)   # lanes left of layer k used by targets there
+    for i in fb:
+        gaps_src[lay.layer[conns[i].src_block]] += 1
+        gaps_dst[lay.layer[conns[i].dst_block]] += 1
+    n_wires = [0] * n_layers
+    for i, c in enumerate(conns):
+        if i not in fb:
+            for k in range(lay.layer[c.src_block], lay.layer[c.dst_block]):
+                n_wires[k] += 1
+    column_x = []
+    x = 0.45 + gaps_dst[0] * LANE if n_layers else 0.0
+    for k in range(n_layers):
+        column_x.append((x, x + widths[k]))
+        if k + 1 < n_layers:
+            x += widths[k] + 1.1 + 0.04 * n_wires[k] + (gaps_src[k] + gaps_dst[k + 1]) * LANE
+    # vertical placement: each item near the wires that feed it, in the order found
+    boxes: dict[str, Box] = {}
+    waypoints: dict[tuple[int, int], tuple[float, float, float]] = {}
+    anchor_y: dict[object, dict] = {}
+
+    def height(item):
+        return sizes[item][1] if isinstance(item, str) else WAYPOINT
+
+    def feed_y(item):
+        """The y of the item's wired inputs, relative to its top, and where they come from."""
+        own, other = [], []
+        for i, c in enumerate(conns):
+            if i in fb:
+                continue
+            if isinstance(item, str) and c.dst_block == item:
+                src_item = c.src_block if lay.layer[c.src_block] == lay.layer[item] - 1 else (i, lay.layer[item] - 1)
+                own.append(HEADER + (sizes[item][2].index(c.dst_port) + 0.5) * ROW)
+            elif not isinstance(item, str) and i == item[0]:
+                k = item[1]
+                src_item = c.src_block if lay.layer[c.src_block] == k - 1 else (i, k - 1)
+                own.append(WAYPOINT / 2)
+            else:
+                continue
+            if src_item in anchor_y:
+                other.append(anchor_y[src_item].get(c.src_port if isinstance(src_item, str) else None))
+            else:
+                own.pop()
+        pairs = [(o, t) for o, t in zip(own, other) if t is not None]
+        if not pairs:
+            return None
+        return float(np.mean([t - o for o, t in pairs]))
+
+    for k, col in enumerate(lay.columns):
+        desired = []
+        for item in col:
+            want = feed_y(item) if k else None
+            desired.append(want)
+        tops, y = [], 0.0
+        for j, item in enumerate(col):
+            want = desired[j]
+            top = y if want is None else max(want, y)
+            tops.append(top)
+            if j + 1 < len(col):
+                boxes_both = isinstance(item, str) + isinstance(col[j + 1], str)
+                y = top + height(item) + (V_GAP, 0.22, 0.04)[2 - boxes_both]
+        placed = [(tops[j] - desired[j]) for j in range(len(col)) if desired[j] is not None]
+        shift = float(np.median(placed)) if placed else 0.0
+        shift = min(shift, tops[0] - min(0.0, tops[0])) if tops else 0.0
+        for j, item in enumerate(col):
+            top = tops[j] - shift
+            x0, x1 = column_x[k]
+            if isinstance(item, str):
+                w, h, ins, outs = sizes[item]
+                cx = (x0 + x1) / 2
+                box = boxes[item] = Box(cx - w / 2, top, w, h, ins, outs)
+                anchor_y[item] = {p: box.out_anchor(p)[1] for p in outs}
+            else:
+                waypoints[item] = (x0, x1, top + WAYPOINT / 2)
+                anchor_y[item] = {None: top + WAYPOINT / 2}
+    # make the first layers' tops start at 0
+    all_tops = [b.y for b in boxes.values()] + [w[2] - WAYPOINT / 2 for w in waypoints.values()]
+    lift = min(all_tops, default=0.0)
+    for b in boxes.values():
+        b.y -= lift
+    waypoints = {key: (a, b, y - lift) for key, (a, b, y) in waypoints.items()}
+    top = 0.0
+    bottom = max((b.y + b.h for b in boxes.values()), default=0.0)
+    bottom = max([bottom] + [w[2] + WAYPOINT for w in waypoints.values()])
+    # the returning wires' channels and lanes
+    lanes: dict[tuple[int, str], float] = {}
+    channels: dict[int, float] = {}
+    above, below = [], []
+    for i in fb:
+        c = conns[i]
+        ys = (boxes[c.src_block].out_anchor(c.src_port)[1], boxes[c.dst_block].in_anchor(c.dst_port)[1])
+        (above if np.mean(ys) - top < bottom - np.mean(ys) else below).append(i)
+
+    def span(i):
+        c = conns[i]
+        return boxes[c.src_block].x + boxes[c.src_block].w - boxes[c.dst_block].x
+
+    for group, sign, edge in ((above, -1, top), (below, 1, bottom)):
+        group.sort(key=span)
+        for j, i in enumerate(group):
+            channels[i] = edge + sign * (0.3 + j * CHANNEL)
+    nested = sorted(fb, key=lambda i: (i in above, span(i)))
+    used_src: dict[int, int] = {}
+    used_dst: dict[int, int] = {}
+    for i in nested:
+        c = conns[i]
+        ks, kd = lay.layer[c.src_block], lay.layer[c.dst_block]
+        lanes[(i, "src")] = column_x[ks][1] + 0.2 + used_src.get(ks, 0) * LANE
+        used_src[ks] = used_src.get(ks, 0) + 1
+        lanes[(i, "dst")] = column_x[kd][0] - 0.3 - used_dst.get(kd, 0) * LANE
+        used_dst[kd] = used_dst.get(kd, 0) + 1
+    ys = [top, bottom] + list(channels.values())
+    xs = [0.0, column_x[-1][1] if column_x else 1.0] + list(lanes.values())
+    return Geometry(boxes, waypoints, column_x, lanes, channels, (min(xs), max(xs), min(ys), max(ys)))
+
+
+def wire_path(diagram: Diagram, lay: Layered, geo: Geometry, i: int):
+    """The vertices and codes of a matplotlib Path for connection ``i``, and the point
+    where its delay mark goes."""
+    from matplotlib.path import Path as MPath
+
+    c = diagram.connections[i]
+    x0, y0 = geo.boxes[c.src_block].out_anchor(c.src_port)
+    x1, y1 = geo.boxes[c.dst_block].in_anchor(c.dst_port)
+    if i in geo.channels:
+        xs, xd, yc = geo.lanes[(i, "src")], geo.lanes[(i, "dst")], geo.channels[i]
+        r = 0.08
+        sgn_a = 1 if yc > y0 else -1
+        sgn_b = 1 if y1 > yc else -1
+        pts = [(x0, y0), (xs - r, y0), (xs, y0), (xs, y0 + sgn_a * r), (xs, yc - sgn_a * r), (xs, yc),
+               (xs - r, yc), (xd + r, yc), (xd, yc), (xd, yc + sgn_b * r), (xd, y1 - sgn_b * r), (xd, y1),
+               (xd + r, y1), (x1, y1)]
+        codes = [MPath.MOVETO, MPath.LINETO, MPath.CURVE3, MPath.CURVE3, MPath.LINETO, MPath.CURVE3,
+                 MPath.CURVE3, MPath.LINETO, MPath.CURVE3, MPath.CURVE3, MPath.LINETO, MPath.CURVE3,
+                 MPath.CURVE3, MPath.LINETO]
+        return pts, codes, ((xs + xd) / 2, yc)
+    ks, kd = lay.layer[c.src_block], lay.layer[c.dst_block]
+    stops = [(x0, y0)]
+    for k in range(ks + 1, kd):
+        left, right, y = geo.waypoints[(i, k)]
+        stops += [(left, y), (right, y)]
+    stops.append((x1, y1))
+    pts, codes = [stops[0]], [MPath.MOVETO]
+    for j in range(0, len(stops) - 1, 2):
+        (ax_, ay), (bx, by) = stops[j], stops[j + 1]
+        d = (bx - ax_) * 0.5
+        pts += [(ax_ + d, ay), (bx - d, by), (bx, by)]
+        codes += [MPath.CURVE4] * 3
+        if j + 2 < len(stops):
+            pts.append(stops[j + 2])
+            codes.append(MPath.LINETO)
+    (ax_, ay), (bx, by) = stops[0], stops[1]
+    mark = ((ax_ + bx) / 2, (ay + by) / 2)
+    return pts, codes, mark
+
+
+def draw(diagram: Diagram, schedule: Schedule):
+    """The wiring drawn on a new matplotlib Figure (sized in inches to fit its text).
+
+    Every connection is a patch whose gid is ``wire:`` and the connection's text
+    (``plant.q -> reflex.q``), every block a patch with gid ``block:NAME``.
+    """
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import FancyBboxPatch, Patch, PathPatch, Polygon
+    from matplotlib.path import Path as MPath
+
+    rates = rate_colors(diagram, schedule)
+    lay = layered(diagram)
+    geo = geometry(diagram, schedule, lay, rates)
+    x_min, x_max, y_min, y_max = geo.bounds
+    title_h = 0.45
+    # legend: one row if it fits, else as many columns as fit
+    entries = [(label, colour) for label, colour in rates.legend]
+    has_delay = any(c.delay for c in diagram.connections)
+    labels = [label for label, _ in entries] + (["delayed one sample (z\u207b\u00b9)"] if has_delay else [])
+    entry_w = max((text_width(t, FONT) for t in labels), default=1.0) + 0.65
+    content_w = x_max - x_min + 0.6
+    width = max(content_w, text_width(diagram.name, 12, bold=True) + 0.6, 4.0)
+    ncol = max(1, min(len(labels), int((width - 0.3) // entry_w)))
+    if ncol * entry_w + 0.3 > width:
+        width = ncol * entry_w + 0.3
+    legend_rows = -(-len(labels) // ncol) if labels else 0
+    legend_h = 0.3 + 0.24 * legend_rows
+    height = (y_max - y_min) + title_h + legend_h + 0.5
+    fig = Figure(figsize=(width, height))
+    ax = fig.add_axes((0, 0, 1, 1))
+    ax.set_axis_off()
+    left = x_min - (width - (x_max - x_min)) / 2
+    top = y_min - title_h - legend_h - 0.15
+    ax.set_xlim(left, left + width)
+    ax.set_ylim(top + height, top)
+    ax.text(left + 0.3, top + 0.3, diagram.name, fontsize=12, fontweight="bold", va="center", ha="left")
+    handles = [Patch(facecolor=tint(colour, 0.3), edgecolor=colour, linewidth=1.6, label=label)
+               for label, colour in entries]
+    if has_delay:
+        handles.append(Line2D([], [], color="0.3", linestyle="--", label=labels[-1]))
+    if handles:
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(left + 0.2, top + title_h + 0.05),
+                  bbox_transform=ax.transData, ncol=ncol, frameon=False, fontsize=FONT, title="rates",
+                  title_fontsize=FONT, alignment="left", handlelength=1.6, columnspacing=1.2, borderaxespad=0)
+    for name, box in geo.boxes.items():
+        colour = rates.colors[name]
+        ax.add_patch(FancyBboxPatch((box.x, box.y), box.w, box.h, boxstyle="round,pad=0,rounding_size=0.05",
+                                    facecolor=tint(colour), edgecolor=colour, linewidth=1.8, zorder=2,
+                                    gid=f"block:{name}"))
+        cx = box.x + box.w / 2
+        ax.text(cx, box.y + 0.16, name, fontsize=TITLE_FONT, fontweight="bold", ha="center", va="center", zorder=4)
+        ax.text(cx, box.y + 0.34, diagram.blocks[name].type_name, fontsize=SMALL_FONT, style="italic",
+                color="0.3", ha="center", va="center", zorder=4)
+        ax.text(cx, box.y + 0.50, rate_line(schedule, rates, name), fontsize=SMALL_FONT, color=colour,
+                ha="center", va="center", zorder=4)
+        ax.plot([box.x, box.x + box.w], [box.y + HEADER - 0.03] * 2, color=colour, linewidth=0.8, alpha=0.6,
+                zorder=3)
+        wired_in = {c.dst_port for c in diagram.connections if c.dst_block == name}
+        wired_out = {c.src_port for c in diagram.connections if c.src_block == name}
+        for p in box.inputs:
+            x, y = box.in_anchor(p)
+            ax.text(x + PAD, y, p, fontsize=FONT, ha="left", va="center", zorder=4,
+                    color="black" if p in wired_in else "0.55")
+        for p in box.outputs:
+            x, y = box.out_anchor(p)
+            ax.text(x - PAD, y, p, fontsize=FONT, ha="right", va="center", zorder=4,
+                    color="black" if p in wired_out else "0.55")
+            if p in wired_out:
+                ax.plot([x], [y], marker="o", markersize=3.5, color=rates.colors[name], zorder=5)
+    for i, c in enumerate(diagram.connections):
+        pts, codes, mark = wire_path(diagram, lay, geo, i)
+        colour = rates.colors[c.src_block]
+        ax.add_patch(PathPatch(MPath(pts, codes), facecolor="none", edgecolor=colour, linewidth=1.3,
+                               linestyle=(0, (4, 2.5)) if c.delay else "-", zorder=1, gid=f"wire:{c}",
+                               capstyle="round"))
+        x1, y1 = pts[-1]
+        ax.add_patch(Polygon([(x1, y1), (x1 - 0.11, y1 - 0.045), (x1 - 0.11, y1 + 0.045)], closed=True,
+                             facecolor=colour, edgecolor=colour, linewidth=0.5, zorder=5))
+        if c.delay:
+            ax.text(mark[0], mark[1], "z\u207b\u00b9", fontsize=SMALL_FONT, ha="center", va="center", zorder=6,
+                    color=colour, bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor=colour,
+                                            linewidth=0.9))
+    return fig
 
 
 def render(diagram: Diagram, schedule: Schedule, path: str | Path) -> Path:
-    """Draw the diagram to an SVG or PNG file (format from the suffix)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    """Draw the diagram to an SVG, PNG or PDF file (format from the suffix)."""
     path = Path(path)
-    pos = layered_positions(diagram)
-    width = max(x for x, _ in pos.values()) + 1
-    height = max(abs(y) for _, y in pos.values()) * 2 + 1
-    fig, ax = plt.subplots(figsize=(2.6 * width + 1, 1.6 * height + 1))
-    boxes = {name: ax.text(x, y, block_label(diagram, schedule, name), ha="center", va="center",
-                           fontsize=8, bbox=dict(boxstyle="round,pad=0.4", fc="#eef3fb", ec="#3a5a8c"))
-             for name, (x, y) in pos.items()}
-    for c in diagram.connections:
-        (x0, y0), (x1, y1) = pos[c.src_block], pos[c.dst_block]
-        forward = x1 > x0
-        ax.annotate("", xy=(0.0, 0.5) if forward else (0.5, 1.0), xycoords=boxes[c.dst_block],
-                    xytext=(1.0, 0.5) if forward else (0.5, 1.0), textcoords=boxes[c.src_block],
-                    arrowprops=dict(arrowstyle="-|>", color="0.3", shrinkA=4, shrinkB=4,
-                                    linestyle="--" if c.delay else "-",
-                                    connectionstyle="arc3,rad=0" if forward else "arc3,rad=0.3"))
-        ax.text((x0 + x1) / 2, (y0 + y1) / 2 + (0.06 if forward else 0.2 + 0.15 * abs(x1 - x0)), f"{c.src_port}→{c.dst_port}",
-                fontsize=7, ha="center", color="0.25")
-    ax.set_xlim(-0.6, width - 0.4)
-    ys = [y for _, y in pos.values()]
-    ax.set_ylim(min(ys) - 0.8, max(ys) + 0.8)
-    ax.set_axis_off()
-    ax.set_title(diagram.name)
-    fig.tight_layout()
+    fig = draw(diagram, schedule)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path)
-    plt.close(fig)
+    fig.savefig(path, dpi=150)
     return path

@@ -1,4 +1,5 @@
-"""``graph``: the wiring of a diagram as DOT text, or drawn to SVG, PNG or PDF."""
+"""``graph``: the wiring of a diagram as DOT text, or drawn to SVG, PNG or PDF: blocks as
+records with their ports, wires port to port, colours by rate with a legend."""
 
 from __future__ import annotations
 
