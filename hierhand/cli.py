@@ -24,16 +24,20 @@ MEASURES_HELP = "a hand task measure: separation_time, object_dropped, peak_rati
 
 def add_animate(sub, program) -> argparse.ArgumentParser:
     """The ``animate`` command."""
-    animate = sub.add_parser("animate", help="animate the hand, object and contact forces of a run (GIF)",
-                             description="Write a GIF of the hand, the object and the contact force arrows "
-                                         "over time from a results folder (needs PLANT.q and PLANT.obj logged; "
-                                         "arrows need PLANT.fn, PLANT.ft and PLANT.normal).")
+    animate = sub.add_parser("animate", help="animate the hand, object and contact forces of a run (GIF or MP4)",
+                             description="Write a GIF (or an MP4, with ffmpeg) of the hand, the object and the "
+                                         "contact force arrows over time from a results folder, each frame "
+                                         "showing the simulated time, the task's phase and the fingers in "
+                                         "contact (needs PLANT.q and PLANT.obj logged; arrows need PLANT.fn, "
+                                         "PLANT.ft and PLANT.normal).")
     animate.add_argument("run_dir", type=Path, metavar="RUN_DIR", help="results folder of 'hierhand run'")
-    animate.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.gif", help="GIF file to write")
-    animate.add_argument("--fps", type=float, default=25.0, help="GIF frames per second (default: 25)")
+    animate.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.gif",
+                         help="file to write: FILE.gif, or FILE.mp4 (needs ffmpeg)")
+    animate.add_argument("--fps", type=float, default=25.0, help="frames per second (default: 25)")
     timing = animate.add_mutually_exclusive_group()
-    timing.add_argument("--speed", type=float, default=1.0,
-                        help="simulated seconds per second of GIF (default: 1; 0.1 = ten times slower)")
+    timing.add_argument("--speed", type=float, default=None,
+                        help="simulated seconds per second of animation (0.1 = ten times slower than real "
+                             "time; default: a round value making it last about 10 s, 0.1 for a 1 s run)")
     timing.add_argument("--every", type=int, metavar="N",
                         help="instead of --speed: a frame at every N-th logged sample of PLANT.q")
     animate.add_argument("--plant", metavar="NAME", help="the HandPlant block (needed if the run has several)")
@@ -76,7 +80,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     results = Results.load(args.run_dir)
     try:
         written = animate_run(results, args.output, fps=args.fps, speed=args.speed,
-                              plant=args.plant, every=args.every)
+                              plant=args.plant, every=args.every, report=print)
     except AnimationError as exc:
         raise UsageError(str(exc)) from None
     print(f"wrote {written}")

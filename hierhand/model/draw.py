@@ -20,16 +20,20 @@ def draw_hand(
     obj_pose: np.ndarray,
     forces: Any = None,
     force_scale: float = 0.01,
+    normal_forces: Any = None,
 ) -> dict[str, list]:
     """Draw fingers (links as lines, joints as dots), fingertip circles, the object and
     contact force arrows; return the artists by kind.
 
     ``forces``: rows ``(x, y, fx, fy)`` (a force on the object and where it acts), or a
     ``ContactWrenches`` (its per-finger force on the object at the contact point).
-    Arrows are ``force_scale`` metres long per newton.
+    Arrows are ``force_scale`` metres long per newton. ``normal_forces``: rows ``(fx, fy)``,
+    per row of ``forces`` its normal part, drawn as a thin dark arrow from the same point
+    (artists ``"normal_forces"``).
     """
     pts = hand.joint_positions(np.asarray(q, dtype=float))
-    artists: dict[str, list] = {"links": [], "joints": [], "tips": [], "object": [], "forces": []}
+    artists: dict[str, list] = {"links": [], "joints": [], "tips": [], "object": [], "forces": [],
+                                "normal_forces": []}
     corners = hand.object_corners(obj_pose)
     obj = Polygon(corners, closed=True, facecolor="0.85", edgecolor="0.3", linewidth=1.2, zorder=1)
     ax.add_patch(obj)
@@ -43,9 +47,21 @@ def draw_hand(
         artists["links"].append(line)
         artists["joints"].append(dots)
         artists["tips"].append(tip)
-    for x, y, fx, fy in _force_rows(forces):
+    rows = _force_rows(forces)
+    normals = None if normal_forces is None else np.asarray(normal_forces, dtype=float).reshape(-1, 2)
+    if normals is not None and len(normals) != len(rows):
+        raise ValueError(f"normal_forces must have a row per force, got {len(normals)} for {len(rows)}")
+    for i, (x, y, fx, fy) in enumerate(rows):
         if not (np.isfinite([x, y, fx, fy]).all() and (fx or fy)):
             continue
+        if normals is not None and np.isfinite(normals[i]).all() and normals[i].any():
+            part = FancyArrow(
+                x, y, normals[i, 0] * force_scale, normals[i, 1] * force_scale,
+                width=0.0002, head_width=0.0018, head_length=0.0018,
+                length_includes_head=True, color="0.15", alpha=0.8, zorder=5,
+            )
+            ax.add_patch(part)
+            artists["normal_forces"].append(part)
         arrow = FancyArrow(
             x, y, fx * force_scale, fy * force_scale,
             width=0.0006, head_width=0.003, head_length=0.003,

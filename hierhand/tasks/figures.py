@@ -43,8 +43,10 @@ def _torque_axes(ax, results: Results, joint: int, b: TaskBlocks, title: str) ->
         ax.plot(t_g, tau_g[:, joint], lw=0.8, ls="--", color="C0", label="grasp torque from the reflex")
         t_a, tau_a = results[applied]
         ax.plot(t_a, tau_a[:, joint], lw=1.2, color="C0", label="grasp torque applied (after the suppresser)")
+    elif not suppressing:  # the reflex's torque is applied as it is
+        ax.plot(t_g, tau_g[:, joint], lw=1.2, color="C0", label="grasp torque (reflex, applied unsuppressed)")
     else:
-        ax.plot(t_g, tau_g[:, joint], lw=1.2, label="grasp torque (reflex)")
+        ax.plot(t_g, tau_g[:, joint], lw=1.2, color="C0", label="grasp torque (reflex)")
     ax.step(t_m, tau_m[:, joint], where="post", lw=1.2, color="C1", label="manipulation torque (PD)")
     ax.axhline(0, color="k", lw=0.5)
     ax.set_ylabel("torque (N m)")
@@ -109,7 +111,8 @@ def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBloc
 
     r = summary["regrasp"]
     fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
-    for ax, key, label in ((axes[0], "regrasp", "with suppresser"), (axes[1], "regrasp_unsuppressed", "without")):
+    for ax, key, label in ((axes[0], "regrasp", "with suppresser"),
+                           (axes[1], "regrasp_unsuppressed", "without suppresser")):
         _ratio_axes(ax, runs[key], (FORE,), b, f"Fig. 13: forefinger friction ratio, re-grasp {label}")
         run_key = "suppressed" if key == "regrasp" else "unsuppressed"
         _mark(ax, r[run_key]["middle_contact_time_s"], " middle touches")
@@ -117,7 +120,8 @@ def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBloc
     written.append(_save(fig, out / "fig13.png"))
 
     fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
-    for ax, key, label in ((axes[0], "regrasp", "with suppresser"), (axes[1], "regrasp_unsuppressed", "without")):
+    for ax, key, label in ((axes[0], "regrasp", "with suppresser"),
+                           (axes[1], "regrasp_unsuppressed", "without suppresser")):
         _torque_axes(ax, runs[key], fore_joint1, b, f"Fig. 14: forefinger joint 1, re-grasp {label}")
         run_key = "suppressed" if key == "regrasp" else "unsuppressed"
         _mark(ax, r[run_key]["fore_separation_time_s"], " forefinger leaves")

@@ -4,13 +4,17 @@ from __future__ import annotations
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
 
 import blocks
-from hierhand.animation import AnimationError, _frame_indices, animate_run
+from hierhand.animation import (AnimationError, _frame_indices, animate_run, default_speed, frame_figure,
+                                phase_at, task_phases)
+
+ROOT = Path(__file__).resolve().parents[2]
 
 DIAGRAM = """\
 name: animate-test
@@ -96,7 +100,7 @@ def test_plant_choice_errors(run_dir, tmp_path):
                     tmp_path / "x.gif")
     with pytest.raises(AnimationError, match="is a Gain"):
         animate_run(results, tmp_path / "x.gif", plant="gain")
-    with pytest.raises(AnimationError, match=r"\.gif"):
+    with pytest.raises(AnimationError, match=r"\.gif or \*\.mp4"):
         animate_run(results, tmp_path / "x.png")
 
 
@@ -106,3 +110,138 @@ def test_frames_follow_q_and_hold_between_its_samples():
     assert list(_frame_indices(t, fps=4, speed=1.0, every=None)) == [0, 2, 5, 7, 10]  # 0.25 s -> held 0.2
     assert list(_frame_indices(t, fps=20, speed=1.0, every=None))[:4] == [0, 0, 1, 1]  # slower than q: held
     assert list(_frame_indices(t, fps=25, speed=1.0, every=4)) == [0, 4, 8, 10]  # ends on the last sample
+
+
+def test_gif_frame_count_follows_speed_and_fps(run_dir, tmp_path):
+    results = blocks.Results.load(run_dir)  # 20 ms of q at 0.1 ms
+    out = animate_run(results, tmp_path / "a.gif", fps=5, speed=0.01)  # 2 ms a frame: 0, 2, ..., 20 ms
+    assert frames(out) == 11
+    with Image.open(out) as im:
+        assert im.info["duration"] == 200  # ms per frame at 5 fps
+    out = animate_run(results, tmp_path / "b.gif", fps=4, speed=0.03)  # 7.5 ms: 0, 7.5, 15 ms and the end
+    assert frames(out) == 4
+
+
+def test_default_speed_makes_about_ten_seconds_and_is_printed(run_dir, tmp_path):
+    assert default_speed(1.0) == pytest.approx(0.1)  # a 1 s task: 10 s of GIF, ten times slower
+    assert default_speed(1.2) == pytest.approx(0.1)
+    assert default_speed(0.02) == pytest.approx(0.002)
+    assert default_speed(30.0) == pytest.approx(2.0)
+    told = []
+    out = animate_run(blocks.Results.load(run_dir), tmp_path / "d.gif", fps=2, report=told.append)
+    assert frames(out) == 21  # 20 ms at 0.002 s per second of GIF, 2 fps: a frame per ms
+    assert len(told) == 1 and "speed 0.002 (chosen" in told[0] and "21 frames" in told[0]
+
+
+@pytest.fixture(scope="module")
+def regrasp():
+    """The first 50 ms of the shipped re-grasp task: thumb and forefinger on the object."""
+    results = blocks.simulate(blocks.load_diagram(ROOT / "diagrams" / "regrasp.yaml"), t_end=0.05)
+    assert results.complete
+    return results
+
+
+def test_force_arrows_start_at_the_contact_points_along_the_forces(regrasp):
+    from matplotlib.colors import to_rgb
+    from matplotlib.patches import FancyArrow
+
+    from hierhand.model import load_hand
+
+    fig = frame_figure(regrasp, 0.04, newtons_per_mm=0.5)
+    texts = " | ".join(t.get_text() for t in fig.texts)
+    assert "1 N = 2 mm" in texts and "t = 0.040 s" in texts
+    assert "object on its support (released at 0.1 s)" in texts
+    assert "in contact (normal force): thumb" in texts and "forefinger" in texts
+    ax = fig.axes[0]
+    red = [p for p in ax.patches if isinstance(p, FancyArrow) and np.allclose(p.get_facecolor()[:3], to_rgb("tab:red"))]
+    dark = [p for p in ax.patches if isinstance(p, FancyArrow) and np.allclose(p.get_facecolor()[:3], to_rgb("0.15"))]
+    fn = regrasp.held("plant.fn", np.array([0.04]))[0]
+    ft = regrasp.held("plant.ft", np.array([0.04]))[0]
+    n = regrasp.held("plant.normal", np.array([0.04]))[0].reshape(3, 2)
+    touching = np.flatnonzero(fn > 0)
+    assert list(touching) == [0, 1]  # thumb and forefinger
+    assert len(red) == len(touching) + 1  # one per contact and the key arrow
+    assert len(dark) == len(touching)  # the normal parts
+    hand = load_hand(regrasp.info["parameters"]["plant"])
+    tips = hand.tip_positions(regrasp.held("plant.q", np.array([0.04]))[0])
+    m_per_n = 1e-3 / 0.5
+    for f in touching:
+        contact = tips[f] + hand.tip_radius[f] * n[f]
+        force = fn[f] * n[f] + ft[f] * np.array([-n[f, 1], n[f, 0]])
+        # a FancyArrow's polygon: its head's point is vertex 0, its tail's centre the
+        # midpoint of vertices 3 and 4
+        matches = [a for a in red if np.allclose((a.get_xy()[3] + a.get_xy()[4]) / 2, contact, atol=1e-9)]
+        assert len(matches) == 1
+        assert np.allclose(matches[0].get_xy()[0], contact + force * m_per_n, atol=1e-9)
+        normal = [a for a in dark if np.allclose(a.get_xy()[0], contact + fn[f] * n[f] * m_per_n, atol=1e-9)]
+        assert len(normal) == 1
+
+
+def test_no_arrows_and_a_hint_without_normal_logged(run_dir):
+    results = blocks.Results.load(run_dir)
+    bare = blocks.Results({k: results[k] for k in results if k != "plant.normal"}, results.info)
+    fig = frame_figure(bare, 0.01)
+    texts = " | ".join(t.get_text() for t in fig.texts)
+    assert "no force arrows" in texts and "plant.normal" in texts
+    assert "no finger in contact" in texts  # fn tells who touches
+
+
+def test_regrasp_phases_from_the_diagram(regrasp):
+    from hierhand.model import load_hand
+
+    results = regrasp  # only its block types and parameters matter here
+
+    hand = load_hand(results.info["parameters"]["plant"])
+    phases = task_phases(results.info, hand)
+    assert phase_at(phases, 0.05) == "object on its support (released at 0.1 s)"
+    assert phase_at(phases, 0.12) == "support released"
+    assert phase_at(phases, 0.2) == "middle finger moving in (0.15-0.35 s)"
+    assert phase_at(phases, 0.36) == "middle finger in place"
+    assert phase_at(phases, 0.5) == "forefinger withdrawing (0.38-0.68 s)"
+    assert phase_at(phases, 0.9) == "forefinger withdrawn"
+    # with the contacts of the run: a withdrawal that did not let go says so
+    assert (phase_at(phases, 0.9, lambda f: f != "middle")
+            == "forefinger told to withdraw (by 0.68 s) but still in contact")
+    assert phase_at(phases, 0.36, lambda f: f != "middle") == "middle finger moved in (by 0.35 s) but not in contact"
+
+
+def test_manipulation_and_grasp_phases():
+    info = {"block_types": {"manip": "ManipulationPD", "push": "Step", "support": "ObjectSupport"},
+            "parameters": {"manip": {"trajectories": {
+                "thumb": {"waypoints": [[0.3, -0.03, 0.06, 0.0], [0.8, -0.025, 0.065, 0.0]]},
+                "fore": {"waypoints": [[0.3, 0.03, 0.06, 3.0], [0.8, 0.035, 0.065, 3.0]]}}},
+                "push": {"time": 0.5}, "support": {"until": 0.1}}}
+    moved = lambda t: np.array([0.0, 0.06, 0.0]) if t < 0.5 else np.array([0.005, 0.065, 0.0])  # noqa: E731
+    phases = task_phases(info, object_pose=moved)
+    assert phase_at(phases, 0.4) == "thumb and forefinger moving the object (0.3-0.8 s)"
+    assert phase_at(phases, 0.9) == "thumb and forefinger done moving the object"
+    assert phase_at(phases, 0.2) == "support released"
+    assert task_phases({}) == []
+
+
+def test_mp4_without_ffmpeg_is_a_one_line_error(run_dir, tmp_path, monkeypatch, capsys):
+    import shutil
+
+    from hierhand import cli
+
+    monkeypatch.setattr(shutil, "which", lambda name, *a, **k: None)
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)  # import fails
+    with pytest.raises(AnimationError, match="ffmpeg"):
+        animate_run(run_dir, tmp_path / "a.mp4")
+    code = cli.main(["animate", str(run_dir), "-o", str(tmp_path / "a.mp4")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert "needs ffmpeg" in err[0] and "install" in err[0] and "a.gif" in err[0]
+    assert not (tmp_path / "a.mp4").exists()
+
+
+def test_mp4_uses_matplotlibs_ffmpeg_writer_when_ffmpeg_is_found(tmp_path, monkeypatch):
+    import shutil
+
+    from matplotlib.animation import FFMpegWriter
+
+    from hierhand.animation import _writer
+
+    monkeypatch.setattr(shutil, "which", lambda name, *a, **k: "/opt/bin/ffmpeg" if name == "ffmpeg" else None)
+    writer = _writer(tmp_path / "a.mp4", 25)
+    assert isinstance(writer, FFMpegWriter) and writer.ffmpeg_exe == "/opt/bin/ffmpeg" and writer.fps == 25

@@ -111,3 +111,23 @@ def test_a_missing_task_diagram_is_bad_input_found_before_anything_runs(tmp_path
     with pytest.raises(MissingDiagram, match=r"manipulate\.yaml: task diagram not found"):
         reproduce(tmp_path / "out", tmp_path / "diagrams")
     assert not (tmp_path / "out").exists()
+
+
+def test_fig14_legend_names_the_unsuppressed_run_as_such():
+    """The panel without suppresser plots the reflex's torque as applied, labelled so."""
+    import blocks
+    from matplotlib.figure import Figure
+
+    from hierhand.tasks.figures import _torque_axes
+    from hierhand.tasks.summaries import TaskBlocks
+
+    labels = {}
+    for task in ("regrasp", "regrasp_unsuppressed"):
+        results = blocks.simulate(blocks.load_diagram(ROOT / "diagrams" / f"{task}.yaml"), t_end=0.01)
+        ax = Figure().add_subplot()
+        _torque_axes(ax, results, 3, TaskBlocks(), "Fig. 14")
+        labels[task] = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert "grasp torque applied (after the suppresser)" in labels["regrasp"]
+    unsuppressed = " | ".join(labels["regrasp_unsuppressed"])
+    assert "unsuppressed" in unsuppressed and "(suppressed)" not in unsuppressed
+    assert "after the suppresser" not in unsuppressed
