@@ -97,6 +97,12 @@ class Block:
       then holds its initial value at t = 0, see ``Schedule.initial_held``).
     - ``time_varying``: the outputs depend on ``t`` itself (sources such as Step).
 
+    and may describe what a port's values are, for files, plots and ``hierhand blocks``:
+    ``port_units(port)`` (the unit: ``"rad"``, ``"N m"``, ``"1"`` for a dimensionless
+    value; one per element where they differ; None, the default, when unknown) and
+    ``element_labels(port)`` (names of a vector port's elements: ``thumb.1``, ``x``).
+    run.json records both for every logged signal that has them.
+
     and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
     Parameters are the keyword arguments of ``__init__``, with their defaults; the
     ``Parameters`` section (numpydoc) of the class docstring documents them, which
@@ -218,10 +224,20 @@ class Block:
         return None
 
     def element_labels(self, port: str) -> list[str] | None:
-        """Names of the elements of output ``port``, one per element (``["1", "2"]`` or
-        ``["1,1", "1,2", ...]``), for the CSV columns ``signal[label]``; None, the
-        default, numbers them from 0. A block whose elements have names of their own (an
-        FMU's ``y[1]``, ``y[2]``) returns them so that files keep them."""
+        """Names of the elements of port ``port``, one per element (``["1", "2"]``,
+        ``["1,1", "1,2", ...]``, ``["thumb.1", "thumb.2", ...]``), for the CSV columns
+        ``signal[label]``, the legends of plots and ``hierhand blocks``; None, the default,
+        numbers them from 0. A block whose elements have names of their own (an FMU's
+        ``y[1]``, ``y[2]``, a hand's fingers) returns them so that files keep them."""
+        return None
+
+    def port_units(self, port: str) -> str | list[str] | None:
+        """The unit of port ``port`` (input or output): one string for all its elements
+        (``"rad"``, ``"N m"``, ``"m/s"``, ``"1"`` for a dimensionless value or a flag), or
+        a list of one string per element where they differ (``["m", "m", "rad"]`` for a
+        pose; ``""`` for an element of unknown unit); None, the default, when the block
+        does not know. Plots put it beside the signal's name and run.json keeps it
+        (``units``); it is information for people, not checked against connections."""
         return None
 
     def describe(self) -> str:
@@ -288,6 +304,21 @@ class Block:
 
     def has_feedthrough(self) -> bool:
         return any(self.reads(p) for p in self.outputs)
+
+
+def checked_units(units: Any, width: int | None, port: str) -> str | list[str] | None:
+    """``Block.port_units`` as files keep it: None, one string, or one string per element
+    (a list whose elements are all alike becomes that one string); ValueError for anything
+    else, or a list whose length is not ``width`` (not checked when ``width`` is None)."""
+    if units is None or isinstance(units, str):
+        return units
+    if not isinstance(units, (list, tuple)) or not all(isinstance(u, str) for u in units):
+        raise ValueError(f"the units of '{port}' must be a string or a list of strings, got {units!r}")
+    if width is not None and len(units) != width:
+        raise ValueError(f"{len(units)} units for the {width} elements of '{port}'")
+    if units and all(u == units[0] for u in units):
+        return units[0]
+    return list(units)
 
 
 @functools.cache

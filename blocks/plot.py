@@ -10,14 +10,18 @@ import numpy as np
 
 from .results import Results
 
-AXES_PER_PAGE = 8
-MAX_LEGEND = 12
-TITLE_WIDTH = 100
+AXES_PER_PAGE = 6
+MAX_LEGEND = 24
+LEGEND_ROWS = 12
+FIGURE_WIDTH = 11.0
+AXES_HEIGHT = 2.3
+TITLE_WIDTH = 110
+STOP_MARGIN = 0.02
 
 
 def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | None = None,
                  title: str | None = None) -> list[Path]:
-    """Write PNG(s) of ``signals`` (default all) to ``path``; more than 8 signals make pages.
+    """Write PNG(s) of ``signals`` (default all) to ``path``; more than 6 signals make pages.
 
     Discrete signals hold between samples, so they are drawn as steps; a signal's last
     value is held to the run's end time (where a block ended it, if one did, as the title
@@ -48,25 +52,45 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
 
 
 def figure(results: Results, names: Sequence[str], title: str | None = None):
-    """One page: an axis per signal of ``names``, over the time the run covered."""
+    """One page: an axis per signal of ``names``, over the time the run covered.
+
+    Each axis is labelled with the signal's name and unit; its legend, right of the axis,
+    names the elements as the block does (``thumb.1``), each with its unit where they
+    differ. Elements named ``group.member`` share a colour per group and a line style per
+    member, so nine joints read as three fingers of three. The time axis spans the data:
+    from the first sample to the end time, or to where a failed or interrupted run stopped,
+    which a dashed line marks, with a dot on each element's last sample."""
     import matplotlib.pyplot as plt
 
     end, stop = time_span(results)
-    fig, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False, figsize=(9, 1.2 + 2.0 * len(names)))
+    firsts = [float(results[n][0][0]) for n in names if len(results[n][0])]
+    start = min(firsts, default=0.0)
+    fig, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False, layout="constrained",
+                             figsize=(FIGURE_WIDTH, 1.0 + AXES_HEIGHT * len(names)))
     for ax, name in zip(axes[:, 0], names):
         t, v = results[name]
+        last_t, last_v = (t[-1], v[-1]) if len(t) else (None, None)
         if end is not None and len(t) and t[-1] < end:
             t, v = np.append(t, end), np.vstack([v, v[-1:]])
         width = v.shape[1]
-        labels = results.element_labels(name) or [str(j) for j in range(width)]
+        labels = results.element_labels(name) or [f"[{j}]" for j in range(width)]
+        units = results.units(name)
+        mixed = units is not None and len(set(units)) > 1
+        styles = line_styles(labels)
         for j in range(width):
-            ax.step(t, v[:, j], where="post", label=f"[{labels[j]}]" if width > 1 else None, lw=1.2)
+            label = labels[j] + (f" ({units[j] or '?'})" if mixed else "") if width > 1 else None
+            ax.step(t, v[:, j], where="post", label=label, **styles[j])
         if stop is not None:
             ax.axvline(stop, color="tab:red", ls="--", lw=1.0)
-        ax.set_ylabel(name, rotation=0, ha="right", va="center")
+            if last_t is not None:
+                ax.scatter(np.full(width, last_t), last_v, s=18, color="tab:red", zorder=5, clip_on=False)
+        ax.set_ylabel(axis_label(name, units))
         ax.grid(True, alpha=0.3)
         if 1 < width <= MAX_LEGEND:
-            ax.legend(loc="upper right", fontsize="small", ncol=min(width, 6))
+            ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
+                      ncol=1 if width <= LEGEND_ROWS else 2, borderaxespad=0.0, handlelength=2.5)
+    if end is not None and end > start:  # past a stop a little, so that its line and dots show
+        axes[0, 0].set_xlim(start, end + (STOP_MARGIN * (end - start) if stop is not None else 0.0))
     if stop is not None:
         axes[0, 0].annotate(results.status.split(": ", 1)[0], xy=(stop, 1.0), xycoords=("data", "axes fraction"),
                             xytext=(0, 3), textcoords="offset points", ha="right", va="bottom",
@@ -77,8 +101,43 @@ def figure(results: Results, names: Sequence[str], title: str | None = None):
     if note:
         heading += "\n" + textwrap.fill(f"[{note}]", TITLE_WIDTH)
     fig.suptitle(heading)
-    fig.tight_layout()
     return fig
+
+
+def axis_label(name: str, units: Sequence[str] | None) -> str:
+    """'name' over '(unit)': the shared unit, the distinct ones where elements differ, and
+    '(dimensionless)' for ``1``; the name alone when the block gave no units."""
+    if not units:
+        return name
+    distinct = list(dict.fromkeys(u or "?" for u in units))
+    text = "dimensionless" if distinct == ["1"] else ", ".join(distinct)
+    return f"{name}\n({text})"
+
+
+LINE_STYLES = ("-", "--", ":", "-.")
+
+
+def line_styles(labels: Sequence[str]) -> list[dict]:
+    """Colour, line style and width per element: for labels ``group.member`` (``thumb.1``,
+    ``fore.x``) with at most 10 groups of at most 4 members, a colour per group and a
+    style per member; otherwise the colour cycle (solid, then dashed past 10). Earlier
+    colours draw wider, so that a line another one covers (two fingers both in contact)
+    still shows at its edges."""
+    parts = [label.split(".", 1) for label in labels]
+    if len(labels) > 1 and all(len(p) == 2 for p in parts):
+        groups = list(dict.fromkeys(p[0] for p in parts))
+        members = list(dict.fromkeys(p[1] for p in parts))
+        if 1 < len(groups) <= 10 and len(members) <= len(LINE_STYLES):
+            return [{"color": f"C{groups.index(g)}", "ls": LINE_STYLES[members.index(m)],
+                     "lw": _width(groups.index(g), len(groups))} for g, m in parts]
+    n = min(len(labels), 10)
+    return [{"color": f"C{j % 10}", "ls": LINE_STYLES[(j // 10) % len(LINE_STYLES)], "lw": _width(j % 10, n)}
+            for j in range(len(labels))]
+
+
+def _width(k: int, n: int) -> float:
+    """Line width of colour ``k`` of ``n``: from 2.2 for the first down to 1.0 for the last."""
+    return 1.1 if n <= 1 else 2.2 - 1.2 * k / (n - 1)
 
 
 def time_span(results: Results) -> tuple[float | None, float | None]:

@@ -167,6 +167,22 @@ class Results:
         width = self[name][1].shape[1]
         return [str(label) for label in labels] if labels is not None and len(labels) == width else None
 
+    def units(self, name: str) -> list[str] | None:
+        """The unit of each element of signal ``name`` (run.json's ``units``, which holds
+        one string for a signal whose elements share a unit), ``""`` for an element of
+        unknown unit; None when its block gave no units."""
+        units = (self.info.get("units") or {}).get(name)
+        width = self[name][1].shape[1]
+        if isinstance(units, str):
+            return [units] * width
+        return [str(u) for u in units] if isinstance(units, list) and len(units) == width else None
+
+    def unit(self, name: str) -> str | None:
+        """The unit all elements of signal ``name`` share (``"rad"``, ``"N m"``, ``"1"``);
+        None when its block gave none or its elements differ (see ``units``)."""
+        units = self.units(name)
+        return units[0] if units and units[0] and all(u == units[0] for u in units) else None
+
     def write_csv(self, f) -> None:
         """Columns ``time`` (every logged sample time) and each signal held at those times.
 

@@ -26,7 +26,7 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
-from .block import BlockError, EndRun
+from .block import BlockError, EndRun, checked_units
 from .compiled import CompiledSide, Runner
 from .diagram import Diagram
 from .issues import DiagramError
@@ -578,6 +578,7 @@ class _Run:
         failure: _StepFailure | None = None
         interrupted: KeyboardInterrupt | None = None
         labels: dict[str, list[str]] = {}
+        units: dict[str, str | list[str]] = {}
         k = 0
         initial = self.compile(self.s.initial).function
         try:
@@ -585,6 +586,7 @@ class _Run:
                 name, exc = self.compiled.failure
                 raise _StepFailure(name, "kernel", 0, exc)
             labels = self.element_labels()
+            units = self.port_units()
             spans = self.spans()
             initial(0, min(spans[0][0], n) if spans else n)
             n = self.end_tick
@@ -632,7 +634,7 @@ class _Run:
             t_stop = t_fail
         else:
             t_stop = None if ended_by is None else ended_by["time"]
-        info = self.info(status, wall, t_stop, ended_by, labels)
+        info = self.info(status, wall, t_stop, ended_by, labels, units)
         results = Results(self.collect_through_interrupt(), info)
         if failure is not None:
             return results, SimulationError(status, results, failure.block, t_fail,
@@ -677,6 +679,24 @@ class _Run:
             found[e.signal] = labels
         return found
 
+    def port_units(self) -> dict[str, str | list[str]]:
+        """The units of the logged signals whose blocks know them (``Block.port_units``),
+        checked once at the start: a string, or one string per element."""
+        found = {}
+        for e in self.d.log:
+            blk = self.d.blocks[e.block].block
+            try:
+                units = blk.port_units(e.port)
+                try:
+                    units = checked_units(units, blk.outputs[e.port], e.port)
+                except ValueError as exc:
+                    raise BlockError(str(exc), port=e.port) from None
+            except Exception as exc:
+                raise _StepFailure(e.block, "port_units", 0, exc) from exc
+            if units is not None:
+                found[e.signal] = units
+        return found
+
     def collect_through_interrupt(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """``collect``, once more if an interrupt cuts it short: the signals are all there
         is of the run (a program that defers later interrupts lets the second try finish)."""
@@ -697,8 +717,9 @@ class _Run:
         return signals
 
     def info(self, status: str, wall: float, t_stop: float | None, ended_by: dict | None,
-             labels: dict[str, list[str]]) -> dict:
-        """run.json's record of the run (``element_labels`` only when a block names elements)."""
+             labels: dict[str, list[str]], units: dict[str, str | list[str]]) -> dict:
+        """run.json's record of the run (``element_labels`` only when a block names elements,
+        ``units`` only when a block knows the units of a logged signal)."""
         simulated = float(self.t_end) if t_stop is None else t_stop
         info = {
             "diagram": self.d.name,
@@ -718,6 +739,8 @@ class _Run:
         }
         if labels:
             info["element_labels"] = labels
+        if units:
+            info["units"] = units
         return info
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import inspect
 
-from .block import Block
+from .block import Block, checked_units
 from .paramdocs import parameter_docs
 
 
@@ -41,14 +41,45 @@ def describe_type(cls: type[Block]) -> str:
             return ", ".join(f"{p}[{'n' if w is None else w}]" for p, w in d.items()) or "none"
 
         optional = f" (optional: {', '.join(block.input_defaults)})" if block.input_defaults else ""
-        lines.append(f"  inputs: {ports(block.inputs)}{optional}")
-        lines.append(f"  outputs: {ports(block.outputs)}")
+        details = {p: _port_details(block, p, w) for p, w in (*block.inputs.items(), *block.outputs.items())}
+        if any(details.values()):  # a port per line, with its unit and elements
+            shown = {p: f"{p}[{'n' if w is None else w}]" for p, w in (*block.inputs.items(), *block.outputs.items())}
+            pad = max(map(len, shown.values()))
+            for what, d, extra in (("inputs", block.inputs, optional), ("outputs", block.outputs, "")):
+                lines.append(f"  {what}{extra}:" if d else f"  {what}: none")
+                lines += [f"    {shown[p]:<{pad}}  {details[p]}".rstrip() for p in d]
+        else:
+            lines.append(f"  inputs: {ports(block.inputs)}{optional}")
+            lines.append(f"  outputs: {ports(block.outputs)}")
         lines.append(f"  feedthrough: {_feedthrough(block.feedthrough)}")
         if block.initial_feedthrough is not None:
             lines.append(f"  feedthrough at t = 0: {_feedthrough(block.initial_feedthrough)}")
     if cls.time_varying:
         lines.append("  time-varying source: needs a period")
     return "\n".join(lines)
+
+
+def unit_text(unit: str) -> str:
+    """A unit as people read it: ``1`` (a ratio, a flag) as "1 (dimensionless)"."""
+    return "1 (dimensionless)" if unit == "1" else unit
+
+
+def _port_details(block: Block, port: str, width: int | None) -> str:
+    """A port's unit and element names, "rad; elements thumb.1, thumb.2, ..." (each element
+    with its own unit where they differ: "x (m), y (m), theta (rad)"); "" if it has neither."""
+    try:
+        units = checked_units(block.port_units(port), width, port)
+        labels = block.element_labels(port)
+    except Exception:  # a block whose example cannot say: list the port bare
+        return ""
+    labels = [str(x) for x in labels] if labels is not None and (width is None or len(labels) == width) else None
+    if isinstance(units, list):
+        names = labels or [f"[{i}]" for i in range(len(units))]
+        return ", ".join(f"{n} ({u or 'unit unknown'})" for n, u in zip(names, units))
+    parts = [unit_text(units)] if units else []
+    if labels:
+        parts.append("elements " + ", ".join(labels))
+    return "; ".join(parts)
 
 
 def _feedthrough(ft) -> str:

@@ -24,7 +24,8 @@ names: FMI 2's Real is Float64, its Integer Int32), so ``validate`` lists connec
 between different types with their rules. Scalars named ``x[1]``, ``x[2]``, ... (and
 ``A[1,1]``, ``A[1,2]``, ... row-major) form one vector port ``x``; an FMI 3 array variable
 is one port of its flattened size; ``element_labels`` keeps the FMU's indices for the CSV
-columns. The indices must start at 1 and have no gaps. Port names are the variable (or
+columns, and ``port_units`` the variables' units (their ``unit`` or their declared
+type's). The indices must start at 1 and have no gaps. Port names are the variable (or
 vector) names with every character other than letters, digits and ``_`` replaced by
 ``_`` (``body.v[2]`` -> port ``body_v``). FMI 3 ``<Alias>`` outputs are ports of their own.
 String, Binary and Clock variables are not ports (``port_hint`` says so when a diagram

@@ -167,6 +167,12 @@ class FMU(Block):
         spec = self._model.inputs.get(port) or self._model.outputs.get(port)
         return spec.labels if spec is not None else None
 
+    def port_units(self, port: str) -> str | list[str] | None:
+        """The unit the modelDescription gives the variable(s) behind a port (their own
+        ``unit`` or their declared type's); None where it gives none."""
+        spec = self._model.inputs.get(port) or self._model.outputs.get(port)
+        return spec.units if spec is not None else None
+
     def input_rule(self, port: str) -> str | None:
         spec = self._model.inputs.get(port)
         return None if spec is None or spec.kind.name == "Float64" else spec.kind.input_rule()

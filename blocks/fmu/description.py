@@ -60,6 +60,17 @@ class FMUDescription:
         return step if step is not None and step > 0 else None
 
 
+def variable_unit(v: Any) -> str | None:
+    """The unit of a variable as its modelDescription declares it: the ``unit`` attribute of
+    a Real (FMI 2) or Float32/Float64 (FMI 3) variable, else that of its declared type
+    (FMI 2 ``<SimpleType><Real unit=...>``, FMI 3 ``<Float64Type unit=...>``); None when
+    neither gives one (and for integer, Boolean and other variables, which have no unit)."""
+    unit = getattr(v, "unit", None)
+    if not unit and getattr(v, "declaredType", None) is not None:
+        unit = getattr(v.declaredType, "unit", None)
+    return str(unit) if unit else None
+
+
 def read_description(path: str | Path, shown: str, validate: bool = True) -> FMUDescription:
     """The modelDescription of the FMU archive ``path`` (``shown`` names it in messages),
     checked against the FMI schema if ``validate``; FMUInfoError if it cannot be read."""
@@ -122,7 +133,7 @@ def describe_fmu(path: str | Path) -> str:
     lines.append(f"    {'name':<{width}}  {'causality':<15} {'variability':<12} {'type':<8} start")
     for v in md.modelVariables:
         start = "" if v.start is None else str(v.start)
-        unit = f" {v.unit}" if getattr(v, "unit", None) else ""
+        unit = f" {variable_unit(v)}" if variable_unit(v) else ""
         lines.append(f"    {v.name:<{width}}  {v.causality or '':<15} {v.variability or '':<12} "
                      f"{v.type:<8} {start}{unit}")
     return "\n".join(lines)

@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from .description import variable_unit
 from .port_types import KINDS, PortKind
 
 _INDEXED = re.compile(r"^(?P<base>.*[^\s])\[(?P<index>\s*\d+\s*(?:,\s*\d+\s*)*)\]$")
@@ -36,6 +37,7 @@ class Port:
     width: int
     source: str               # the variable or vector name in the FMU, for messages
     labels: list[str] | None = None   # the FMU's own element indices ("1", "1,2"), if a vector
+    units: str | list[str] | None = None  # the variables' units (one per element where they differ)
 
 
 @dataclass
@@ -84,7 +86,7 @@ def group_variables(variables: list, what: str, fmu: str, major: int) -> dict[st
             if width < 1:
                 raise ValueError(f"{what} '{v.name}' of {fmu} is an array of size 0")
             port = Port(port_name(base), KINDS[major][v.type], [v.valueReference], width, v.name,
-                        _array_labels(v) if width > 1 else None)
+                        _array_labels(v) if width > 1 else None, variable_unit(v))
         else:
             port = _vector_port(base, items, what, fmu, major)
         if port.name in ports:
@@ -127,8 +129,17 @@ def _vector_port(base: str, items: list[tuple[tuple[int, ...] | None, Any]], wha
     if len(kinds) > 1:
         raise ValueError(f"{what}s of {fmu}: vector '{base}' mixes the types "
                          f"{', '.join(sorted(kinds))}")
+    units = [variable_unit(v) for _, v in items]
     return Port(port_name(base), KINDS[major][items[0][1].type], [v.valueReference for _, v in items],
-                len(items), f"{base}[...]", [",".join(map(str, i)) for i in indices])
+                len(items), f"{base}[...]", [",".join(map(str, i)) for i in indices], _port_units(units))
+
+
+def _port_units(units: list[str | None]) -> str | list[str] | None:
+    """The units of a vector port's scalars: one string if they share it, None if none has
+    one, else one string per element ("" where a scalar has none)."""
+    if all(u == units[0] for u in units):
+        return units[0]
+    return [u or "" for u in units]
 
 
 def _array_labels(v: Any) -> list[str]:

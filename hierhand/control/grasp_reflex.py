@@ -56,6 +56,7 @@ from blocks.kernel import Kernel, address
 
 from ..kernels import KERNELS, context, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
+from ..model.port_info import DescribesHandPorts
 from .reflex_kernel import (
     N_OUT,
     WHOLE_SHARE,
@@ -82,7 +83,7 @@ def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray
     return np.array([n in chosen for n in names])
 
 
-class GraspReflex(ModelsTheHand, Block):
+class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
     """Grasping reflex: internal forces among the fingers in contact, kept inside the
     friction cone at the safety ratio by integral control of the fingertip forces.
 

@@ -34,6 +34,7 @@ from blocks.kernel import Kernel, address
 
 from ..kernels import KERNELS, context, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
+from ..model.port_info import DescribesHandPorts
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
@@ -42,7 +43,7 @@ DERIVATIVE_STEP = 1e-3
 """Seconds either side of t for the joint-velocity target (central difference of the IK)."""
 
 
-class ManipulationPD(ModelsTheHand, Block):
+class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
     """Manipulation controller: fingertip trajectories -> inverse kinematics -> joint PD.
 
     Its hand (finger geometry and q0, gravity, the object's mass for the load

@@ -14,6 +14,7 @@ from blocks.arrays import flat_float64, float_array
 from blocks.kernel import Kernel, address
 
 from ..kernels import KERNELS
+from ..model.port_info import DescribesHandPorts
 
 from .suppresser_kernel import (
     N_OUT,
@@ -28,7 +29,7 @@ from .suppresser_kernel import (
 )
 
 
-class Suppresser(Block):
+class Suppresser(DescribesHandPorts, Block):
     """Actuator command ``tau = tau_g * sigmoid(S_a (S_b - g(tau_m))) + tau_m`` per joint.
 
     An optional input ``tau_ff`` (zero when unconnected) is added to the command

@@ -50,6 +50,7 @@ from .layout import (
     W_TIP_M,
     anchor_offset,
 )
+from .port_info import DescribesHandPorts
 
 _PORT_SLICES = []  # (port, its columns in an output row)
 _offset = 0
@@ -89,7 +90,7 @@ class ContactWrenches:
     tip: np.ndarray  # (3, 3) tip centre x, y and link-3 angle
 
 
-class HandPlant(Block):
+class HandPlant(DescribesHandPorts, Block):
     """Three-fingered planar hand grasping a square object, with the paper's contact law;
     the diagram's one hand, which the other blocks use by naming this block (hand: plant).
 

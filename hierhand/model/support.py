@@ -18,9 +18,10 @@ from blocks.kernel import Kernel, address
 
 from ..kernels import KERNELS
 from .hand_source import ModelsTheHand, hand_of
+from .port_info import DescribesHandPorts
 
 
-class ObjectSupport(ModelsTheHand, Block):
+class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
     """The force of a support carrying the object's weight, removed at ``until``.
 
     Output ``y`` in the plant's ``f_ext`` layout (fx, fy, torque about the object's

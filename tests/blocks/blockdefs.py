@@ -299,15 +299,20 @@ class EndInOutput(Block):
 
 
 class Labelled(Block):
-    """y = [1, 2, ..., width] with the elements named by ``labels`` (None: numbered from 0)."""
+    """y = [1, 2, ..., width] with the elements named by ``labels`` (None: numbered from 0)
+    and the unit(s) ``units`` (None: unknown)."""
 
-    def __init__(self, labels=None, width: int = 3):
+    def __init__(self, labels=None, width: int = 3, units=None):
         self.labels = labels
+        self.units = units
         self.outputs = {"y": width}
         self.feedthrough = False
 
     def element_labels(self, port):
         return self.labels
+
+    def port_units(self, port):
+        return self.units
 
     def output(self, t, state, inputs):
         return {"y": np.arange(1.0, self.outputs["y"] + 1)}

@@ -64,3 +64,80 @@ def test_plot_signals_writes_one_png_per_page(tmp_path):
     written = plot_signals(many, tmp_path / "p.png")
     assert [p.name for p in written] == ["p-1.png", "p-2.png"]
     assert all(p.read_bytes()[:4] == b"\x89PNG" for p in written)
+
+
+def described(status: str = "complete", **info) -> Results:
+    """q (width 3, rad, elements thumb.1 ...) every 1 ms from 1 ms to 5 ms; pose (x m, y m,
+    theta rad) every 2 ms; r (width 1, no units); t_end 5 ms."""
+    t_q, t_p = np.arange(1, 6) * 1e-3, np.arange(3) * 2e-3
+    signals = {"b.q": (t_q, np.column_stack([t_q, 2 * t_q, 3 * t_q])), "b.pose": (t_p, np.ones((3, 3))),
+               "b.r": (t_q, t_q[:, None])}
+    return Results(signals, {"diagram": "d", "status": status, "t_end": 0.005,
+                             "element_labels": {"b.q": ["thumb.1", "thumb.2", "fore.1"],
+                                                "b.pose": ["x", "y", "theta"]},
+                             "units": {"b.q": "rad", "b.pose": ["m", "m", "rad"]}, **info})
+
+
+def legend_texts(ax) -> list[str]:
+    return [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_axes_name_signal_and_unit_and_legends_name_the_elements_outside_the_data():
+    fig = figure(described(), ["b.q", "b.pose", "b.r"])
+    try:
+        q, pose, r = fig.axes
+        assert q.get_ylabel() == "b.q\n(rad)"
+        assert pose.get_ylabel() == "b.pose\n(m, rad)"
+        assert r.get_ylabel() == "b.r" and r.get_legend() is None  # one element, no units: the name alone
+        assert legend_texts(q) == ["thumb.1", "thumb.2", "fore.1"]
+        assert legend_texts(pose) == ["x (m)", "y (m)", "theta (rad)"]  # each with its unit where they differ
+        for ax in (q, pose):
+            anchor = ax.get_legend().get_bbox_to_anchor().transformed(ax.transAxes.inverted())
+            assert anchor.x0 > 1.0  # right of the axes, off the data
+        colours = [line.get_color() for line in q.get_lines()]
+        styles = [line.get_linestyle() for line in q.get_lines()]
+        assert colours[0] == colours[1] != colours[2] and styles[0] != styles[1]  # thumb.1, thumb.2: one finger
+        assert q.get_xlim() == pytest.approx((0.0, 0.005))  # the data's span: no margins
+    finally:
+        plt.close(fig)
+    fig = figure(described(), ["b.q"])
+    try:
+        assert fig.axes[0].get_xlim() == pytest.approx((0.001, 0.005))  # from the first sample
+    finally:
+        plt.close(fig)
+
+
+def test_dimensionless_signals_say_so():
+    r = Results({"a.ratio": (np.arange(3.0), np.ones((3, 1)))}, {"diagram": "d", "units": {"a.ratio": "1"}})
+    fig = figure(r, ["a.ratio"])
+    try:
+        assert fig.axes[0].get_ylabel() == "a.ratio\n(dimensionless)"
+    finally:
+        plt.close(fig)
+
+
+def test_a_failed_run_marks_the_last_sample_of_every_element():
+    fig = figure(described(FAILED, t_stop=0.005), ["b.q", "b.pose"])
+    try:
+        q, pose = fig.axes
+        (dots,) = q.collections
+        np.testing.assert_allclose(dots.get_offsets(), [[0.005, 0.005], [0.005, 0.010], [0.005, 0.015]])
+        (dots,) = pose.collections
+        np.testing.assert_allclose(dots.get_offsets()[:, 0], [0.004] * 3)  # its last sample, before the stop
+        assert 0.005 < q.get_xlim()[1] < 0.0052  # a little past the stop, so that the marks show
+        assert "failed at t=0.005 s" in fig._suptitle.get_text()
+    finally:
+        plt.close(fig)
+
+
+def test_a_complete_run_has_no_marks():
+    fig = figure(described(), ["b.q"])
+    try:
+        assert len(fig.axes[0].collections) == 0 and stop_lines(fig.axes[0]) == []
+    finally:
+        plt.close(fig)
+
+
+def test_plot_signals_writes_the_png(tmp_path):
+    (written,) = plot_signals(described(), tmp_path / "plots" / "s.png")
+    assert written == tmp_path / "plots" / "s.png" and written.read_bytes()[:4] == b"\x89PNG"

@@ -266,3 +266,51 @@ def test_element_labels_of_the_wrong_length_fail_the_run_at_its_start():
     assert r.status == ("failed at t=0 s: block 'named' (Labelled), signal named.y element_labels: "
                         "2 labels for the 3 elements of 'y'")
     assert len(r["named.y"][0]) == 0
+
+
+UNITS = """
+time: {t_end: 2 ms}
+blocks:
+  same: {type: "python:tests.blocks.blockdefs:Labelled", period: 1 ms, params: {units: N m}}
+  mixed: {type: "python:tests.blocks.blockdefs:Labelled", period: 1 ms,
+          params: {labels: [x, y, theta], units: UNITS}}
+  plain: {type: "python:tests.blocks.blockdefs:Labelled", period: 1 ms, params: {width: 2}}
+log: [same.y, mixed.y, plain.y]
+"""
+
+
+def units_run(units: str) -> Results:
+    return blocks.simulate(blocks.loads_diagram(UNITS.replace("UNITS", units), trust=True))
+
+
+def test_run_json_keeps_the_units_blocks_give_and_results_read_them_back(tmp_path):
+    r = units_run("[m, m, rad]")
+    assert r.complete, r.status
+    assert r.info["units"] == {"same.y": "N m", "mixed.y": ["m", "m", "rad"]}
+    r.save(tmp_path, csv=True)
+    assert json.loads((tmp_path / "run.json").read_text())["units"] == r.info["units"]
+    again = Results.load(tmp_path)
+    assert again.units("same.y") == ["N m"] * 3 and again.unit("same.y") == "N m"
+    assert again.units("mixed.y") == ["m", "m", "rad"] and again.unit("mixed.y") is None
+    assert again.units("plain.y") is None and again.unit("plain.y") is None
+    header, _ = read_csv(tmp_path / "signals.csv")  # the CSV's columns are as before: units live in run.json
+    assert header[1:4] == ["same.y[0]", "same.y[1]", "same.y[2]"] and header[4:7] == ["mixed.y[x]", "mixed.y[y]",
+                                                                                       "mixed.y[theta]"]
+
+
+def test_a_list_of_one_unit_is_kept_as_that_unit():
+    assert units_run("[m, m, m]").info["units"]["mixed.y"] == "m"
+
+
+@pytest.mark.parametrize("units, problem", [
+    ("[m, rad]", "2 units for the 3 elements of 'y'"),
+    ("[m, 1, rad]", "the units of 'y' must be a string or a list of strings, got ['m', 1, 'rad']"),
+])
+def test_units_that_do_not_fit_the_port_fail_the_run_at_its_start(units, problem):
+    r = units_run(units)
+    assert r.status == f"failed at t=0 s: block 'mixed' (Labelled), signal mixed.y port_units: {problem}"
+
+
+def test_results_without_units_in_run_json_have_none():
+    r = two_rate_results()
+    assert r.units("b.y") is None and r.unit("a.y") is None

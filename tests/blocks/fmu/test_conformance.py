@@ -322,3 +322,26 @@ def test_fmu_info_lists_every_variable_type(typed):
     text = describe_fmu(typed[3])
     for kind in ("UInt64", "Int8", "Boolean", "Enumeration", "Binary", "Clock"):
         assert f" {kind}" in text
+
+
+def test_port_units_come_from_the_variables_or_their_declared_types(typed, tmp_path):
+    fmu2 = fmu_diagram(typed[2], {}, []).blocks["fmu"].block
+    assert fmu2.port_units("r_in") == "rad"  # FMI 2 <SimpleType name="Angle"><Real unit="rad"/>
+    assert fmu2.port_units("r_out") == "m"  # <Real unit="m"/>
+    assert fmu2.port_units("i_out") is None and fmu2.port_units("time_out") is None
+    d3 = fmu_diagram(typed[3], {"c": 1.0}, ["c.y -> fmu.f_in"], log="[fmu.m_out, fmu.time_out, fmu.i8_out]")
+    fmu3 = d3.blocks["fmu"].block
+    assert fmu3.port_units("f_in") == "rad" and fmu3.port_units("time_out") == "s"
+    assert fmu3.port_units("m_out") == "m"  # FMI 3 <Float64Type name="Length" unit="m"/>, an array
+    simulate(d3).save(tmp_path)
+    again = Results.load(tmp_path)
+    assert again.info["units"] == {"fmu.m_out": "m", "fmu.time_out": "s"}
+    assert again.units("fmu.m_out") == ["m"] * 4 and again.unit("fmu.time_out") == "s"
+    assert again.units("fmu.i8_out") is None
+
+
+def test_fmu_info_shows_units_of_declared_types(typed):
+    from blocks.fmu import describe_fmu
+
+    lines = describe_fmu(typed[2]).splitlines()
+    assert next(line for line in lines if line.strip().startswith("r_in ")).endswith(" rad")

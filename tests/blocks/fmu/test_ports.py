@@ -26,3 +26,16 @@ def test_grouping_rules():
         group_variables([var("a.b", 1), var("a_b", 2)], "input", "F", 2)
     with pytest.raises(ValueError, match="indices must start at 1"):
         group_variables([var("x[0]", 1), var("x[1]", 2)], "input", "F", 2)
+
+
+def test_vector_ports_take_the_units_of_their_scalars():
+    def var(name, vr, unit=None, declared=None):
+        return V(name=name, valueReference=vr, type="Real", dimensions=[], shape=(), unit=unit,
+                 declaredType=None if declared is None else V(unit=declared))
+
+    ports = group_variables([var("p[1]", 1, "m"), var("p[2]", 2, declared="m"),  # own unit or its type's
+                             var("pose[1]", 3, "m"), var("pose[2]", 4, "rad"), var("pose[3]", 5),
+                             var("n[1]", 6), var("n[2]", 7), var("s", 8, declared="s")], "output", "F", 2)
+    assert ports["p"].units == "m"
+    assert ports["pose"].units == ["m", "rad", ""]  # "" where a scalar declares none
+    assert ports["n"].units is None and ports["s"].units == "s"
