@@ -10,7 +10,6 @@ from hypothesis import strategies as st
 from hierhand.control import Trajectory
 
 from . import oracles
-from .oracles import minjerk, minjerk_rate
 
 WAYPOINTS = [
     (0.1, 0.03, 0.06, 3.0),

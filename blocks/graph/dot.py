@@ -1,0 +1,84 @@
+"""The wiring as Graphviz DOT text: record-shaped blocks, port-to-port edges, rate colours and a legend."""
+
+from __future__ import annotations
+
+from ..diagram import Diagram
+from ..schedule import Schedule
+from .layout import layered
+from .ports import input_ports, output_ports
+from .rates import RateColors, rate_colors, rate_line, tint
+
+
+def dot_quoted(text: str) -> str:
+    """``text`` as a DOT double-quoted string: backslashes and quotes escaped, line breaks
+    as ``\\n``, so that a diagram's free-form name cannot break the DOT file."""
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\r", "").replace("\n", "\\n")
+    return f'"{escaped}"'
+
+
+def record_text(text: str) -> str:
+    """``text`` as a field of a record label: the record's own characters escaped."""
+    out = []
+    for ch in text.replace("\r", ""):
+        if ch in '{}|<>"\\':
+            out.append("\\" + ch)
+        elif ch == "\n":
+            out.append("\\n")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+def port_id(direction: str, port: str) -> str:
+    """The record field name of a port: ``in_q``, ``out_tau`` (odd characters as ``_``)."""
+    return f"{direction}_" + "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in port)
+
+
+def record_label(diagram: Diagram, schedule: Schedule, rates: RateColors, name: str) -> str:
+    """``{{<in_a> a|...}|name\\ntype\\nrate|{<out_y> y|...}}`` (a side without ports left
+    out): with ``rankdir=LR`` the outer braces lay the three parts side by side, the inner
+    ones stack the ports."""
+    def ports(direction, names):
+        fields = "|".join(f"<{port_id(direction, p)}> {record_text(p)}" for p in names)
+        return [f"{{{fields}}}"] if fields else []
+    middle = "\\n".join(record_text(t) for t in
+                        (name, diagram.blocks[name].type_name, rate_line(schedule, rates, name)))
+    parts = ports("in", input_ports(diagram, name)) + [middle] + ports("out", output_ports(diagram, name))
+    return "{" + "|".join(parts) + "}"
+
+
+def to_dot(diagram: Diagram, schedule: Schedule) -> str:
+    """Graphviz DOT text: blocks as records with their ports, wires port to port,
+    coloured by rate, with a legend node of the rates."""
+    rates = rate_colors(diagram, schedule)
+    layout = layered(diagram)
+    lines = [f"digraph {dot_quoted(diagram.name)} {{", "  rankdir=LR;", "  splines=true;", "  nodesep=0.4;",
+             '  node [shape=record, fontname="Helvetica", fontsize=10, style=filled];',
+             '  edge [fontname="Helvetica", fontsize=9, arrowsize=0.7];']
+    for name in diagram.blocks:
+        colour = rates.colors[name]
+        label = record_label(diagram, schedule, rates, name)
+        lines.append(f'  {dot_quoted(name)} [label="{label}", color="{colour}", fillcolor="{tint(colour)}", '
+                     "penwidth=1.6];")
+    feedback = set(layout.feedback)
+    for c in diagram.connections:
+        attrs = [f'color="{rates.colors[c.src_block]}"']
+        if c.delay:
+            attrs += ["style=dashed", 'label="z\u207b\u00b9"']
+        if c in feedback:
+            attrs.append("constraint=false")
+        lines.append(f"  {dot_quoted(c.src_block)}:{port_id('out', c.src_port)}:e -> "
+                     f"{dot_quoted(c.dst_block)}:{port_id('in', c.dst_port)}:w [{', '.join(attrs)}];")
+    rows = "".join(f'<tr><td bgcolor="{tint(colour, 0.35)}"><font color="{colour}">\u25a0</font> '
+                   f"{html_text(label)}</td></tr>" for label, colour in rates.legend)
+    legend_id = "rates (legend)"
+    while legend_id in diagram.blocks:
+        legend_id += " "
+    lines.append(f"  {dot_quoted(legend_id)} [shape=plaintext, style=solid, label=<<table border=\"0\" "
+                 f'cellborder="1" cellspacing="0"><tr><td><b>rates</b></td></tr>{rows}</table>>];')
+    lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def html_text(text: str) -> str:
+    return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
