@@ -106,6 +106,12 @@ class Diagram:
     source_hash: str
     t_end_line: int | None = None
     base_dir: Path = field(default_factory=Path.cwd)
+    files: dict[str, Path] = field(default_factory=dict)
+    """Every file the diagram read, by the reference it makes: its blocks' params files and
+    the files their path parameters name (an FMU's ``path``), as written relative to the
+    diagram's folder (``../fmu/X.fmu``) or absolute, and the ``python:`` modules it imported
+    from its folder (``mymod.py``); each maps to the path it was read from. What a copy of
+    the diagram needs elsewhere (``blocks.sweep.bundle``)."""
 
     def issue(self, line: int | None, message: str, hint: str = "") -> Issue:
         return Issue(self.file, line, message, hint)

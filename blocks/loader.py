@@ -26,7 +26,7 @@ from .issues import DiagramError, Issue
 from .limits import MAX_PORT_WIDTH
 from .param_paths import PathError, set_path
 from .references import build_order, chain_text
-from .registry import RegistryError, resolve_type
+from .registry import PYTHON_PREFIX, RegistryError, resolve_type
 from .safepath import inside
 from .timebase import DurationError, parse_duration
 from .widths import propagate_widths
@@ -38,6 +38,9 @@ BLOCK_KEYS = ("type", "period", "offset", "params", "params_file", "description"
 CONNECTION_KEYS = ("from", "to", "delay", "initial")
 LOG_KEYS = ("signal", "decimate")
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+CODE_DIR_KEY = "."
+"""The key of a ``files`` map that gives the diagram's folder itself: where ``python:``
+block types' modules are looked for (a diagram copied elsewhere, with its files)."""
 _ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
 
 
@@ -61,10 +64,14 @@ class _Entry:
     params: dict
     source: _ParamsFile | None = None
     references: dict[str, str] = field(default_factory=dict)
+    arguments: dict[str, str] = field(default_factory=dict)
+    """Constructor arguments that differ from ``params``: path parameters read from a
+    ``files`` map (``params`` keeps the path the diagram names)."""
 
 
 def read_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
-                 trust: bool = False, origins: Mapping[str, str] | None = None) -> Diagram:
+                 trust: bool = False, origins: Mapping[str, str] | None = None,
+                 files: Mapping[str, str | Path] | None = None) -> Diagram:
     """Read and validate a diagram file; the arguments are those of
     ``blocks.load.load_diagram``, which also plans the diagram."""
     path = Path(path)
@@ -76,16 +83,18 @@ def read_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
     except YamlSourceError as exc:
         raise DiagramError([Issue(str(path), exc.line, exc.message, exc.hint)]) from None
     return parse_diagram(text, filename=str(path), base_dir=path.parent, overrides=overrides, trust=trust,
-                         origins=origins)
+                         origins=origins, files=files)
 
 
 def parse_diagram(text: str, filename: str = "<diagram>", base_dir: str | Path | None = None,
                   overrides: Mapping[str, Any] | None = None, trust: bool = False,
-                  origins: Mapping[str, str] | None = None) -> Diagram:
+                  origins: Mapping[str, str] | None = None,
+                  files: Mapping[str, str | Path] | None = None) -> Diagram:
     """Validate a diagram from YAML text (``base_dir`` resolves ``params_file``); the
     arguments are those of ``blocks.load.loads_diagram``."""
     loader = _Loader(filename, Path(base_dir) if base_dir is not None else Path.cwd(),
-                     dict(overrides or {}), trust, dict(origins or {}))
+                     dict(overrides or {}), trust, dict(origins or {}),
+                     {k: Path(v) for k, v in (files or {}).items()})
     return loader.load(text)
 
 
@@ -118,9 +127,17 @@ class _Loader:
     """One pass over a diagram text, collecting every issue before raising."""
 
     def __init__(self, filename: str, base_dir: Path, overrides: dict[str, Any], trust: bool,
-                 origins: dict[str, str]):
+                 origins: dict[str, str], files: dict[str, Path] | None = None):
         self.file = filename
         self.base_dir = base_dir
+        self.files_map = files or {}
+        """Where to read each file the diagram names (``load_diagram``'s ``files``)."""
+        self.code_dir = self.files_map.get(CODE_DIR_KEY, base_dir)
+        """Where ``python:`` modules are looked for: the diagram's folder, or its copy."""
+        self.files: dict[str, Path] = {}
+        """The files read, by the reference the diagram makes (``Diagram.files``)."""
+        self.path_refs: dict[tuple[str, str], str] = {}
+        """(block, path parameter) -> the path as the diagram (or an override) gives it."""
         self.overrides = overrides
         self.trust = trust
         self.origins = origins
@@ -171,7 +188,37 @@ class _Loader:
         return Diagram(name=name, description=description, file=self.file, blocks=blocks,
                        connections=connections, log=log, t_end=t_end,
                        source_hash=self.hash.hexdigest(), t_end_line=t_end_line,
-                       base_dir=self.base_dir)
+                       base_dir=self.base_dir, files=dict(self.files))
+
+    # -- the files a diagram names ----------------------------------------------------
+
+    def found(self, ref: str, default: Path) -> Path:
+        """Where to read the file the diagram names as ``ref``: its entry in the files map,
+        else ``default`` (``ref`` resolved against the diagram's folder); recorded in
+        ``self.files`` when it is a file."""
+        real = self.files_map.get(ref, default)
+        if real.is_file():
+            self.files[ref] = real
+        return real
+
+    def module_files(self, cls: type) -> None:
+        """Record the files of a ``python:`` type's module when it comes from the diagram's
+        folder (a package: every .py file in it); installed modules are not the diagram's."""
+        import sys
+
+        module = sys.modules.get(cls.__module__)
+        origin = getattr(module, "__file__", None)
+        if not origin:
+            return
+        folder = Path(self.code_dir).resolve()
+        origin = Path(origin).resolve()
+        top = origin.relative_to(folder).parts[0] if inside(origin, folder) else None
+        if top is None:
+            return
+        found = sorted((folder / top).rglob("*.py")) if (folder / top).is_dir() else [folder / top]
+        for path in found:
+            if "__pycache__" not in path.parts:
+                self.files[path.relative_to(folder).as_posix()] = path
 
     # -- small field helpers ----------------------------------------------------------
 
@@ -267,10 +314,12 @@ class _Loader:
                        "run 'hierhand blocks' to list the registered types")
             return None
         try:
-            cls = resolve_type(type_name, self.trust, self.base_dir)
+            cls = resolve_type(type_name, self.trust, self.code_dir)
         except RegistryError as exc:
             self.error(spec.line_of("type"), f"block '{name}': {exc}", exc.hint)
             return None
+        if type_name.startswith(PYTHON_PREFIX):
+            self.module_files(cls)
         period = offset = None
         if "period" in spec:
             period = self.duration(spec, "period", f"block '{name}' period")
@@ -300,7 +349,14 @@ class _Loader:
         params = self.params(name, spec, cls, line, source)
         if params is None:
             return None
-        return _Entry(name, spec, line, cls, period, offset, params, source)
+        entry = _Entry(name, spec, line, cls, period, offset, params, source)
+        for key in cls.path_params:
+            ref = self.path_refs.get((name, key))
+            if ref is not None:
+                real = self.found(ref, Path(params[key]).expanduser())
+                if real != Path(params[key]).expanduser():
+                    entry.arguments[key] = str(real)
+        return entry
 
     def references(self, entry: _Entry, names: Mapping) -> bool:
         """Check the block's block-reference parameters against the diagram's block names
@@ -354,6 +410,7 @@ class _Loader:
         name, spec, line, cls, period = entry.name, entry.spec, entry.line, entry.cls, entry.period
         type_name = spec["type"]
         arguments = dict(entry.params)
+        arguments.update(entry.arguments)
         arguments.update({key: built[target].block for key, target in entry.references.items()})
         try:
             block = cls(**arguments)
@@ -427,8 +484,10 @@ class _Loader:
                 ok = False
         for key in cls.path_params:
             value = params.get(key)
-            if isinstance(value, str) and value.strip() and not Path(value).expanduser().is_absolute():
-                params[key] = str(self.base_dir / value)
+            if isinstance(value, str) and value.strip():
+                self.path_refs[(name, key)] = value
+                if not Path(value).expanduser().is_absolute():
+                    params[key] = str(self.base_dir / value)
         missing = [p for p, d in declared.items() if d.default is d.empty and p not in params]
         if missing:
             self.error(spec.line_of("params") if "params" in spec else line,
@@ -452,7 +511,8 @@ class _Loader:
                        "(Python: trust=True) if you trust this diagram")
             return None
         try:
-            text = read_yaml_file(path)
+            text = read_yaml_file(self.files_map.get(rel, path))
+            self.found(rel, path)
             self.hash.update(text.encode("utf-8"))
             data = load_yaml(text)
         except FileNotFoundError:

@@ -31,10 +31,12 @@ def command(measures_help: str = MEASURES_HELP) -> Command:
                                            "file, on a Dask LocalCluster (default: one single-threaded worker "
                                            "process per core) or a running scheduler, appending one row per "
                                            "finished run to OUTPUT/sweep.csv. Re-running the same command "
-                                           "resumes: points already in the file are skipped.")
+                                           "resumes: points already in the file are skipped. The diagram and "
+                                           "every file it reads are sent to the workers, which need only the "
+                                           "installed packages (same versions).")
         sweep.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
         sweep.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
-                           help="sweep folder: sweep.csv and sweep.json")
+                           help="sweep folder: sweep.csv and sweep.json (and runs/ with --keep-results)")
         sweep.add_argument("--grid", action="append", default=[], metavar="BLOCK.PARAM=V1,V2,...",
                            help="grid axis, values read as YAML (repeatable: cartesian product), "
                                 "e.g. --grid suppress.S_b=0.05,0.1,0.2")
@@ -55,6 +57,9 @@ def command(measures_help: str = MEASURES_HELP) -> Command:
         where.add_argument("--serial", action="store_true", help="run the points in this process, one by one")
         sweep.add_argument("--t-end", "--stop-time", dest="t_end", metavar="T",
                            help="end time of every run (default: the diagram's time.t_end)")
+        sweep.add_argument("--keep-results", action="store_true",
+                           help="also keep every run's signals.npz and run.json, in DIR/runs/<point hash>/ "
+                                "(written by this process; a failed run's partial results too)")
         trust_arg(sweep)
         sweep.add_argument("-q", "--quiet", action="store_true", help="no progress line or summary")
         sweep.set_defaults(handler=cmd_sweep)
@@ -120,7 +125,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             summary = run_sweep(args.diagram, points, metrics, args.output, t_end=args.t_end, workers=args.workers,
                                 scheduler=args.scheduler, serial=serial, trust=args.trust, progress=not args.quiet,
                                 axes=axes, origins=origins(args.grid, args.random, args.points, points),
-                                start_method=method)
+                                start_method=method, keep_results=args.keep_results)
         except SweepInterrupted as stop:
             print(f"{prog}: sweep interrupted: {stop.stored} of {stop.total} points are in {stop.csv} "
                   "(hint: run the same command again to run the rest)", file=sys.stderr)

@@ -9,6 +9,12 @@ waited on that worker. So the points of a lost task are run again one at a time,
 nothing else in flight, and only a point that is lost even then is recorded as failed:
 the point that kills its worker, not its neighbours.
 
+The diagram goes to the workers as content (``bundle``): a worker plugin gives every
+worker, and any that joins or is restarted, the files once; each task carries the
+bundle's manifest only. Connecting to a running scheduler checks first that the client,
+the scheduler and the workers run the same versions of Dask and of the packages the runs
+need (``check_versions``).
+
 ``warm_up`` has run the diagram briefly in this process before the cluster starts
 (modules imported, FMUs unpacked), and LocalCluster workers are forked from it where the
 platform can fork (``start_method``), so they start with all of that done.
@@ -23,6 +29,7 @@ import time
 import uuid
 from collections import deque
 from contextlib import contextmanager
+from dataclasses import replace
 from typing import Any
 
 from .chunks import ChunkSizer
@@ -85,18 +92,87 @@ def _children_ignore_ctrl_c():
 
 
 def _connect(scheduler: str, timeout: float):
+    import warnings
+
     from distributed import Client
 
     try:
-        client = Client(scheduler, timeout=timeout)
+        with warnings.catch_warnings():  # Dask's own table of mismatched versions: check_versions says it
+            warnings.filterwarnings("ignore", message="Mismatched versions found")
+            client = Client(scheduler, timeout=timeout)
     except (OSError, TimeoutError) as exc:
         raise SweepError(f"--scheduler {scheduler}: cannot connect: {one_line(exc)}") from None
     try:
         client.wait_for_workers(1, timeout=WORKER_WAIT_S)
+        check_versions(client, scheduler)
     except TimeoutError:
         client.close()
         raise SweepError(f"--scheduler {scheduler}: no workers after {WORKER_WAIT_S:g} s") from None
+    except SweepError:
+        client.close()
+        raise
     return client
+
+
+CHECKED_PACKAGES = ("numpy", "pyyaml", "fmpy")
+"""Packages whose versions must agree beyond Dask's own (``distributed.versions``): what
+the runs compute with. The distribution that provides ``blocks`` is checked too."""
+SCHEDULER_PACKAGES = ("python", "dask", "distributed", "cloudpickle", "tornado", "toolz")
+"""The packages the scheduler's versions are checked for (it runs no simulation)."""
+
+
+def _own_distribution() -> list[str]:
+    try:
+        from importlib.metadata import packages_distributions
+
+        return sorted(set(packages_distributions().get("blocks", [])))
+    except Exception:  # no metadata (run from a source tree): nothing more to check
+        return []
+
+
+def version_mismatches(versions: dict[str, Any]) -> list[str]:
+    """``package: VERSION here, VERSION on the scheduler, VERSION on N worker(s)`` for every
+    package whose version differs, from ``Client.get_versions()``'s answer."""
+    def packages(info: Any) -> dict[str, Any]:
+        return (info or {}).get("packages") or {} if isinstance(info, dict) else {}
+
+    here = packages(versions.get("client"))
+    scheduler = packages(versions.get("scheduler"))
+    workers = {address: packages(info) for address, info in (versions.get("workers") or {}).items()}
+    names = sorted(set(here) | set(scheduler) | {n for w in workers.values() for n in w})
+    lines = []
+    for name in names:
+        mine = here.get(name) or "missing"
+        found: list[tuple[str, str]] = []
+        if name in SCHEDULER_PACKAGES:
+            found.append(("the scheduler", scheduler.get(name) or "missing"))
+        counts: dict[str, int] = {}
+        for w in workers.values():
+            counts[w.get(name) or "missing"] = counts.get(w.get(name) or "missing", 0) + 1
+        found += [(f"{n} worker(s)", v) for v, n in sorted(counts.items())]
+        if any(v != mine for _, v in found):
+            lines.append(f"{name} {mine} here, " + ", ".join(f"{v} on {where}" for where, v in found))
+    return lines
+
+
+def check_versions(client, scheduler: str) -> None:
+    """Raise SweepError (one line, with a hint) when this process, the scheduler and the
+    workers do not run the same versions of Dask, Python and the packages the runs use:
+    Dask only warns, and a sweep would then fail in its tasks, or worse, differ."""
+    from distributed.versions import optional_packages, required_packages
+
+    extra = [*CHECKED_PACKAGES, *_own_distribution()]
+    versions = client.get_versions(packages=extra)
+    checked = {"python", *required_packages, *optional_packages, *extra}
+    for part in (versions.get("client"), versions.get("scheduler"), *(versions.get("workers") or {}).values()):
+        if isinstance(part, dict) and isinstance(part.get("packages"), dict):
+            part["packages"] = {k: v for k, v in part["packages"].items() if k in checked}
+    mismatches = version_mismatches(versions)
+    if mismatches:
+        raise SweepError(f"--scheduler {scheduler}: versions differ between this process, the scheduler and "
+                         f"the workers: {'; '.join(mismatches)} (hint: install the same versions on every "
+                         "machine, e.g. from one lock file or environment, and restart the scheduler and "
+                         "workers)")
 
 
 def _local_cluster(workers: int | None, method: str | None):
@@ -124,9 +200,11 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
     """
     from distributed import Client, as_completed
 
+    from .worker_plugin import DiagramFiles
+
     report = SweepReport()
     t0 = time.perf_counter()
-    cluster = client = None
+    cluster = client = plugin = None
     in_flight: dict[Any, list[tuple[str, Point]]] = {}
     try:
         if scheduler:
@@ -134,6 +212,10 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
         else:
             cluster = _local_cluster(workers, method)
             client = Client(cluster)
+        if job.bundle is not None:  # the files once per worker; each task carries the manifest only
+            plugin = DiagramFiles(job.bundle, uuid.uuid4().hex[:8])
+            client.register_plugin(plugin, name=plugin.name)
+            job = replace(job, bundle=job.bundle.manifest())
         workers_info = client.scheduler_info()["workers"]
         threads = sum(w["nthreads"] for w in workers_info.values())
         report.workers = len(workers_info)
@@ -183,6 +265,11 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
         if client is not None:
             if in_flight:
                 client.cancel(list(in_flight))
+            if plugin is not None and scheduler:  # a LocalCluster's workers go with it
+                try:
+                    client.unregister_worker_plugin(plugin.name)
+                except Exception:  # the copies are removed when the workers stop
+                    pass
             client.close()
         if cluster is not None:
             cluster.close()

@@ -15,13 +15,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from .bundle import bundle_for, discard
 from .errors import SweepError
 from .metrics import Metric, parse_metrics
 from .points import Point, point_json, unique_points
 from .progress import SweepProgress
 from .cluster import run_dask
 from .runner import Outcome, SweepJob, SweepReport, run_serial, warm_up
-from .store import OK, SWEEP_CSV, SweepStore, read_sweep
+from .store import OK, RUNS, SWEEP_CSV, SweepStore, read_sweep
 
 
 @dataclass
@@ -36,9 +37,11 @@ class SweepPlan:
 
     def description(self) -> dict[str, Any]:
         """What sweep.json records: enough to read the CSV and to repeat the sweep."""
+        bundle = self.job.bundle
         return {
             "diagram": self.job.diagram,
             "diagram_hash": self.diagram_hash,
+            "files": {f.ref: f.sha256 for f in bundle.files} if bundle is not None else {},
             "t_end": self.job.t_end,
             "parameters": self.parameters,
             "axes": self.axes,
@@ -49,8 +52,9 @@ class SweepPlan:
 
 def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_end: str | None = None,
             trust: bool = False, axes: dict[str, Any] | None = None,
-            origins: dict[str, str] | None = None) -> SweepPlan:
-    """Check the points' parameter names and the metrics against the diagram; hash the points.
+            origins: dict[str, str] | None = None, keep_results: bool = False) -> SweepPlan:
+    """Check the points' parameter names and the metrics against the diagram; bundle the
+    diagram with every file it reads (``bundle``) and hash the points with the bundle's hash.
 
     Raises the loader's DiagramError for an unknown block or parameter, SweepError for
     anything else that cannot work. ``origins`` says how the user gave each parameter
@@ -74,10 +78,31 @@ def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_e
             raise
     for metric in metrics:
         metric.check(checked)
+    bundle = bundle_for(diagram, [base, checked], _swept_files(base, points))
     job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust,
-                   origins=tuple((origins or {}).items()))
-    return SweepPlan(job=job, points=unique_points(points, base.source_hash, t_end), parameters=keys,
-                     diagram_hash=base.source_hash, axes=axes or {})
+                   origins=tuple((origins or {}).items()), bundle=bundle, keep_results=keep_results)
+    return SweepPlan(job=job, points=unique_points(points, bundle.hash, t_end), parameters=keys,
+                     diagram_hash=bundle.hash, axes=axes or {})
+
+
+def _swept_files(base, points: list[Point]) -> dict[str, Path]:
+    """The files that swept path parameters name (``--grid plant.path=a.fmu,b.fmu``), by the
+    reference each point gives, resolved as the loader does; those that are no file are
+    left to fail in their points."""
+    found: dict[str, Path] = {}
+    for key in points[0]:
+        block, _, param = key.partition(".")
+        spec = base.blocks.get(block)
+        if spec is None or param not in type(spec.block).path_params:
+            continue
+        for point in points:
+            ref = point[key]
+            if isinstance(ref, str) and ref.strip():
+                path = Path(ref).expanduser()
+                path = path if path.is_absolute() else base.base_dir / ref
+                if path.is_file():
+                    found[ref] = path
+    return found
 
 
 def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, scheduler: str | None = None,
@@ -97,6 +122,9 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
     bar = SweepProgress(len(todo), enabled=progress)
 
     def record(h: str, point: Point, outcome: Outcome) -> None:
+        if outcome.results is not None:  # the run's folder first: a row in the CSV has its folder
+            outcome.results.info.setdefault("sweep", {})["point_hash"] = h
+            outcome.results.save(Path(output) / RUNS / h)
         store.append(h, point, outcome.status, outcome.error, outcome.wall_s, outcome.values)
         bar.update(outcome.status == OK)
 
@@ -110,6 +138,8 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
                                     method=start_method))
     finally:
         bar.close()
+        if plan.job.bundle is not None:
+            discard(plan.job.bundle.hash)  # this process's copy (warm-up, serial runs)
     return report, len(plan.points) - len(todo), failed_before + report.failed
 
 
@@ -149,7 +179,7 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
               t_end: str | None = None, workers: int | None = None, scheduler: str | None = None,
               serial: bool = False, trust: bool = False, progress: bool = True,
               axes: dict[str, Any] | None = None, origins: dict[str, str] | None = None,
-              start_method: str | None = None) -> SweepSummary:
+              start_method: str | None = None, keep_results: bool = False) -> SweepSummary:
     """Run the diagram file at every point and append one row per run to OUTPUT/sweep.csv.
 
     ``points``: dicts of ``block.param`` overrides, all naming the same parameters
@@ -162,11 +192,17 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
     that fails is recorded as failed and the others go on. ``axes`` is recorded in
     sweep.json; ``origins`` says how each parameter was given, for load errors.
 
+    The diagram travels as content: its text and every file it reads go to each worker
+    once (``bundle``), so workers need the installed packages but none of the client's
+    files or folders. With ``keep_results`` each run's signals.npz and run.json (which
+    records the point, its status and metrics under ``sweep``) are written by this
+    process into OUTPUT/runs/<point hash>/, a failed run's partial results included.
+
     Raises ``DiagramError`` or ``SweepError`` before anything runs when the sweep cannot
     work, and ``SweepInterrupted`` on Ctrl-C, with only whole rows in the file.
     """
     plan = prepare(diagram, points, parse_metrics(metrics), t_end=None if t_end is None else str(t_end),
-                   trust=trust, axes=axes, origins=origins)
+                   trust=trust, axes=axes, origins=origins, keep_results=keep_results)
     t0 = time.perf_counter()
     try:
         report, skipped, failed = execute(plan, output, workers=workers, scheduler=scheduler,

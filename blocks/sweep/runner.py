@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import Any, Callable
 
+from .bundle import DiagramBundle
 from .metrics import Metric
 from .points import Point
 from .store import FAILED, OK
@@ -29,13 +30,30 @@ WARM_UP_TIME = Fraction(1, 100)
 class SweepJob:
     """What every point runs: the diagram file, the metrics, the end time, trust, and how
     the user gave each parameter (``points.origins``, as pairs) for the messages of a point
-    that fails to load."""
+    that fails to load.
+
+    ``bundle`` is the diagram as content (``bundle.DiagramBundle``): with it a point loads
+    the diagram from the bundle's copy of its files, never from ``diagram``, the path as
+    the user gave it (without it, from that path: a run in this process). ``keep_results``:
+    each outcome carries its run's results, to be saved by the sweep's process.
+    """
 
     diagram: str
     metrics: tuple[Metric, ...] = ()
     t_end: str | None = None
     trust: bool = False
     origins: tuple[tuple[str, str], ...] = ()
+    bundle: DiagramBundle | None = None
+    keep_results: bool = False
+
+    def load(self, point: Point, origins: bool = True):
+        """The diagram with the point's overrides, from the bundle if there is one."""
+        given = dict(self.origins) if origins else None
+        if self.bundle is not None:
+            return self.bundle.load(overrides=point, trust=self.trust, origins=given)
+        from blocks import load_diagram
+
+        return load_diagram(self.diagram, overrides=point, trust=self.trust, origins=given)
 
 
 @dataclass
@@ -46,6 +64,8 @@ class Outcome:
     error: str = ""
     wall_s: float = 0.0
     values: dict[str, Any] = field(default_factory=dict)
+    results: Any = None
+    """The run's ``Results`` when the job keeps them (None if the point did not get to run)."""
 
 
 @dataclass
@@ -67,22 +87,30 @@ def one_line(text: str) -> str:
 
 def run_point(job: SweepJob, point: Point) -> Outcome:
     """Load, simulate and measure one point; failures are returned, not raised."""
-    from blocks import DiagramError, load_diagram, simulate
+    from blocks import DiagramError, simulate
 
     t0 = time.perf_counter()
+    results = None
     try:
-        diagram = load_diagram(job.diagram, overrides=point, trust=job.trust, origins=dict(job.origins))
+        diagram = job.load(point)
         results = simulate(diagram, t_end=job.t_end)
         if results.interrupted:
             raise KeyboardInterrupt  # the user's Ctrl-C stops the sweep; this point stays to be run
         if not results.complete:
-            return Outcome(FAILED, one_line(results.status), time.perf_counter() - t0)
-        values = {m.name: m.evaluate(results, diagram) for m in job.metrics}
+            outcome = Outcome(FAILED, one_line(results.status), time.perf_counter() - t0)
+        else:
+            values = {m.name: m.evaluate(results, diagram) for m in job.metrics}
+            outcome = Outcome(OK, "", time.perf_counter() - t0, values)
     except DiagramError as exc:
-        return Outcome(FAILED, one_line("; ".join(str(i) for i in exc.issues)), time.perf_counter() - t0)
+        outcome = Outcome(FAILED, one_line("; ".join(str(i) for i in exc.issues)), time.perf_counter() - t0)
     except Exception as exc:  # a block's or a metric's own error: this point fails, the sweep goes on
-        return Outcome(FAILED, one_line(f"{type(exc).__name__}: {exc}"), time.perf_counter() - t0)
-    return Outcome(OK, "", time.perf_counter() - t0, values)
+        outcome = Outcome(FAILED, one_line(f"{type(exc).__name__}: {exc}"), time.perf_counter() - t0)
+    if job.keep_results and results is not None:
+        results.info["sweep"] = {"point": point, "status": outcome.status, "error": outcome.error,
+                                 "metrics": outcome.values,
+                                 "bundle_hash": job.bundle.hash if job.bundle is not None else None}
+        outcome.results = results
+    return outcome
 
 
 def run_points(job: SweepJob, points: list[Point]) -> list[Outcome]:
@@ -95,11 +123,11 @@ def warm_up(job: SweepJob, point: Point) -> None:
 
     A point that cannot run is not an error here: the sweep records it when it runs.
     """
-    from blocks import load_diagram, simulate
+    from blocks import simulate
     from blocks.timebase import parse_duration
 
     try:
-        diagram = load_diagram(job.diagram, overrides=point, trust=job.trust)
+        diagram = job.load(point, origins=False)
         t_end = diagram.t_end if job.t_end is None else job.t_end
         simulate(diagram, t_end=min(parse_duration(t_end), WARM_UP_TIME) if t_end is not None else WARM_UP_TIME)
     except Exception:  # the point's own failure shows up in its row

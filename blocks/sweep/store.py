@@ -22,6 +22,8 @@ from .errors import SweepError
 
 SWEEP_CSV = "sweep.csv"
 SWEEP_JSON = "sweep.json"
+RUNS = "runs"
+"""The folder of the runs kept with ``--keep-results``: RUNS/<point hash>/ (signals.npz, run.json)."""
 FIXED_COLUMNS = ("point_hash", "status", "error", "wall_s")
 OK, FAILED = "ok", "failed"
 
