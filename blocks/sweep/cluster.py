@@ -91,7 +91,9 @@ def _children_ignore_ctrl_c():
         signal.signal(signal.SIGINT, previous)
 
 
-def _connect(scheduler: str, timeout: float):
+def connect(scheduler: str, timeout: float = 20.0):
+    """A client of the running scheduler at ``scheduler`` with at least one worker whose
+    versions match this process's; a one-line SweepError otherwise."""
     import warnings
 
     from distributed import Client
@@ -190,9 +192,10 @@ def _local_cluster(workers: int | None, method: str | None):
 
 def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, workers: int | None = None,
              scheduler: str | None = None, connect_timeout: float = 20.0,
-             method: str | None = None) -> SweepReport:
+             method: str | None = None, client: Any = None) -> SweepReport:
     """Run the points on a new LocalCluster (``workers`` processes, started by ``method``:
-    see ``start_method``) or at ``scheduler``.
+    see ``start_method``), at ``scheduler``, or through ``client`` (from ``connect``; this
+    call closes it).
 
     Runs are recorded as their tasks complete. On any exit (Ctrl-C included) the tasks in
     flight are cancelled, their points left to a later resume, and the client and the
@@ -204,11 +207,13 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
 
     report = SweepReport()
     t0 = time.perf_counter()
-    cluster = client = plugin = None
+    cluster = plugin = None
     in_flight: dict[Any, list[tuple[str, Point]]] = {}
     try:
-        if scheduler:
-            client = _connect(scheduler, connect_timeout)
+        if client is not None:
+            pass
+        elif scheduler:
+            client = connect(scheduler, connect_timeout)
         else:
             cluster = _local_cluster(workers, method)
             client = Client(cluster)

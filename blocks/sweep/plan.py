@@ -20,7 +20,7 @@ from .errors import SweepError
 from .metrics import Metric, parse_metrics
 from .points import Point, point_json, unique_points
 from .progress import SweepProgress
-from .cluster import run_dask
+from .cluster import connect, run_dask
 from .runner import Outcome, SweepJob, SweepReport, run_serial, warm_up
 from .store import OK, RUNS, SWEEP_CSV, SweepStore, read_sweep
 
@@ -114,9 +114,17 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
     the number of failed points in the whole sweep (recorded before or now).
     ``start_method`` is how a LocalCluster starts its workers (``cluster.start_method``).
     """
-    store = SweepStore(output, plan.parameters, [m.name for m in plan.job.metrics])
-    done = store.open()
-    store.write_description(plan.description())
+    client = None
+    if scheduler and not serial and stored_count(plan, output) < len(plan.points):
+        client = connect(scheduler)  # a scheduler that is down or mismatched: said before the file is touched
+    try:
+        store = SweepStore(output, plan.parameters, [m.name for m in plan.job.metrics])
+        done = store.open()
+        store.write_description(plan.description())
+    except BaseException:
+        if client is not None:
+            client.close()
+        raise
     todo = [(h, p) for h, p in plan.points if h not in done]
     failed_before = sum(1 for h, _ in plan.points if done.get(h, OK) != OK)
     bar = SweepProgress(len(todo), enabled=progress)
@@ -135,9 +143,12 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
             warm_up(plan.job, todo[0][1])
             report = (run_serial(plan.job, todo, record) if serial
                       else run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,
-                                    method=start_method))
+                                    method=start_method, client=client))
+            client = None  # run_dask closed it
     finally:
         bar.close()
+        if client is not None:
+            client.close()
         if plan.job.bundle is not None:
             discard(plan.job.bundle.hash)  # this process's copy (warm-up, serial runs)
     return report, len(plan.points) - len(todo), failed_before + report.failed
