@@ -163,19 +163,28 @@ def test_a_changed_params_file_makes_new_points(tmp_path):
     assert set(after) == set(before) and all(after[k] != before[k] for k in after)
 
 
-def _copy_fmu_project(root: Path) -> Path:
+@pytest.fixture(scope="module")
+def plant_fmu(tmp_path_factory) -> Path:
+    """The hand plant exported as an FMI 2 FMU (a clean checkout has none in fmu/)."""
+    from hierhand.fmu_export import export_plant_fmu
+
+    return export_plant_fmu(tmp_path_factory.mktemp("export") / "HandPlant_fmi2.fmu", fmi=2)
+
+
+def _copy_fmu_project(root: Path, fmu: Path) -> Path:
+    """The shipped FMU diagram in ``root/diagrams``, its FMU at ``../fmu/`` as it expects."""
     (root / "diagrams").mkdir(parents=True)
     (root / "fmu").mkdir()
-    shutil.copy(ROOT / "fmu" / "HandPlant_fmi2.fmu", root / "fmu")
+    shutil.copy(fmu, root / "fmu" / "HandPlant_fmi2.fmu")
     shutil.copy(ROOT / "diagrams" / "regrasp_fmu.yaml", root / "diagrams")
     return root / "diagrams" / "regrasp_fmu.yaml"
 
 
-def test_an_fmu_travels_with_the_sweep_by_relative_and_absolute_path(tmp_path):
-    diagram = _copy_fmu_project(tmp_path / "proj")
+def test_an_fmu_travels_with_the_sweep_by_relative_and_absolute_path(tmp_path, plant_fmu):
+    diagram = _copy_fmu_project(tmp_path / "proj", plant_fmu)
     other = tmp_path / "fmus" / "Other.fmu"
     other.parent.mkdir()
-    with zipfile.ZipFile(ROOT / "fmu" / "HandPlant_fmi2.fmu") as src, zipfile.ZipFile(other, "w") as dst:
+    with zipfile.ZipFile(plant_fmu) as src, zipfile.ZipFile(other, "w") as dst:
         for item in src.infolist():  # the same model, other bytes
             dst.writestr(item, src.read(item.filename))
         dst.writestr("documentation/note.txt", "another copy")
@@ -199,7 +208,7 @@ def test_an_fmu_travels_with_the_sweep_by_relative_and_absolute_path(tmp_path):
         written = point["plant.path"]
         assert shown == (written if os.path.isabs(written) else str(diagram.parent / written))
     # the FMU's bytes are part of the points' identity
-    diagram = _copy_fmu_project(tmp_path / "proj")
+    diagram = _copy_fmu_project(tmp_path / "proj", plant_fmu)
     again = prepare(diagram, points[:1], metrics, t_end="20 ms")
     with zipfile.ZipFile(tmp_path / "proj" / "fmu" / "HandPlant_fmi2.fmu", "a") as fmu:
         fmu.writestr("documentation/note.txt", "changed")
