@@ -54,6 +54,9 @@ class CompiledBlock:
         self.rows: np.ndarray | None = None
         self.logs = (0, 0)
         """The range of this block's entries in the run's log table."""
+        self.forwards: list[tuple[list[int], tuple[str, str]]] = []
+        """Copies of its outputs into readers' buffers after each of its hits, with their
+        steps: inputs that hold a default until this block first fires."""
 
 
 class CompiledSide:
@@ -125,8 +128,14 @@ class CompiledSide:
                 if c is None:
                     value = self.inputs[cb.name][port]
                     self.owners.append(value)
-                elif not c.delay and c.src_block in self.blocks:
+                elif not c.delay and c.src_block in self.blocks and port not in cb.block.input_defaults:
                     value = self.blocks[c.src_block].views[c.src_port]
+                elif not c.delay and c.src_block in self.blocks:
+                    # it holds its default until the source's first hit, then follows it
+                    value = self.buffers[cb.name, port] = np.array(self.inputs[cb.name][port], dtype=float)
+                    source = self.blocks[c.src_block].views[c.src_port]
+                    self.blocks[c.src_block].forwards.append(
+                        ([OP_COPY, source.size, address(value), address(source)], (cb.name, "input")))
                 else:
                     value = self.buffers[cb.name, port] = np.array(self.inputs[cb.name][port], dtype=float)
                 cb.pointers[i] = address(value)
@@ -156,6 +165,10 @@ class CompiledSide:
                 lg.pos, lg.hits = pos, hits
 
     # -- ops ---------------------------------------------------------------------------
+
+    def forward_ops(self, name: str) -> list[tuple[list[int], tuple[str, str]]]:
+        """The copies that follow a compiled block's outputs (``CompiledBlock.forwards``)."""
+        return self.blocks[name].forwards
 
     def output_op(self, name: str, log: bool) -> list[int]:
         cb = self.blocks[name]

@@ -319,6 +319,7 @@ class _Run:
             log = b in program.firing and last_step[b] == i
             if b in kernel:
                 pending.append((self.compiled.output_op(b, log), (b, "output")))
+                pending.extend(self.compiled.forward_ops(b))
             else:
                 flush()
                 python = True
@@ -341,6 +342,7 @@ class _Run:
         for b in program.advance:
             if b in kernel:
                 pending.append((self.compiled.advance_op(b), (b, "advance")))
+                pending.extend(self.compiled.forward_ops(b))
             else:
                 flush()
                 python = True

@@ -358,3 +358,21 @@ log: [g.y]
     r = simulate(loads_diagram(text, filename="default.yaml"))
     assert CALLS.get("Scale.output", 0) == 1  # through Python, which finds the width wrong
     assert "output 'y' must be a float64 array of shape (2,), got shape (1,)" in r.status
+
+
+def test_a_default_input_holds_until_its_compiled_source_first_fires(monkeypatch):
+    """A connected input with a default holds the default until its source's first hit
+    (here an offset one): the same whether the blocks run compiled or in Python."""
+    monkeypatch.setattr(Leak, "input_defaults", {"u": np.array([3.0, -1.0])})
+    text = """
+time: {t_end: 10 ms}
+blocks:
+  src:  {type: TestLeak, period: 5 ms, offset: 4 ms, params: {x0: 2.0, compiled: %s}}
+  leak: {type: TestLeak, period: 1 ms, params: {compiled: %s}}
+connections: [src.y -> leak.u]
+log: [leak.y, src.y]
+"""
+    compiled = simulate(loads_diagram(text % ("true", "true"), filename="offset.yaml"))
+    python = simulate(loads_diagram(text % ("false", "false"), filename="offset.yaml"))
+    assert_same(compiled, python)
+    assert compiled["leak.y"][1][1, 0] == pytest.approx(0.1 * 3.0)  # the default, before src fires at 4 ms
