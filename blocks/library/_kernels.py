@@ -60,7 +60,9 @@ def error(code: int, which: int, t: float, phase: str) -> BaseException:
 
 
 def cached(block: Any, key: tuple, build) -> Kernel | None:
-    """``build()``'s Kernel, kept on the block while ``key`` (period, widths, model) holds."""
+    """``build()``'s Kernel, kept on the block while ``key`` holds: the period, the widths
+    and the parameters' values the context copies, so a parameter changed on the block
+    between runs reaches its kernel as it reaches its Python methods."""
     held = getattr(block, "_kernel_cache", None)
     if held is not None and held[0] == key:
         return held[1]

@@ -48,7 +48,7 @@ class Gain(Block):
         """C output: elementwise (the same bits), or the matrix product (library.c's
         ``matvec``: ``ndarray.dot`` to round-off where a row has several terms)."""
         width = self.inputs["u"]
-        return _kernels.cached(self, (width, self.k.shape), lambda: self._build_kernel(width))
+        return _kernels.cached(self, (width, self.k.shape, self.k.tobytes()), lambda: self._build_kernel(width))
 
     def _build_kernel(self, width):
         if width is None:
@@ -213,4 +213,4 @@ class Saturation(Block):
             hi = np.broadcast_to(self.upper, (width,))
             return _kernels.make_kernel(np.concatenate(((width,), lo, hi)), "saturation_output")
 
-        return _kernels.cached(self, (width,), build)
+        return _kernels.cached(self, (width, np.asarray(self.lower).tobytes(), np.asarray(self.upper).tobytes()), build)

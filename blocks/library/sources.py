@@ -44,7 +44,7 @@ class Constant(Block):
         return {"y": self.value.copy()}
 
     def kernel(self):
-        return _kernels.cached(self, (self.value.size,), lambda: _kernels.make_kernel(
+        return _kernels.cached(self, (self.value.tobytes(),), lambda: _kernels.make_kernel(
             np.concatenate(((self.value.size,), self.value)), "constant_output"))
 
 
@@ -75,7 +75,8 @@ class Step(Block):
 
     def kernel(self):
         w = self.before.size
-        return _kernels.cached(self, (w, self.time), lambda: _kernels.make_kernel(
+        key = (self.time, self.before.tobytes(), self.after.tobytes())
+        return _kernels.cached(self, key, lambda: _kernels.make_kernel(
             np.concatenate(((w, self.time), self.before, self.after)), "step_output"))
 
 
@@ -109,5 +110,6 @@ class Ramp(Block):
 
     def kernel(self):
         w = self.slope.size
-        return _kernels.cached(self, (w, self.start), lambda: _kernels.make_kernel(
+        key = (self.start, self.slope.tobytes(), self.initial.tobytes())
+        return _kernels.cached(self, key, lambda: _kernels.make_kernel(
             np.concatenate(((w, self.start), self.slope, self.initial)), "ramp_output"))

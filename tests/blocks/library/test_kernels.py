@@ -391,3 +391,23 @@ def test_polymorphic_blocks_need_a_width():
 def test_kernel_is_built_once():
     block = prepared(DiscreteStateSpace([[0.9]], [[1.0]], [[1.0]]))
     assert block.kernel() is block.kernel()
+
+
+def test_a_parameter_changed_between_runs_reaches_the_kernel():
+    """Kernels are cached on their block by the values they copy: a gain changed on the
+    block between runs is used by the next run, as its Python output would use it."""
+    import blocks
+
+    text = """
+time: {t_end: 2 ms}
+blocks:
+  c: {type: Constant, period: 1 ms, params: {value: 2.0}}
+  g: {type: Gain, params: {k: 3.0}}
+connections: [c.y -> g.u]
+log: [g.y]
+"""
+    d = blocks.loads_diagram(text, filename="k.yaml")
+    assert blocks.simulate(d)["g.y"][1][-1, 0] == 6.0
+    d.blocks["g"].block.k[...] = 5.0
+    d.blocks["c"].block.value[...] = 1.5
+    assert blocks.simulate(d)["g.y"][1][-1, 0] == 7.5
