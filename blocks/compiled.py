@@ -5,9 +5,11 @@ hits in C (``blocks._native.Runner``, see ``blocks/csrc/runner.c``). Each such b
 writes its outputs into one buffer of its own; a kernel reads its inputs through
 pointers into the buffers of the blocks that feed it, so values pass on with no copy.
 Where the two worlds meet, values are copied: a Python block's output into the input
-buffer of a compiled reader when it is computed, a compiled block's output into a Python
-reader's inputs when that reader runs (a copy, because the buffer changes in place and a
-Python block may keep what it was given). Loggers of compiled blocks are filled in C.
+buffer of a compiled reader when it is computed, a compiled block's outputs into its
+Python readers' inputs after each C call that computed them (copies, because the buffer
+changes in place and a Python block may keep what it was given). An input with a default
+has a buffer of its own too, which holds the default until its source first fires.
+Loggers of compiled blocks are filled in C.
 """
 
 from __future__ import annotations
@@ -196,8 +198,8 @@ class CompiledSide:
             steps += event_steps
         tick = self.s.base_tick
         native = NativeRunner(self.slots, np.array(ops, dtype=np.int64).reshape(-1, 4),
-                                np.array(table, dtype=np.int64).reshape(-1, 3), self.log_table, self.counters,
-                                tick.numerator, tick.denominator, (self.owners, self.blocks))
+                              np.array(table, dtype=np.int64).reshape(-1, 3), self.log_table, self.counters,
+                              tick.numerator, tick.denominator, (self.owners, self.blocks))
         return Runner(native, steps, self)
 
     def error(self, name: str, phase: str, code: int, which: int, tick: int) -> BaseException:
@@ -209,8 +211,8 @@ class CompiledSide:
 
 class Runner:
     """A compiled piece of an event program: ``run(k, next_k)`` returns None or the
-    failure ``(code, which, op, tick)``; ``raise_failure`` turns that into the step's
-    exception."""
+    failure ``(code, which, op, tick)``, which ``failure`` turns into its block, phase,
+    tick and exception."""
 
     def __init__(self, native, steps: list[tuple[str, str]], side: CompiledSide):
         self.native = native
