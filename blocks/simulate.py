@@ -664,39 +664,24 @@ class _Run:
     def element_labels(self) -> dict[str, list[str]]:
         """The element names of the logged signals whose blocks name them
         (``Block.element_labels``), checked once at the start: one label per element."""
-        found = {}
-        for e in self.d.log:
-            blk = self.d.blocks[e.block].block
-            try:
-                labels = blk.element_labels(e.port)
-                if labels is None:
-                    continue
-                labels = [str(label) for label in labels]
-                width = blk.outputs[e.port]
-                if len(labels) != width:
-                    raise BlockError(f"{len(labels)} labels for the {width} elements of '{e.port}'",
-                                     port=e.port)
-            except Exception as exc:
-                raise _StepFailure(e.block, "element_labels", 0, exc) from exc
-            found[e.signal] = labels
-        return found
+        return self.logged_port_info("element_labels", _labels_of)
 
     def port_units(self) -> dict[str, str | list[str]]:
         """The units of the logged signals whose blocks know them (``Block.port_units``),
         checked once at the start: a string, or one string per element."""
+        return self.logged_port_info("port_units", _units_of)
+
+    def logged_port_info(self, phase: str, read: Callable[[Any, Any], Any]) -> dict[str, Any]:
+        """What ``read(block, log_entry)`` says of each logged signal (None: nothing), asked
+        once at the start; what it raises fails the run at t = 0 in that block's ``phase``."""
         found = {}
         for e in self.d.log:
-            blk = self.d.blocks[e.block].block
             try:
-                units = blk.port_units(e.port)
-                try:
-                    units = checked_units(units, blk.outputs[e.port], e.port)
-                except ValueError as exc:
-                    raise BlockError(str(exc), port=e.port) from None
+                value = read(self.d.blocks[e.block].block, e)
             except Exception as exc:
-                raise _StepFailure(e.block, "port_units", 0, exc) from exc
-            if units is not None:
-                found[e.signal] = units
+                raise _StepFailure(e.block, phase, 0, exc) from exc
+            if value is not None:
+                found[e.signal] = value
         return found
 
     def collect_through_interrupt(self) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -744,6 +729,27 @@ class _Run:
         if units:
             info["units"] = units
         return info
+
+
+def _labels_of(blk, e) -> list[str] | None:
+    """A logged signal's element labels, one per element, or None."""
+    labels = blk.element_labels(e.port)
+    if labels is None:
+        return None
+    labels = [str(label) for label in labels]
+    width = blk.outputs[e.port]
+    if len(labels) != width:
+        raise BlockError(f"{len(labels)} labels for the {width} elements of '{e.port}'", port=e.port)
+    return labels
+
+
+def _units_of(blk, e) -> str | list[str] | None:
+    """A logged signal's units, checked against its width, or None."""
+    units = blk.port_units(e.port)
+    try:
+        return checked_units(units, blk.outputs[e.port], e.port)
+    except ValueError as exc:
+        raise BlockError(str(exc), port=e.port) from None
 
 
 @functools.cache
