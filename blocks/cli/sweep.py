@@ -28,12 +28,14 @@ def command(measures_help: str = MEASURES_HELP) -> Command:
     def add(sub, program) -> argparse.ArgumentParser:
         sweep = sub.add_parser("sweep", help="run a diagram at many parameter points (Dask), one CSV row each",
                                description="Run DIAGRAM at every point of a grid, random samples or a points "
-                                           "file, on a Dask LocalCluster (default: one single-threaded worker "
-                                           "process per core) or a running scheduler, appending one row per "
+                                           "file, on a Dask LocalCluster of single-threaded worker processes "
+                                           "or a running scheduler, appending one row per "
                                            "finished run to OUTPUT/sweep.csv. Re-running the same command "
                                            "resumes: points already in the file are skipped. The diagram and "
                                            "every file it reads are sent to the workers, which need only the "
-                                           "installed packages (same versions).")
+                                           "installed packages (same versions). By default the points start "
+                                           "at once in a local process, and a LocalCluster of one worker per "
+                                           "core takes over when the runs left are worth starting one.")
         sweep.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
         sweep.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                            help="sweep folder: sweep.csv and sweep.json (and runs/ with --keep-results)")
@@ -51,7 +53,8 @@ def command(measures_help: str = MEASURES_HELP) -> Command:
                            help=f"{REDUCERS_HELP}; or {measures_help}")
         where = sweep.add_mutually_exclusive_group()
         where.add_argument("--workers", type=int, metavar="N",
-                           help="LocalCluster worker processes (default: one per core; 0 = in this process)")
+                           help="run on a LocalCluster of N worker processes from the start (default: start "
+                                "locally, then one worker per core if the work is worth it; 0 = in this process)")
         where.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                            help="use the workers of a running scheduler")
         where.add_argument("--serial", action="store_true", help="run the points in this process, one by one")
@@ -134,8 +137,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise UsageError(str(exc)) from None
     report = summary.report
     if not args.quiet:
-        where = ("" if report.ran == 0 else " in this process" if report.workers == 0
-                 else f" on {report.workers} Dask worker(s)")
+        where = ("" if report.ran == 0 else f" on {report.workers} Dask worker(s)" if report.workers else
+                 " in a local process (too little work for a cluster to pay off)" if report.local else
+                 " in this process")
+        if report.workers and report.local:
+            where += f", {report.local} of them in a local process while the cluster started"
         print(f"sweep: {summary.points} points: {report.ran} run{where} ({report.failed} failed), "
               f"{summary.skipped} already in {summary.csv}; {summary.wall_s:.3g} s")
     if summary.failed:

@@ -13,9 +13,11 @@ expressions: what number to keep from each run), ``measures`` (the named measure
 applications register through the ``blocks.measures`` entry-point group), ``store`` (the
 append-only sweep.csv and resuming it), ``bundle`` (the diagram as content: its text and
 every file it reads, sent to the workers and written there once), ``runner`` (one point's
-run, and the serial loop), ``cluster`` (running the points on Dask, with ``worker_plugin``,
-and the version check of a running scheduler), ``chunks`` (how
-many points one Dask task runs), ``plan`` (checking a sweep and executing it),
+run, and the serial loop), ``local`` (the default's head start: a forked local process
+runs points while a cluster starts, or all of them when none would pay off), ``queue``
+(the points still to hand out, shared with that process), ``cluster`` (running the
+points on Dask, with ``worker_plugin``, and the version check of a running scheduler),
+``chunks`` (how many points one Dask task runs), ``plan`` (checking a sweep and executing it),
 ``progress`` (the terminal progress line) and ``plot`` (line plots and heat maps of a
 finished sweep). Importing this package imports neither Dask nor matplotlib.
 """

@@ -30,13 +30,17 @@ import uuid
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .chunks import ChunkSizer
 from .errors import SweepError
 from .points import Point
+from .queue import PointQueue, SharedQueue
 from .runner import Outcome, Record, SweepJob, SweepReport, default_workers, one_line, run_points
 from .store import FAILED, OK
+
+if TYPE_CHECKING:
+    from .local import LocalRunner
 
 WORKER_WAIT_S = 30.0
 """How long to wait for a remote scheduler to have at least one worker."""
@@ -190,16 +194,19 @@ def _local_cluster(workers: int | None, method: str | None):
                             plugins={IgnoreCtrlC()})
 
 
-def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, workers: int | None = None,
-             scheduler: str | None = None, connect_timeout: float = 20.0,
-             method: str | None = None, client: Any = None) -> SweepReport:
+def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQueue, record: Record,
+             workers: int | None = None, scheduler: str | None = None, connect_timeout: float = 20.0,
+             method: str | None = None, client: Any = None, beside: LocalRunner | None = None) -> SweepReport:
     """Run the points on a new LocalCluster (``workers`` processes, started by ``method``:
     see ``start_method``), at ``scheduler``, or through ``client`` (from ``connect``; this
     call closes it).
 
     Runs are recorded as their tasks complete. On any exit (Ctrl-C included) the tasks in
     flight are cancelled, their points left to a later resume, and the client and the
-    cluster this call started are closed.
+    cluster this call started are closed. ``beside`` is a local runner taking points from
+    the same ``todo`` queue while the cluster starts (``local``): once the cluster is
+    ready it is told to stop, its run times size the first tasks, and what it sends is
+    recorded as tasks complete.
     """
     from distributed import Client, as_completed
 
@@ -227,7 +234,13 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
         report.startup_s = time.perf_counter() - t0
 
         sizer = ChunkSizer(threads)
-        queue, suspects = deque(todo), deque()
+        if beside is not None:
+            beside.stop()
+            beside.collect()
+            for wall in beside.walls:
+                sizer.observe(wall)
+        queue = todo if isinstance(todo, (PointQueue, SharedQueue)) else PointQueue(todo)
+        suspects: deque = deque()
         isolated: set[Any] = set()
         token, submitted = uuid.uuid4().hex[:8], 0
         finished = as_completed()
@@ -245,8 +258,8 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
                 if not in_flight:
                     isolated.add(submit([suspects.popleft()]))
                 return
-            while queue and len(in_flight) < sizer.in_flight:
-                submit([queue.popleft() for _ in range(sizer.size(len(queue)))])
+            while len(in_flight) < sizer.in_flight and (chunk := queue.take(sizer.size(len(queue)))):
+                submit(chunk)
 
         top_up()
         for future in finished:
@@ -264,6 +277,8 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]], record: Record, worke
                 sizer.observe(outcome.wall_s)
                 report.ran += 1
                 report.failed += outcome.status != OK
+            if beside is not None:
+                beside.collect()
             top_up()
         report.run_s = time.perf_counter() - t0 - report.startup_s
     finally:

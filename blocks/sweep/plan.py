@@ -21,6 +21,7 @@ from .metrics import Metric, parse_metrics
 from .points import Point, point_json, unique_points
 from .progress import SweepProgress
 from .cluster import connect, run_dask
+from .local import can_run_locally, run_local_first
 from .runner import Outcome, SweepJob, SweepReport, run_serial, warm_up
 from .store import OK, RUNS, SWEEP_CSV, SweepStore, read_sweep
 
@@ -113,6 +114,9 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
     Returns the execution report, the number of points skipped (already in the file) and
     the number of failed points in the whole sweep (recorded before or now).
     ``start_method`` is how a LocalCluster starts its workers (``cluster.start_method``).
+    With neither ``workers`` nor ``scheduler`` nor ``serial`` the points start at once in
+    a local process and a LocalCluster takes over when the work left is worth one
+    (``local``).
     """
     client = None
     if scheduler and not serial and stored_count(plan, output) < len(plan.points):
@@ -141,10 +145,14 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
             report = SweepReport()
         else:
             warm_up(plan.job, todo[0][1])
-            report = (run_serial(plan.job, todo, record) if serial
-                      else run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,
-                                    method=start_method, client=client))
-            client = None  # run_dask closed it
+            if serial:
+                report = run_serial(plan.job, todo, record)
+            elif workers is None and scheduler is None and can_run_locally():
+                report = run_local_first(plan.job, todo, record, method=start_method)
+            else:
+                report = run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,
+                                  method=start_method, client=client)
+                client = None  # run_dask closed it
     finally:
         bar.close()
         if client is not None:
@@ -197,9 +205,11 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
     (``points.grid_points``, ``random_points``, ``csv_points`` make them); ``metrics``:
     ``"NAME=EXPR"`` texts (``metrics``) or parsed ``Metric`` objects, one column each;
     ``t_end``: every run's end time as the CLI's ``--t-end`` takes it (default: the
-    diagram's). The points run on a new LocalCluster of ``workers`` processes (default:
-    one per core), on the workers of a running ``scheduler``, or in this process with
-    ``serial`` (or ``workers=0``). Points already in the file are skipped, so calling again resumes; a point
+    diagram's). The points run on a new LocalCluster of ``workers`` processes, on the
+    workers of a running ``scheduler``, or in this process with ``serial`` (or
+    ``workers=0``). By default they start at once in a process forked from this one, and a
+    LocalCluster of one worker per core takes over when the runs left are worth starting
+    one (``local``): a sweep of a fraction of a second never waits for Dask. Points already in the file are skipped, so calling again resumes; a point
     that fails is recorded as failed and the others go on. ``axes`` is recorded in
     sweep.json; ``origins`` says how each parameter was given, for load errors.
 

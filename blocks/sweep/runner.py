@@ -70,7 +70,8 @@ class Outcome:
 
 @dataclass
 class SweepReport:
-    """What an execution did: runs recorded, failures, wall time, and the cluster's set-up time."""
+    """What an execution did: runs recorded, failures, wall time, the cluster's set-up time
+    and its number of workers (0: none was started)."""
 
     ran: int = 0
     failed: int = 0
@@ -78,6 +79,8 @@ class SweepReport:
     startup_s: float = 0.0
     run_s: float = 0.0
     workers: int = 0
+    local: int = 0
+    """Points run by a local runner process (``local``), beside or instead of the workers."""
 
 
 def one_line(text: str) -> str:

@@ -58,7 +58,7 @@ def _group_gone(pgid: int, timeout: float) -> bool:
 
 
 @pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups are POSIX")
-@pytest.mark.parametrize("mode", [["--workers", "2"], ["--serial"]], ids=["local-cluster", "serial"])
+@pytest.mark.parametrize("mode", [["--workers", "2"], ["--serial"], []], ids=["local-cluster", "serial", "default"])
 def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
     out = tmp_path / "sweep"
     proc = subprocess.Popen(_command(out, mode), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
