@@ -211,3 +211,15 @@ def test_mp4_uses_matplotlibs_ffmpeg_writer_when_ffmpeg_is_found(tmp_path, monke
     monkeypatch.setattr(shutil, "which", lambda name, *a, **k: "/opt/bin/ffmpeg" if name == "ffmpeg" else None)
     writer = _writer(tmp_path / "a.mp4", 25)
     assert isinstance(writer, FFMpegWriter) and writer.ffmpeg_exe == "/opt/bin/ffmpeg" and writer.fps == 25
+
+
+def test_cli_writes_an_mp4_that_decodes_to_its_frames(run_dir, tmp_path):
+    """A real MP4 through the ffmpeg of imageio-ffmpeg (a test extra): 5 frames at 10 fps."""
+    imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg")
+    mp4 = tmp_path / "hand.mp4"
+    proc = cli(run_dir, "-o", mp4, "--every", "50", "--fps", "10")
+    assert proc.returncode == 0, proc.stderr
+    count, seconds = imageio_ffmpeg.count_frames_and_secs(str(mp4))
+    assert count == 5 and seconds == pytest.approx(0.5, abs=0.05)
+    first = next(imageio_ffmpeg.read_frames(str(mp4)))["size"]
+    assert first[0] > 300 and first[1] > 300  # a whole figure, not a stub frame
