@@ -80,6 +80,22 @@ static int arm(int64_t *c, double t, const double *const *inputs)
     return 0;
 }
 
+/* One set or get call of a group of Float64 values; first is FMU_SET or FMU_GET, whose
+   slots follow in the order of fmu.h: function, value references, their count, the buffer,
+   the number of values. */
+static int transfer(const int64_t *c, int first, bool fmi3, bool set)
+{
+    void *component = SLOT(c, FMU_COMPONENT, void *);
+    const unsigned int *vrs = SLOT(c, first + 1, const unsigned int *);
+    size_t nvr = (size_t)c[first + 2], count = (size_t)c[first + 4];
+    double *buf = SLOT(c, first + 3, double *);
+    if (set)
+        return fmi3 ? SLOT(c, first, fmi3_set_fn)(component, vrs, nvr, buf, count)
+                    : SLOT(c, first, fmi2_set_fn)(component, vrs, nvr, buf);
+    return fmi3 ? SLOT(c, first, fmi3_get_fn)(component, vrs, nvr, buf, count)
+                : SLOT(c, first, fmi2_get_fn)(component, vrs, nvr, buf);
+}
+
 static int fmu_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
 {
     (void)state, (void)which;
@@ -99,10 +115,7 @@ static int fmu_update(const void *ctx, double t, double *state, const double *co
         double *buf = SLOT(c, FMU_SET_BUF, double *);
         for (int64_t i = 0; i < c[FMU_N_IN]; i++, port += 2)
             memcpy(buf + port[0], inputs[i], (size_t)port[1] * sizeof(double));
-        const unsigned int *vrs = SLOT(c, FMU_SET_VRS, const unsigned int *);
-        size_t nvr = (size_t)c[FMU_SET_NVR];
-        status = fmi3 ? SLOT(c, FMU_SET, fmi3_set_fn)(component, vrs, nvr, buf, (size_t)c[FMU_SET_COUNT])
-                      : SLOT(c, FMU_SET, fmi2_set_fn)(component, vrs, nvr, buf);
+        status = transfer(c, FMU_SET, fmi3, true);
         if (status > 1)
             return slow(c, FMU_SLOW_SET, t, status, inputs);
     }
@@ -123,13 +136,10 @@ static int fmu_update(const void *ctx, double t, double *state, const double *co
     Py_DECREF(checked);
     v[FMU_V_TIME] = t + h;
     if (c[FMU_GET]) {
-        double *buf = SLOT(c, FMU_GET_BUF, double *);
-        const unsigned int *vrs = SLOT(c, FMU_GET_VRS, const unsigned int *);
-        size_t nvr = (size_t)c[FMU_GET_NVR];
-        status = fmi3 ? SLOT(c, FMU_GET, fmi3_get_fn)(component, vrs, nvr, buf, (size_t)c[FMU_GET_COUNT])
-                      : SLOT(c, FMU_GET, fmi2_get_fn)(component, vrs, nvr, buf);
+        status = transfer(c, FMU_GET, fmi3, false);
         if (status > 1)
             return slow(c, FMU_SLOW_GET, t, status, inputs);
+        const double *buf = SLOT(c, FMU_GET_BUF, const double *);
         double *held = v + FMU_V_HELD;
         port = c + FMU_PORTS + 2 * c[FMU_N_IN];
         for (int64_t i = 0; i < c[FMU_N_OUT]; i++, port += 2) {

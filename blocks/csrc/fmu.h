@@ -21,8 +21,8 @@ enum {
     FMU_READY,     /* the steady step applies: started, not broken, not ended */
     FMU_VERSION,   /* 2 or 3 */
     FMU_COMPONENT, /* the fmi2Component / fmi3Instance */
-    FMU_SET,       /* set: the function (0: no inputs), value references, their count, the value buffer, */
-    FMU_SET_VRS,   /* the number of values (FMI 3) */
+    FMU_SET,       /* set: the function (0: no inputs), value references, their count, */
+    FMU_SET_VRS,   /* the value buffer, the number of values (FMI 3), in this order */
     FMU_SET_NVR,
     FMU_SET_BUF,
     FMU_SET_COUNT,
