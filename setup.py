@@ -3,7 +3,7 @@
 Metadata lives in pyproject.toml; this file only declares what is compiled, because
 setuptools' extension support is the build path every pip and every Python install
 already has (no CMake, no code generator). The framework's extension ``blocks._native``
-runs the compiled parts of event programs (``blocks/csrc``). Besides the extension ``hierhand._native``
+runs the compiled parts of event programs and holds the FMU block's kernel (``blocks/csrc``). Besides the extension ``hierhand._native``
 the build links two plain shared libraries from the same C sources,
 ``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so``, that ``hierhand fmu export`` copies
 into FMUs, so exporting needs no compiler. They link libc and libm only; their FMI
@@ -71,8 +71,8 @@ setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c"],
-            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h"],
+            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/fmu.c"],
+            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/fmu.h"],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),

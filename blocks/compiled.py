@@ -10,6 +10,11 @@ Python readers' inputs after each C call that computed them (copies, because the
 changes in place and a Python block may keep what it was given). An input with a default
 has a buffer of its own too, which holds the default until its source first fires.
 Loggers of compiled blocks are filled in C.
+
+A kernel with a ``bind`` is bound to its block's state once per run, here, after every
+other check has chosen it. An update that returns ``END_RUN`` is handed to the
+executor's ``end`` while the C call goes on; a kernel's ``RAISED`` exception comes back
+in the failure.
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .block import BlockError
-from .kernel import Kernel, address
+from .kernel import END_RUN, RAISED, Kernel, address
 
 try:
     from ._native import Runner as NativeRunner
@@ -90,13 +95,22 @@ class CompiledSide:
                 continue  # an input default of another width: the Python methods meet it as they would
             state = states[index[name]]
             if state is not None:
-                if not (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.ndim == 1
-                        and state.flags.c_contiguous and state.flags.writeable):
+                if kernel.bind is None and not (isinstance(state, np.ndarray) and state.dtype == np.float64
+                                                and state.ndim == 1 and state.flags.c_contiguous
+                                                and state.flags.writeable):
                     continue
                 if name in updated and not kernel.update:
                     continue
             if name in schedule.advanced and not kernel.advance:
                 continue
+            if kernel.bind is not None:
+                try:
+                    kernel = kernel.bind(state)
+                except Exception as exc:
+                    self.failure = (name, exc)
+                    self.blocks.clear()
+                    return
+                state = None
             self.blocks[name] = CompiledBlock(name, block, kernel, state, len(self.blocks))
         if not self.blocks:
             return
@@ -189,17 +203,25 @@ class CompiledSide:
         source = self.blocks[c.src_block].views[c.src_port]
         return [OP_COPY, source.size, address(self.buffers[c.dst_block, c.dst_port]), address(source)]
 
-    def runner(self, events: list[tuple[int, list[list[int]], list[tuple[str, str]]]]) -> "Runner":
-        """A C runner of ``events``: (tick offset, ops, (block, phase) per op) each."""
+    def runner(self, events: list[tuple[int, list[list[int]], list[tuple[str, str]]]],
+               end: Callable[[str, BaseException, int], int]) -> "Runner":
+        """A C runner of ``events``: (tick offset, ops, (block, phase) per op) each.
+        ``end(block, exception, tick)`` takes an update's request to end the run (its
+        ``EndRun``, from the kernel's error factory) and returns the tick the run ends at."""
         table, ops, steps = [], [], []
         for offset, event_ops, event_steps in events:
             table.append([offset, len(ops), len(ops) + len(event_ops)])
             ops += event_ops
             steps += event_steps
         tick = self.s.base_tick
+
+        def on_end(op: int, which: int, k: int) -> int:
+            name, phase = steps[op]
+            return end(name, self.error(name, phase, END_RUN, which, k), k)
+
         native = NativeRunner(self.slots, np.array(ops, dtype=np.int64).reshape(-1, 4),
                               np.array(table, dtype=np.int64).reshape(-1, 3), self.log_table, self.counters,
-                              tick.numerator, tick.denominator, (self.owners, self.blocks))
+                              tick.numerator, tick.denominator, (self.owners, self.blocks), on_end)
         return Runner(native, steps, self)
 
     def error(self, name: str, phase: str, code: int, which: int, tick: int) -> BaseException:
@@ -211,8 +233,8 @@ class CompiledSide:
 
 class Runner:
     """A compiled piece of an event program: ``run(k, next_k)`` returns None or the
-    failure ``(code, which, op, tick)``, which ``failure`` turns into its block, phase,
-    tick and exception."""
+    failure ``(code, which, op, tick, raised)``, which ``failure`` turns into its block,
+    phase, tick and exception (``raised`` itself for ``RAISED``)."""
 
     def __init__(self, native, steps: list[tuple[str, str]], side: CompiledSide):
         self.native = native
@@ -220,8 +242,10 @@ class Runner:
         self.steps = steps
         self.side = side
 
-    def failure(self, result: tuple[int, int, int, int]) -> tuple[str, str, int, BaseException]:
+    def failure(self, result: tuple[int, int, int, int, Any]) -> tuple[str, str, int, BaseException]:
         """(block, phase, tick, exception) of a failure ``run`` returned."""
-        code, which, op, tick = result
+        code, which, op, tick, raised = result
         name, phase = self.steps[op]
+        if code == RAISED:
+            return name, phase, tick, raised
         return name, phase, tick, self.side.error(name, phase, code, which, tick)

@@ -6,6 +6,13 @@ convention in ``blocks/csrc/blocks_kernel.h`` returns a ``Kernel`` from
 whose blocks all have kernels in one C call (no Python between the 1 ms hits of a
 controller and a plant, say). A block without a kernel runs through its Python methods
 as before; both kinds mix freely in one diagram.
+
+A block whose state is a live external object (an FMU instance) rather than a flat array
+gives its Kernel a ``bind``: the executor calls ``bind(state)`` once per run and uses the
+Kernel it returns, whose context is that run's own (the C functions keep what changes in
+it, and get no state pointer). Its functions may call back into Python (the executor
+holds the GIL), return ``RAISED`` with a Python exception set, and an update may return
+``END_RUN`` to end the run as ``EndRun`` does.
 """
 
 from __future__ import annotations
@@ -18,6 +25,13 @@ import numpy as np
 ErrorFactory = Callable[[int, int, float, str], BaseException]
 """``error(code, which, t, phase)``: the exception for a kernel's failure code at time
 ``t`` in ``phase`` ('output', 'update' or 'advance')."""
+
+END_RUN = -1
+"""``BLK_END_RUN``: an update that is done and asks to end the run; ``Kernel.error(END_RUN,
+...)`` returns the block's ``EndRun``, whose reason the run records."""
+
+RAISED = -2
+"""``BLK_RAISED``: the kernel set a Python exception, which is the step's error as it is."""
 
 
 def address(array: np.ndarray) -> int:
@@ -39,10 +53,12 @@ class Kernel:
     ``context`` is the pointer passed to them as ``ctx``; ``owners`` keeps alive the
     objects whose memory it and the functions use. The block's state must be a flat
     C-contiguous float64 array (or None for a stateless block), which the kernel updates
-    in place. The functions compute what the Python methods compute (to round-off; a run
-    uses one or the other for all of a block's hits). ``error``
-    makes the exception for a failure code (None: ``blocks.compiled.failure``, a message
-    with the code).
+    in place, unless the Kernel has a ``bind``: then ``bind(state)`` gives the Kernel of
+    one run, whose context holds what the functions change (they get NULL as state). The
+    functions compute what the Python methods compute (to round-off; a run uses one or
+    the other for all of a block's hits). ``error`` makes the exception for a failure
+    code, and the ``EndRun`` for ``END_RUN`` (None: ``blocks.compiled.failure``, a
+    message with the code).
     """
 
     context: int
@@ -51,3 +67,4 @@ class Kernel:
     advance: int = 0
     owners: tuple[Any, ...] = field(default=(), repr=False)
     error: ErrorFactory | None = field(default=None, repr=False)
+    bind: Callable[[Any], Kernel] | None = field(default=None, repr=False)

@@ -312,7 +312,8 @@ class _Run:
         def flush() -> None:
             if pending:
                 ops, steps = [op for op, _ in pending], [step for _, step in pending]
-                self.runner_step(code, self.compiled.runner([(0, ops, steps)]), last in {b for b, _ in steps})
+                self.runner_step(code, self.compiled.runner([(0, ops, steps)], self.kernel_end),
+                                 last in {b for b, _ in steps})
                 pending.clear()
 
         for i, (b, ports) in enumerate(program.evaluate):
@@ -367,8 +368,21 @@ class _Run:
             code.step(*copies)
 
     def kernel_failure(self, runner: Runner, result) -> _StepFailure:
+        """The failure a C call returned; an interrupt a kernel raised is raised here, the
+        run having reached its tick."""
         name, phase, tick, error = runner.failure(result)
+        if isinstance(error, KeyboardInterrupt):
+            self.reached = tick
+            raise error
         return _StepFailure(name, phase, tick, error)
+
+    def kernel_end(self, name: str, end: BaseException, tick: int) -> int:
+        """A compiled update's request to end the run (``request_end``); returns where the
+        run now ends. A kernel whose error factory gives no EndRun fails its update."""
+        if not isinstance(end, EndRun):
+            raise _StepFailure(name, "update", tick, end)
+        self.request_end(name, end.reason, tick)
+        return self.end_tick
 
     def interrupted_in_runner(self, runner: Runner, k: int) -> None:
         """An interrupt came during or right after a C call holding an event's last advance."""
@@ -569,7 +583,7 @@ class _Run:
         events = [(k - first, [op for op, _ in c.kernel_steps], [step for _, step in c.kernel_steps])
                   for k, c in pairs]
         code = _ProgramCode(self.s.base_tick)
-        self.runner_step(code, self.compiled.runner(events), has_last_advance=True)
+        self.runner_step(code, self.compiled.runner(events, self.kernel_end), has_last_advance=True)
         return code.function()
 
     def execute(self, progress: ProgressCallback | None) -> tuple[Results, SimulationError | None]:

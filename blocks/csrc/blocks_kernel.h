@@ -7,7 +7,8 @@
  * in one C call, with no Python in between (blocks/csrc/runner.c).
  *
  * Conventions, the same for every kernel:
- * - ctx is Kernel.context, passed back unchanged; the kernel only reads through it.
+ * - ctx is Kernel.context, passed back unchanged; the kernel only reads through it
+ *   (except a per-run context, below).
  * - state is the block's state, the flat float64 array initial_state() returned (NULL
  *   for a stateless block); update and advance change it in place.
  * - inputs[i] points at input port i, in the order of Block.inputs, of its declared
@@ -20,6 +21,17 @@
  *   (a joint, a finger) and advance sets *done to the number of rows it completed before
  *   the failing update. Kernel.error(code, which, t, phase) in Python turns these into
  *   the block's exception, so messages have one definition.
+ * - Two codes are not failures of that kind. BLK_END_RUN from update: the update is done
+ *   and the block asks to end the run (its Python update raises EndRun); the executor
+ *   finishes the tick and ends the run at the block's next hit, taking the reason from
+ *   Kernel.error(BLK_END_RUN, which, t, 'update'). BLK_RAISED: the kernel has set a
+ *   Python exception (only a kernel that runs with the GIL and Python's C API, as the
+ *   executor's calls do), which becomes the step's error as it is, a KeyboardInterrupt
+ *   the run's interrupt.
+ * - A block whose state is an external object rather than a flat array (an FMU instance)
+ *   gives its Kernel a bind(state): the executor calls it once per run and uses the Kernel
+ *   it returns, whose context belongs to that run; that kernel gets NULL as state, keeps
+ *   what changes in its context and may write there.
  * - A kernel computes what the block's Python methods compute. Within a run the executor
  *   uses a block's kernel for all of its hits or for none, so the two need not round
  *   alike; a block whose Python methods call the same C code (the hand's blocks) matches
@@ -30,6 +42,9 @@
 #define BLOCKS_KERNEL_H
 
 #define BLK_KERNEL_ABI 1
+
+#define BLK_END_RUN (-1)
+#define BLK_RAISED (-2)
 
 typedef int (*blk_output_fn)(const void *ctx, double t, const double *state, const double *const *inputs,
                              double *out, int *which);

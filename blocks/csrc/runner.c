@@ -10,6 +10,11 @@
  * costs nothing; logged outputs are copied into the loggers' buffers here, honouring
  * their decimation.
  *
+ * An update that returns BLK_END_RUN asks to end the run: the Runner calls
+ * ``on_end(op, which, tick)``, which records the request and returns the tick the run now
+ * ends at, finishes the event and runs no event from that tick on. A kernel that returns
+ * BLK_RAISED has set a Python exception; the failure carries it.
+ *
  * Time is k * num / den in double, as the Python executor computes it: both are exact
  * integers below 2^53 (the executor checks), so the division rounds the same way.
  */
@@ -20,6 +25,7 @@
 #include <string.h>
 
 #include "blocks_kernel.h"
+#include "fmu.h"
 #include "library.h"
 
 /* -- the tables a Runner is built from (int64 rows; pointers stored as integers) -------- */
@@ -46,6 +52,8 @@ typedef struct {
     Py_ssize_t n_events;
     int64_t num, den;
     int64_t reached; /* the tick the last call completed to (its advances reach it) */
+    int64_t stop;    /* the call runs no event from this tick on (an update asked to end the run) */
+    PyObject *on_end; /* on_end(op, which, tick) -> the tick the run ends at; None: a failure */
     PyObject *owners; /* the arrays the tables and pointers live in */
 } RunnerObject;
 
@@ -75,8 +83,43 @@ typedef struct {
 
 static op_end failure(int code, int which, Py_ssize_t op, int64_t tick)
 {
-    PyObject *t = Py_BuildValue("(iinL)", code, which, op, (long long)tick);
+    PyObject *raised = Py_None;
+    Py_INCREF(raised);
+    if (code == BLK_RAISED) {
+        PyObject *type, *value, *traceback;
+        PyErr_Fetch(&type, &value, &traceback);
+        if (type == NULL) {
+            PyErr_SetString(PyExc_SystemError, "a kernel returned BLK_RAISED without setting an exception");
+            PyErr_Fetch(&type, &value, &traceback);
+        }
+        PyErr_NormalizeException(&type, &value, &traceback);
+        if (traceback != NULL && value != NULL)
+            PyException_SetTraceback(value, traceback);
+        Py_XDECREF(type);
+        Py_XDECREF(traceback);
+        if (value != NULL)
+            Py_SETREF(raised, value);
+    }
+    PyObject *t = Py_BuildValue("(iinLN)", code, which, op, (long long)tick, raised);
     return (op_end){t, t == NULL};
+}
+
+/* An update at tick ke asked to end the run: on_end records it and says where the run
+   ends; no event of this call runs from there on. */
+static op_end end_request(RunnerObject *r, int which, Py_ssize_t op, int64_t ke)
+{
+    if (r->on_end == NULL || r->on_end == Py_None)
+        return failure(BLK_END_RUN, which, op, ke);
+    PyObject *end = PyObject_CallFunction(r->on_end, "niL", op, which, (long long)ke);
+    if (end == NULL)
+        return (op_end){NULL, 1};
+    long long tick = PyLong_AsLongLong(end);
+    Py_DECREF(end);
+    if (tick == -1 && PyErr_Occurred())
+        return (op_end){NULL, 1};
+    if (tick < r->stop)
+        r->stop = tick;
+    return (op_end){NULL, 0};
 }
 
 static const op_end DONE = {NULL, 0};
@@ -137,13 +180,16 @@ static op_end run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next
                 log_row(r, (Py_ssize_t)e, out);
     } else {
         code = ((blk_update_fn)(intptr_t)s[S_UPDATE])(ctx, tick_time(r, ke), state, inputs, &which);
+        if (code == BLK_END_RUN)
+            return end_request(r, which, index, ke);
     }
     return code ? failure(code, which, index, ke) : DONE;
 }
 
-/* run(k, next_k): None, or (code, which, op index, tick) of the first failure. Ctrl-C is
-   looked for between events and between the chunks of long advances; it raises
-   KeyboardInterrupt with ``reached`` saying how far the run got. */
+/* run(k, next_k): None, or (code, which, op index, tick, exception) of the first failure
+   (the exception a kernel raised with BLK_RAISED, else None). Ctrl-C is looked for between
+   events and between the chunks of long advances; it raises KeyboardInterrupt with
+   ``reached`` saying how far the run got. */
 static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t nargs)
 {
     if (nargs != 2) {
@@ -153,6 +199,7 @@ static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t n
     long long k = PyLong_AsLongLong(args[0]), next_k = PyLong_AsLongLong(args[1]);
     if ((k == -1 || next_k == -1) && PyErr_Occurred())
         return NULL;
+    r->stop = next_k;
     for (Py_ssize_t e = 0; e < r->n_events; e++) {
         const int64_t *ev = r->events + e * E_N;
         int64_t ke = k + ev[E_OFFSET];
@@ -171,6 +218,8 @@ static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t n
             }
         }
         r->reached = next;
+        if (r->stop < next_k)
+            next_k = r->stop;
         if (e + 1 < r->n_events && PyErr_CheckSignals() != 0)
             return NULL;
     }
@@ -202,12 +251,16 @@ static int64_t *int64_table(PyObject *obj, Py_ssize_t row, const char *what)
 
 static int runner_init(RunnerObject *r, PyObject *args, PyObject *kwds)
 {
-    PyObject *slots, *ops, *events, *logs, *counters, *owners;
+    PyObject *slots, *ops, *events, *logs, *counters, *owners, *on_end = Py_None;
     long long num, den;
-    static char *names[] = {"slots", "ops", "events", "logs", "counters", "num", "den", "owners", NULL};
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOLLO", names, &slots, &ops, &events, &logs, &counters, &num,
-                                     &den, &owners))
+    static char *names[] = {"slots", "ops", "events", "logs", "counters", "num", "den", "owners", "on_end", NULL};
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOLLO|O", names, &slots, &ops, &events, &logs, &counters, &num,
+                                     &den, &owners, &on_end))
         return -1;
+    if (on_end != Py_None && !PyCallable_Check(on_end)) {
+        PyErr_SetString(PyExc_TypeError, "Runner: on_end must be callable or None");
+        return -1;
+    }
     if (num <= 0 || den <= 0) {
         PyErr_SetString(PyExc_ValueError, "Runner: num and den must be positive");
         return -1;
@@ -225,6 +278,8 @@ static int runner_init(RunnerObject *r, PyObject *args, PyObject *kwds)
     r->num = num;
     r->den = den;
     r->reached = -1;
+    Py_INCREF(on_end);
+    Py_XSETREF(r->on_end, on_end);
     Py_INCREF(owners);
     Py_XSETREF(r->owners, Py_BuildValue("(OOOOOO)", slots, ops, events, logs, counters, owners));
     Py_DECREF(owners);
@@ -233,13 +288,15 @@ static int runner_init(RunnerObject *r, PyObject *args, PyObject *kwds)
 
 static void runner_dealloc(RunnerObject *r)
 {
+    Py_XDECREF(r->on_end);
     Py_XDECREF(r->owners);
     Py_TYPE(r)->tp_free((PyObject *)r);
 }
 
 static PyMethodDef runner_methods[] = {
     {"run", (PyCFunction)(void (*)(void))runner_run, METH_FASTCALL,
-     "run(k, next_k): the events from tick k before next_k; None, or (code, which, op, tick) of a failure."},
+     "run(k, next_k): the events from tick k before next_k; None, or (code, which, op, tick, exception) of a "
+     "failure."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -252,7 +309,8 @@ static PyTypeObject runner_type = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "blocks._native.Runner",
     .tp_basicsize = sizeof(RunnerObject),
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Runner(slots, ops, events, logs, counters, num, den, owners): compiled steps of event programs.",
+    .tp_doc = "Runner(slots, ops, events, logs, counters, num, den, owners, on_end=None): compiled steps of event "
+              "programs.",
     .tp_new = PyType_GenericNew,
     .tp_init = (initproc)runner_init,
     .tp_dealloc = (destructor)runner_dealloc,
@@ -391,10 +449,19 @@ static PyObject *library(PyObject *module, PyObject *unused)
     return found;
 }
 
+/* fmu_kernel(): the FMU block's kernel functions and its context's layout (fmu.h). */
+static PyObject *fmu_kernel(PyObject *module, PyObject *unused)
+{
+    (void)module;
+    (void)unused;
+    return blk_fmu_kernel();
+}
+
 static PyMethodDef module_methods[] = {
     {"call", call_kernel, METH_VARARGS,
      "call(kind, function, context, t, state, inputs, out, n=0): one kernel call ('output', 'update', 'advance')."},
     {"library", library, METH_NOARGS, "library(): {name: address} of the library blocks' kernels."},
+    {"fmu_kernel", fmu_kernel, METH_NOARGS, "fmu_kernel(): the FMU block's kernel functions and context layout."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -78,6 +78,7 @@ Modules, one concept each:
 - ``start_values``: what start values may set, their conversion and checks;
 - ``pool``: the instances of one FMU, reused across runs;
 - ``instance``: one FMU instance with its preallocated per-step calls, FMI 2 and 3;
+- ``kernel``: the compiled steady step (blocks/csrc/fmu.c) of an FMU with Float64 ports only;
 - ``log_messages``: the FMUs' log messages and the FMI 2 logger proxy;
 - ``interrupt``: Ctrl-C inside FMU calls;
 - ``description``: reading a modelDescription without running code (``hierhand fmu info``);

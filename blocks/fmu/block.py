@@ -19,12 +19,14 @@ import zipfile
 from collections.abc import Mapping
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from ..block import Block, BlockError, EndRun, Signal
+from ..kernel import Kernel
 from ..timebase import format_duration
 from . import interrupt
 from .instance import Instance
+from .kernel import fmu_kernel
 from .log_messages import status_name
 from .model import float_or_none
 from .pool import PooledModel
@@ -257,27 +259,48 @@ class FMU(Block):
         if abs(t - state.time) > 1e-9 * max(h, abs(t)):
             raise BlockError(f"{self._model.shown}: asked to step from t={t:.9g} s, but the FMU is at "
                              f"t={state.time:.9g} s (the block must fire every period)")
+        self.step_calls(inst, t, self._step_from, t, state, inst, inputs)
+        return state
+
+    def _step_from(self, t: float, state: FMUState, inst: Instance, inputs: Mapping[str, Signal]) -> None:
+        inst.arm()
+        inst.write(inputs, t)
+        self.stepped(t, state, inst, inst.do_step(t, self._step))
+
+    def stepped(self, t: float, state: FMUState, inst: Instance, outcome: tuple[bool, bool, float]) -> None:
+        """The rest of a step from ``t`` once doStep returned ``outcome`` (terminate
+        requested, returned early, last successful time): a noted Ctrl-C raised, a request
+        to terminate as EndRun, an early return a failure, else the outputs at ``t + h``."""
+        terminate, early, last = outcome
+        h = self._step
+        interrupt.check()
+        if terminate:
+            state.time = state.ended = last
+            state.outputs = inst.read(last)
+            short = f" (its step to t={t + h:.9g} s stopped at t={last:.9g} s)" if last < t + h - 1e-9 * h else ""
+            raise EndRun(f"{self._model.shown} requested to terminate the simulation{short}", state)
+        if early:
+            inst.broken = True
+            raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) returned early "
+                             f"at t={last:.9g} s, which co-simulation here does not allow{inst.log_text()}")
+        state.time = t + h
+        state.outputs = inst.read(state.time)
+
+    def step_calls(self, inst: Instance, t: float, calls: Callable[..., None], *args: Any) -> None:
+        """``calls(*args)``: calls into the FMU for the step from ``t``, whose failure
+        (other than the block's own errors, EndRun and Ctrl-C) breaks the instance and
+        becomes a BlockError with the FMU's log (``_failure``)."""
         try:
-            inst.arm()
-            inst.write(inputs, t)
-            terminate, early, last = inst.do_step(t, h)
-            interrupt.check()
-            if terminate:
-                state.time = state.ended = last
-                state.outputs = inst.read(last)
-                short = f" (its step to t={t + h:.9g} s stopped at t={last:.9g} s)" if last < t + h - 1e-9 * h else ""
-                raise EndRun(f"{self._model.shown} requested to terminate the simulation{short}", state)
-            if early:
-                inst.broken = True
-                raise BlockError(f"{self._model.shown}: doStep at t={t:.9g} s (step {h:.9g} s) returned early "
-                                 f"at t={last:.9g} s, which co-simulation here does not allow{inst.log_text()}")
-            state.time = t + h
-            state.outputs = inst.read(state.time)
+            calls(*args)
         except (BlockError, EndRun):
             raise
         except Exception as exc:
-            raise self._failure(inst, _reason(exc, t, h)) from None
-        return state
+            raise self._failure(inst, _reason(exc, t, self._step)) from None
+
+    def kernel(self) -> Kernel | None:
+        """The steady step in C (``blocks.fmu.kernel``) when every port is Float64; an FMU
+        with ports of other types runs in Python."""
+        return fmu_kernel(self)
 
     def _failure(self, inst: Instance, what: str) -> BlockError:
         """The error of a failed call into the FMU, which breaks the instance: ``what`` with

@@ -65,7 +65,8 @@ class Transfer:
     between the FMU and the C buffer that ``view`` shows (in the variables' own type) and
     returns the FMI status of ``function``; ``slices`` says where each port's values lie,
     ``check`` whether values need checking on their way (an input type narrower than
-    float64, an output type with integers beyond 2^53)."""
+    float64, an output type with integers beyond 2^53). ``address`` and ``vrs`` are the C
+    function and its value references, for a compiled kernel that makes the same call."""
 
     function: str
     call: Callable[[], int]
@@ -73,6 +74,8 @@ class Transfer:
     slices: list[tuple[str, int, int]]
     kind: PortKind
     check: bool
+    address: int
+    vrs: Any
 
 
 def new_instance(model: Binary) -> Instance:
@@ -147,7 +150,22 @@ class Instance:
         """One doStep; (terminate requested, returned early, last successful time).
         Raises fmpy's FMICallException for an error status, or for a discard that is not a
         request to terminate, as fmpy's own call does."""
+        return self.outcome(self.call_do_step(t, h), t, h)
+
+    def call_do_step(self, t: float, h: float) -> int:
+        """The doStep call itself; its status (FMI 3's flags land in ``step_flags``)."""
         raise NotImplementedError
+
+    def outcome(self, status: int, t: float, h: float) -> tuple[bool, bool, float]:
+        """What a doStep from ``t`` that returned ``status`` did, as ``do_step`` says it
+        (a compiled kernel makes the call and asks here when it was not a plain success)."""
+        raise NotImplementedError
+
+    def do_step_address(self) -> int:
+        """The C address of the FMU's doStep."""
+        import ctypes
+
+        return ctypes.cast(self._do_step, ctypes.c_void_p).value
 
     def arm(self) -> None:
         """Before a call into the FMU: the interrupt hook in place."""
@@ -166,7 +184,9 @@ class Instance:
             args = (self.component, vrs, len(g.vrs), buf) + ((g.count,) if self.value_counts else ())
             call = functools.partial(self.slave._functions[function], *args)
             check = not g.kind.is_float if verb == "Set" else g.kind.exceeds_float64
-            out.append(Transfer(function, call, np.frombuffer(buf, dtype=g.kind.dtype), g.slices, g.kind, check))
+            address = ctypes.cast(self.slave._functions[function], ctypes.c_void_p).value
+            out.append(Transfer(function, call, np.frombuffer(buf, dtype=g.kind.dtype), g.slices, g.kind, check,
+                                address, vrs))
         return out
 
     def log_text(self) -> str:
@@ -306,8 +326,10 @@ class FMI2Instance(Instance):
         self.slave.setupExperiment(tolerance=tolerance, startTime=t)
         self.slave.enterInitializationMode()
 
-    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
-        status = self._do_step(self.component, t, h, 1)
+    def call_do_step(self, t: float, h: float) -> int:
+        return self._do_step(self.component, t, h, 1)
+
+    def outcome(self, status: int, t: float, h: float) -> tuple[bool, bool, float]:
         if status == 2 and self._terminated():
             return True, False, self._last_time(t + h)
         if status > 1:
@@ -352,15 +374,17 @@ class FMI3Instance(Instance):
         self.slave.instantiate(logMessage=interrupt.callback(log3))
         self._do_step = self.slave._functions["fmi3DoStep"]
         flags = [ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(), ctypes.c_double()]
-        self._step_flags = flags
+        self.step_flags = flags
         self._step_refs = [ctypes.byref(f) for f in flags]
 
     def _initialise(self, t: float, tolerance: float | None) -> None:
         self.slave.enterInitializationMode(tolerance=tolerance, startTime=t)
 
-    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
-        status = self._do_step(self.component, t, h, True, *self._step_refs)
+    def call_do_step(self, t: float, h: float) -> int:
+        return self._do_step(self.component, t, h, True, *self._step_refs)
+
+    def outcome(self, status: int, t: float, h: float) -> tuple[bool, bool, float]:
         if status > 1:
             raise call_failed("fmi3DoStep", status)
-        _, terminate, early, last = self._step_flags
+        _, terminate, early, last = self.step_flags
         return terminate.value, early.value, last.value

@@ -16,6 +16,10 @@ like a broken FMU. So the FMU block:
 - calls ``check()`` after every call into an FMU, and before it turns an error status
   into a failure: a noted interrupt is raised there as the KeyboardInterrupt it was, so
   the executor stops the run as interrupted and keeps the results so far.
+
+The FMU's compiled kernel (``blocks.fmu.kernel``) does the same from C: before a step it
+arms again when ``sys.unraisablehook`` is not ``hook``, after each doStep it calls
+``check``, and a KeyboardInterrupt raised there ends the run as interrupted.
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ _noted: KeyboardInterrupt | None = None
 _previous: Callable[[Any], None] | None = None
 
 
-def _hook(unraisable: Any) -> None:
+def hook(unraisable: Any) -> None:
     """``sys.unraisablehook``: note a KeyboardInterrupt lost in one of our callbacks."""
     if issubclass(unraisable.exc_type, KeyboardInterrupt) and getattr(unraisable.object, "fmu_callback", False):
         note(unraisable.exc_value)
@@ -42,9 +46,9 @@ def arm() -> None:
     """Install the hook, again if other code has replaced it since (cheap: call before
     every call into an FMU)."""
     global _previous
-    if sys.unraisablehook is not _hook:
+    if sys.unraisablehook is not hook:
         _previous = sys.unraisablehook
-        sys.unraisablehook = _hook
+        sys.unraisablehook = hook
 
 
 def callback(function: Callable[..., None]) -> Callable[..., None]:

@@ -82,3 +82,13 @@ def fmi2_logger():
     scratch.logger = callback
     add(ref)
     return callback
+
+
+def fmi2_logger_arming() -> tuple[int, int]:
+    """``fmi2_logger`` as C can do it before every step: the addresses of fmpy's
+    addLoggerProxy and of the callback functions it takes (ours), for the FMU's kernel."""
+    import ctypes
+
+    fmi2_logger()
+    add, scratch, _, _ = _fmi2_proxy
+    return ctypes.cast(add, ctypes.c_void_p).value, ctypes.addressof(scratch)

@@ -1,0 +1,188 @@
+/* The compiled kernel of the FMU block (blocks/fmu): the steady step of a co-simulation FMU
+ * whose ports are all Float64 -- set the inputs, doStep, get the outputs -- through the
+ * FMU's own C functions, with no Python in between.
+ *
+ * Its context is one run's int64 table (FMU_* slots, then the ports), made and filled by
+ * blocks/fmu/kernel.py, which binds it to the run's FMU instance. The kernel keeps the
+ * FMU's time and outputs there (the values array), so it writes through its context.
+ * Everything but the steady step goes to the Python side, slow(kind, t, status), which
+ * does what the block's Python methods do from that point on, with the same messages: the
+ * first call (taking an instance, initialising it), a step at the wrong time or of a broken
+ * or ended instance, a call that returned worse than a warning, a doStep that asks to
+ * terminate or returned early, and arming the interrupt hook when other code replaced it.
+ * slow returns 0, or 1 when the update ended the run (BLK_END_RUN); a failure is a Python
+ * exception (BLK_RAISED).
+ *
+ * As the Python side does around each step: before it, the interrupt hook is looked at
+ * and FMI 2's log proxy re-armed; after doStep, interrupt.check() raises a Ctrl-C that an
+ * FMU callback noted (blocks/fmu/interrupt.py).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+
+#include <math.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "fmu.h"
+
+/* The FMI functions the step calls (the FMI 2.0 and 3.0 signatures; statuses are ints,
+   ok 0 and warning 1). */
+typedef int (*fmi2_set_fn)(void *, const unsigned int *, size_t, const double *);
+typedef int (*fmi2_get_fn)(void *, const unsigned int *, size_t, double *);
+typedef int (*fmi2_do_step_fn)(void *, double, double, int);
+typedef int (*fmi3_set_fn)(void *, const unsigned int *, size_t, const double *, size_t);
+typedef int (*fmi3_get_fn)(void *, const unsigned int *, size_t, double *, size_t);
+typedef int (*fmi3_do_step_fn)(void *, double, double, bool, bool *, bool *, bool *, double *);
+typedef void (*log_arm_fn)(void *);
+
+#define SLOT(c, i, type) ((type)(intptr_t)(c)[i])
+
+/* The Python side for what is not the steady step; also where the inputs are for it. */
+static int slow(int64_t *c, long kind, double t, int status, const double *const *inputs)
+{
+    c[FMU_INPUTS] = (int64_t)(intptr_t)inputs;
+    PyObject *result = PyObject_CallFunction(SLOT(c, FMU_SLOW, PyObject *), "ldi", kind, t, status);
+    if (result == NULL)
+        return BLK_RAISED;
+    long ended = PyLong_AsLong(result);
+    Py_DECREF(result);
+    if (ended == -1 && PyErr_Occurred())
+        return BLK_RAISED;
+    return ended ? BLK_END_RUN : 0;
+}
+
+static int fmu_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                      int *which)
+{
+    (void)state, (void)which;
+    int64_t *c = (int64_t *)(intptr_t)ctx;
+    if (!c[FMU_STARTED]) {
+        int code = slow(c, FMU_SLOW_OUTPUT, t, 0, inputs);
+        if (code)
+            return code;
+    }
+    memcpy(out, SLOT(c, FMU_VALUES, double *) + FMU_V_HELD, (size_t)c[FMU_WIDTH] * sizeof(double));
+    return 0;
+}
+
+/* Before a step, as Instance.arm: our unraisablehook in place, FMI 2's logger re-armed. */
+static int arm(int64_t *c, double t, const double *const *inputs)
+{
+    if (PySys_GetObject("unraisablehook") != SLOT(c, FMU_HOOK, PyObject *)) {
+        int code = slow(c, FMU_SLOW_ARM, t, 0, inputs);
+        if (code)
+            return code;
+    }
+    if (c[FMU_LOG_ARM])
+        SLOT(c, FMU_LOG_ARM, log_arm_fn)(SLOT(c, FMU_LOG_ARG, void *));
+    return 0;
+}
+
+/* One set or get call of a group of Float64 values; first is FMU_SET or FMU_GET, whose
+   slots follow in the order of fmu.h: function, value references, their count, the buffer,
+   the number of values. */
+static int transfer(const int64_t *c, int first, bool fmi3, bool set)
+{
+    void *component = SLOT(c, FMU_COMPONENT, void *);
+    const unsigned int *vrs = SLOT(c, first + 1, const unsigned int *);
+    size_t nvr = (size_t)c[first + 2], count = (size_t)c[first + 4];
+    double *buf = SLOT(c, first + 3, double *);
+    if (set)
+        return fmi3 ? SLOT(c, first, fmi3_set_fn)(component, vrs, nvr, buf, count)
+                    : SLOT(c, first, fmi2_set_fn)(component, vrs, nvr, buf);
+    return fmi3 ? SLOT(c, first, fmi3_get_fn)(component, vrs, nvr, buf, count)
+                : SLOT(c, first, fmi2_get_fn)(component, vrs, nvr, buf);
+}
+
+static int fmu_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
+{
+    (void)state, (void)which;
+    int64_t *c = (int64_t *)(intptr_t)ctx;
+    double *v = SLOT(c, FMU_VALUES, double *);
+    double h = v[FMU_V_STEP];
+    if (!c[FMU_READY] || fabs(t - v[FMU_V_TIME]) > 1e-9 * fmax(h, fabs(t)))
+        return slow(c, FMU_SLOW_UPDATE, t, 0, inputs);
+    int code = arm(c, t, inputs);
+    if (code)
+        return code;
+    void *component = SLOT(c, FMU_COMPONENT, void *);
+    bool fmi3 = c[FMU_VERSION] == 3;
+    const int64_t *port = c + FMU_PORTS;
+    int status;
+    if (c[FMU_SET]) {
+        double *buf = SLOT(c, FMU_SET_BUF, double *);
+        for (int64_t i = 0; i < c[FMU_N_IN]; i++, port += 2)
+            memcpy(buf + port[0], inputs[i], (size_t)port[1] * sizeof(double));
+        status = transfer(c, FMU_SET, fmi3, true);
+        if (status > 1)
+            return slow(c, FMU_SLOW_SET, t, status, inputs);
+    }
+    if (fmi3) {
+        bool *terminate = SLOT(c, FMU_FLAGS + 1, bool *), *early = SLOT(c, FMU_FLAGS + 2, bool *);
+        status = SLOT(c, FMU_DO_STEP, fmi3_do_step_fn)(component, t, h, true, SLOT(c, FMU_FLAGS, bool *), terminate,
+                                                        early, SLOT(c, FMU_FLAGS + 3, double *));
+        if (status > 1 || *terminate || *early)
+            return slow(c, FMU_SLOW_STEP, t, status, inputs);
+    } else {
+        status = SLOT(c, FMU_DO_STEP, fmi2_do_step_fn)(component, t, h, 1);
+        if (status > 1)
+            return slow(c, FMU_SLOW_STEP, t, status, inputs);
+    }
+    PyObject *checked = PyObject_CallNoArgs(SLOT(c, FMU_CHECK, PyObject *));
+    if (checked == NULL)
+        return BLK_RAISED;
+    Py_DECREF(checked);
+    v[FMU_V_TIME] = t + h;
+    if (c[FMU_GET]) {
+        status = transfer(c, FMU_GET, fmi3, false);
+        if (status > 1)
+            return slow(c, FMU_SLOW_GET, t, status, inputs);
+        const double *buf = SLOT(c, FMU_GET_BUF, const double *);
+        double *held = v + FMU_V_HELD;
+        port = c + FMU_PORTS + 2 * c[FMU_N_IN];
+        for (int64_t i = 0; i < c[FMU_N_OUT]; i++, port += 2) {
+            memcpy(held, buf + port[0], (size_t)port[1] * sizeof(double));
+            held += port[1];
+        }
+    }
+    return 0;
+}
+
+typedef struct {
+    const char *name;
+    int value;
+} named;
+
+static const named slots[] = {
+    {"slow", FMU_SLOW}, {"check", FMU_CHECK}, {"hook", FMU_HOOK}, {"log_arm", FMU_LOG_ARM}, {"log_arg", FMU_LOG_ARG},
+    {"values", FMU_VALUES}, {"inputs", FMU_INPUTS}, {"width", FMU_WIDTH}, {"started", FMU_STARTED},
+    {"ready", FMU_READY}, {"version", FMU_VERSION}, {"component", FMU_COMPONENT}, {"set", FMU_SET},
+    {"set_vrs", FMU_SET_VRS}, {"set_nvr", FMU_SET_NVR}, {"set_buf", FMU_SET_BUF}, {"set_count", FMU_SET_COUNT},
+    {"do_step", FMU_DO_STEP}, {"get", FMU_GET}, {"get_vrs", FMU_GET_VRS}, {"get_nvr", FMU_GET_NVR},
+    {"get_buf", FMU_GET_BUF}, {"get_count", FMU_GET_COUNT}, {"flags", FMU_FLAGS}, {"n_in", FMU_N_IN},
+    {"n_out", FMU_N_OUT}, {"ports", FMU_PORTS}, {NULL, 0}};
+static const named values[] = {{"time", FMU_V_TIME}, {"step", FMU_V_STEP}, {"held", FMU_V_HELD}, {NULL, 0}};
+static const named kinds[] = {{"output", FMU_SLOW_OUTPUT}, {"update", FMU_SLOW_UPDATE}, {"arm", FMU_SLOW_ARM},
+                              {"set", FMU_SLOW_SET}, {"step", FMU_SLOW_STEP}, {"get", FMU_SLOW_GET}, {NULL, 0}};
+
+/* {name: value} of a table of names, or NULL with an exception. */
+static PyObject *names(const named *table)
+{
+    PyObject *found = PyDict_New();
+    for (const named *e = table; found != NULL && e->name != NULL; e++) {
+        PyObject *value = PyLong_FromLong(e->value);
+        if (value == NULL || PyDict_SetItemString(found, e->name, value) != 0)
+            Py_CLEAR(found);
+        Py_XDECREF(value);
+    }
+    return found;
+}
+
+PyObject *blk_fmu_kernel(void)
+{
+    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
+                         PyLong_FromVoidPtr((void *)fmu_update), "slots", names(slots), "values", names(values),
+                         "kinds", names(kinds));
+}

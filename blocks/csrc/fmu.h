@@ -1,0 +1,59 @@
+/* The FMU block's compiled kernel (fmu.c): the layout of its per-run context, for
+ * blocks._native, which hands the layout and the functions to blocks/fmu/kernel.py. */
+#ifndef BLOCKS_FMU_H
+#define BLOCKS_FMU_H
+
+#include <Python.h>
+
+#include "blocks_kernel.h"
+
+/* The context: an int64 table, pointers stored as integers. */
+enum {
+    FMU_SLOW,      /* PyObject *: slow(kind, t, status) -> 0, or 1 when the update ended the run */
+    FMU_CHECK,     /* PyObject *: interrupt.check, called after each doStep */
+    FMU_HOOK,      /* PyObject *: interrupt's sys.unraisablehook (another there: slow arms it again) */
+    FMU_LOG_ARM,   /* FMI 2: fmpy's addLoggerProxy, called with FMU_LOG_ARG before a step; 0 for FMI 3 */
+    FMU_LOG_ARG,
+    FMU_VALUES,    /* double *: the FMU's time, the step, the outputs held there (FMU_V_*) */
+    FMU_INPUTS,    /* the inputs of the call that went to slow, for the Python side */
+    FMU_WIDTH,     /* the summed width of the output ports */
+    FMU_STARTED,   /* the FMU is initialised: the held outputs are its outputs */
+    FMU_READY,     /* the steady step applies: started, not broken, not ended */
+    FMU_VERSION,   /* 2 or 3 */
+    FMU_COMPONENT, /* the fmi2Component / fmi3Instance */
+    FMU_SET,       /* set: the function (0: no inputs), value references, their count, */
+    FMU_SET_VRS,   /* the value buffer, the number of values (FMI 3), in this order */
+    FMU_SET_NVR,
+    FMU_SET_BUF,
+    FMU_SET_COUNT,
+    FMU_DO_STEP,
+    FMU_GET, /* get: as set (0: no outputs) */
+    FMU_GET_VRS,
+    FMU_GET_NVR,
+    FMU_GET_BUF,
+    FMU_GET_COUNT,
+    FMU_FLAGS, /* FMI 3 doStep's output arguments: eventHandlingNeeded, terminateSimulation, earlyReturn, */
+    FMU_N_IN = FMU_FLAGS + 4, /* lastSuccessfulTime (the instance's own) */
+    FMU_N_OUT,
+    FMU_PORTS /* then [offset in the set buffer, width] per input port in Block.inputs order, and
+                 [offset in the get buffer, width] per output port in Block.outputs order */
+};
+
+/* The values array. */
+enum { FMU_V_TIME, FMU_V_STEP, FMU_V_HELD };
+
+/* What slow is asked to do. */
+enum {
+    FMU_SLOW_OUTPUT, /* the outputs of an FMU not yet initialised */
+    FMU_SLOW_UPDATE, /* the whole update (not ready, or a step at the wrong time) */
+    FMU_SLOW_ARM,    /* interrupt.arm() */
+    FMU_SLOW_SET,    /* setting the inputs returned status */
+    FMU_SLOW_STEP,   /* doStep returned status, or asked to terminate, or returned early */
+    FMU_SLOW_GET     /* getting the outputs returned status (the FMU's time is past the step) */
+};
+
+/* {"output": address, "update": address, "slots": {name: index}, "values": {...},
+   "kinds": {...}}: the kernel's functions and its context's layout. */
+PyObject *blk_fmu_kernel(void);
+
+#endif
