@@ -65,6 +65,7 @@ class Timings:
     serial_runs: list[float] = field(default_factory=list)
     auto: list[float] = field(default_factory=list)
     auto_local: list[int] = field(default_factory=list)
+    auto_workers: list[int] = field(default_factory=list)
     dask: list[float] = field(default_factory=list)
     dask_runs: list[float] = field(default_factory=list)
     dask_startup: list[float] = field(default_factory=list)
@@ -126,6 +127,7 @@ def measure(t_end: str, points: int, workers: int | None, repeat: int, tmp: Path
         auto = in_fresh_process("auto", t_end, points, None, tmp / f"auto{i}")
         timings.auto.append(auto["wall"])
         timings.auto_local.append(auto["local"])
+        timings.auto_workers.append(auto["workers"])
         if can_fork:
             timings.pool.append(in_fresh_process("pool", t_end, points, dask["workers"], tmp / f"pool{i}")["wall"])
         timings.failed += serial["failed"] + dask["failed"] + auto["failed"]
@@ -140,8 +142,9 @@ def report(t_end: str, timings: Timings) -> None:
     print(f"  serial, in process:            {serial:7.3f} s  (runs {med(timings.serial_runs):.3f} s)")
     print(f"  LocalCluster, {timings.workers} worker(s):     {dask:7.3f} s  (cluster start "
           f"{med(timings.dask_startup):.3f} s, runs {med(timings.dask_runs):.3f} s)")
-    print(f"  default, local head start:     {auto:7.3f} s  ({med(timings.auto_local)} points run locally "
-          "before the cluster took over)")
+    clustered = sum(1 for w in timings.auto_workers if w)
+    print(f"  default, local head start:     {auto:7.3f} s  (cluster started in {clustered} of "
+          f"{len(timings.auto)} sweeps; {med(timings.auto_local)} points run locally)")
     if timings.pool:
         print(f"  forked process pool, no Dask:  {med(timings.pool):7.3f} s  (reference: the machine's ceiling)")
     print(f"  failed runs: {timings.failed}")

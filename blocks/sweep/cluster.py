@@ -30,7 +30,7 @@ import uuid
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from .chunks import ChunkSizer
 from .errors import SweepError
@@ -38,9 +38,6 @@ from .points import Point
 from .queue import PointQueue, SharedQueue
 from .runner import Outcome, Record, SweepJob, SweepReport, default_workers, one_line, run_points
 from .store import FAILED, OK
-
-if TYPE_CHECKING:
-    from .local import LocalRunner
 
 WORKER_WAIT_S = 30.0
 """How long to wait for a remote scheduler to have at least one worker."""
@@ -196,7 +193,7 @@ def _local_cluster(workers: int | None, method: str | None):
 
 def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQueue, record: Record,
              workers: int | None = None, scheduler: str | None = None, connect_timeout: float = 20.0,
-             method: str | None = None, client: Any = None, beside: LocalRunner | None = None) -> SweepReport:
+             method: str | None = None, client: Any = None, beside: Any = None) -> SweepReport:
     """Run the points on a new LocalCluster (``workers`` processes, started by ``method``:
     see ``start_method``), at ``scheduler``, or through ``client`` (from ``connect``; this
     call closes it).
@@ -206,7 +203,7 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQ
     cluster this call started are closed. ``beside`` is a local runner taking points from
     the same ``todo`` queue while the cluster starts (``local``): once the cluster is
     ready it is told to stop, its run times size the first tasks, and what it sends is
-    recorded as tasks complete.
+    recorded as tasks complete (``local.LocalRunner``: ``stop()``, ``collect()``, ``walls``).
     """
     from distributed import Client, as_completed
 
