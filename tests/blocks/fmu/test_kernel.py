@@ -149,6 +149,29 @@ log: [f.y]
     assert_same(compiled, reference)
 
 
+@pytest.mark.parametrize("which, failing", [("set", "fmi2SetReal"), ("get", "fmi2GetReal")])
+def test_a_failing_set_or_get_through_the_kernel_fails_as_in_python(tmp_path, monkeypatch, which, failing):
+    """The FMU refuses to take u (to give y) from t = 0.3 s: inside a fused C call, the
+    same status, FMU log line and samples as through the Python methods."""
+    why = build_error()
+    if why:
+        pytest.skip(why)
+    library = compile_library(tmp_path / f"fail_{which}{fmpy.sharedLibraryExtension}", "first_order_fmi2.c",
+                              "fmi2_unsupported.c", defines={f"FAIL_{which.upper()}_AT": "0.3"})
+    path = zip_files(tmp_path / f"fail_{which}.fmu", fmi2_files(library))
+    d = diagram(path)
+    reference = python(monkeypatch, d)
+    counts = slow_calls(monkeypatch)
+    compiled = simulate(d)
+    at = "0.3" if which == "set" else "0.2"   # a get fails after the step from 0.2 s to 0.3 s
+    assert compiled.status.startswith(f"failed at t={at} s: block 'f' (FMU)"), compiled.status
+    assert f"{failing} returned status 'error'" in compiled.status
+    assert f"cannot {which} " in compiled.status                          # the FMU's log line
+    assert_same(compiled, reference)
+    assert counts == {"output": 1, which: 1}
+    assert simulate(d).status == compiled.status                          # the broken instance was not pooled
+
+
 def test_an_fmu_with_ports_of_other_types_runs_in_python(fmus, first_order):
     """Only Float64 ports have a C path; FMI 3's first-order FMU has a Float32 output."""
     assert FMU(first_order[2]).kernel() is not None and FMU(first_order[3]).kernel() is not None

@@ -7,6 +7,8 @@
  *
  * Value references: a 0, b 1, x0 2, threshold 3, scale 4 (Integer), frozen 5 (Boolean),
  * u 6, y 7, z[1] 8, z[2] 9.
+ * Built with FAIL_SET_AT (FAIL_GET_AT), setting u (getting y) fails with fmi2Error, logged,
+ * once the FMU's time has reached that value.
  */
 #include <stdio.h>
 #include <stdlib.h>
@@ -97,6 +99,13 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
     Model *m = c;
     for (size_t i = 0; i < n; i++) {
         if (vr[i] >= NREAL) return fmi2Error;
+#ifdef FAIL_GET_AT
+        if (vr[i] == 7 && m->time >= FAIL_GET_AT) {
+            m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError", "cannot get y at t = %g",
+                         m->time);
+            return fmi2Error;
+        }
+#endif
         v[i] = m->r[vr[i]];
     }
     return fmi2OK;
@@ -109,6 +118,13 @@ fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
                          "cannot set value reference %u", vr[i]);
             return fmi2Error;
         }
+#ifdef FAIL_SET_AT
+        if (vr[i] == 6 && m->time >= FAIL_SET_AT) {
+            m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError", "cannot set u at t = %g",
+                         m->time);
+            return fmi2Error;
+        }
+#endif
         m->r[vr[i]] = v[i];
     }
     return fmi2OK;
