@@ -3,7 +3,8 @@
 The options become a call of ``blocks.sweep.run_sweep``: the points from ``--grid``,
 ``--random`` or ``--points``, the metrics from ``--metric``. The environment variable
 ``PREFIX_SWEEP_START`` (``Program.env``) chooses how a LocalCluster starts its workers
-(fork, spawn, forkserver; ``blocks.sweep.cluster.start_method``).
+(fork, spawn, forkserver; ``blocks.sweep.cluster.start_method``); any but fork also keeps
+the sweep from forking its local head-start process (``blocks.sweep.local``).
 """
 
 from __future__ import annotations

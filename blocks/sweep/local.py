@@ -51,10 +51,12 @@ def cluster_pays_off(typical_run_s: float, remaining: int, workers: int) -> bool
     return speedup > 1 and (work - CLUSTER_START_S) * (1 - 1 / speedup) > CLUSTER_STOP_S
 
 
-def can_run_locally() -> bool:
+def can_run_locally(method: str | None = None) -> bool:
     """A local runner needs a platform that forks (a spawned one would import everything
-    again, which takes longer than the work it is there for)."""
-    return "fork" in multiprocessing.get_all_start_methods()
+    again, which takes longer than the work it is there for), and no request to start
+    processes another way (``method``, the sweep's start method: a user who asks for spawn
+    keeps this process from forking)."""
+    return method in (None, "fork") and "fork" in multiprocessing.get_all_start_methods()
 
 
 def _died(process: Any) -> str:

@@ -147,7 +147,7 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
             warm_up(plan.job, todo[0][1])
             if serial:
                 report = run_serial(plan.job, todo, record)
-            elif workers is None and scheduler is None and can_run_locally():
+            elif workers is None and scheduler is None and can_run_locally(start_method):
                 report = run_local_first(plan.job, todo, record, method=start_method)
             else:
                 report = run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,

@@ -74,6 +74,13 @@ def test_a_small_sweep_runs_in_the_local_process_with_the_rows_of_a_serial_sweep
     assert rows(tmp_path / "default") == rows(tmp_path / "serial")
 
 
+def test_asking_for_spawned_processes_keeps_the_sweep_from_forking_a_local_one(tmp_path):
+    assert local.can_run_locally() and local.can_run_locally("fork") and not local.can_run_locally("spawn")
+    summary = run_sweep(TOY, grid_points({"prop.k": [1, 2]}), METRICS, tmp_path / "s", t_end="50 ms",
+                        progress=False, start_method="spawn")
+    assert summary.report.local == 0 and summary.report.workers >= 1 and summary.failed == 0
+
+
 NAP_MODULE = '''
 import time
 
