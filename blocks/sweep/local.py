@@ -32,6 +32,9 @@ importing distributed 0.14 s, starting two forked workers and connecting to them
 CLUSTER_STOP_S = 0.03
 """Seconds to stop a LocalCluster of two workers (0.02 s measured) and collect the last results."""
 
+Keep = Callable[[str, Outcome], None]
+"""Saves a kept run's results by its point hash and drops them from the outcome."""
+
 FIRST_RUN_SLOWER = 2.0
 """At most how much longer a local runner's first run takes than its later ones (1.6x
 measured for a re-grasp), taken on the safe side."""
@@ -69,9 +72,12 @@ def _died(process: Any) -> str:
     return f"exit code {code}"
 
 
-def _serve(job: SweepJob, queue: SharedQueue, stop: Any, conn: Any) -> None:
+def _serve(job: SweepJob, queue: SharedQueue, stop: Any, conn: Any, keep: Keep | None) -> None:
     """The runner process: take one point at a time until none is left or ``stop`` is set;
-    say which point it starts and send its outcome when done."""
+    say which point it starts and send its outcome when done. A kept run's results are
+    saved here by ``keep`` (a folder per point, written before its row), so that only the
+    small outcome goes through the pipe; if saving fails, they go too and the sweep's
+    process saves them, or says why it cannot."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is answered by the sweep's process
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
     try:
@@ -81,6 +87,11 @@ def _serve(job: SweepJob, queue: SharedQueue, stop: Any, conn: Any) -> None:
                 break
             conn.send(("start", taken[0]))
             outcome = run_point(job, queue.items[taken[0]][1])
+            if keep is not None:
+                try:
+                    keep(queue.items[taken[0]][0], outcome)
+                except Exception:  # the sweep's process tries again, and reports it
+                    pass
             try:
                 conn.send(("done", taken[0], outcome))
             except (pickle.PicklingError, TypeError, AttributeError) as exc:  # as a Dask task's result would fail
@@ -98,8 +109,9 @@ class LocalRunner:
     outcome to ``record(index, outcome)`` as it arrives, a point the process died under
     as failed. After such a death ``start`` forks a new one for the points left."""
 
-    def __init__(self, job: SweepJob, queue: SharedQueue, record: Callable[[int, Outcome], None]):
-        self.job, self.queue, self.record = job, queue, record
+    def __init__(self, job: SweepJob, queue: SharedQueue, record: Callable[[int, Outcome], None],
+                 keep: Keep | None = None):
+        self.job, self.queue, self.record, self.keep = job, queue, record, keep
         self.context = multiprocessing.get_context("fork")
         self.stop_flag = self.context.Event()
         self.process: Any = None
@@ -119,7 +131,7 @@ class LocalRunner:
 
     def start(self) -> None:
         receive, send = self.context.Pipe(duplex=False)
-        self.process = self.context.Process(target=_serve, args=(self.job, self.queue, self.stop_flag, send),
+        self.process = self.context.Process(target=_serve, args=(self.job, self.queue, self.stop_flag, send, self.keep),
                                             name="sweep-local-runner", daemon=True)
         self.process.start()
         send.close()
@@ -184,10 +196,11 @@ class LocalRunner:
 
 
 def run_local_first(job: SweepJob, todo: list[tuple[str, Any]], record: Record, workers: int | None = None,
-                    method: str | None = None) -> SweepReport:
+                    method: str | None = None, keep: Keep | None = None) -> SweepReport:
     """Run the points in a local runner, and on a new LocalCluster of ``workers`` (default:
     one per core) as soon as the runs left are worth one (``cluster_pays_off``, judged
-    after every local run). The report's ``local`` counts the points the runner ran."""
+    after every local run). The report's ``local`` counts the points the runner ran.
+    ``keep(point hash, outcome)`` saves a kept run's results in the runner's process."""
     from .cluster import run_dask
 
     workers = workers or default_workers()
@@ -200,7 +213,7 @@ def run_local_first(job: SweepJob, todo: list[tuple[str, Any]], record: Record, 
         report.failed += outcome.status != OK
 
     t0 = time.perf_counter()
-    runner = LocalRunner(job, queue, take)
+    runner = LocalRunner(job, queue, take, keep)
     try:
         runner.start()
         while True:

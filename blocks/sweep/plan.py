@@ -10,6 +10,7 @@ store and skips the points the store already holds. ``run_sweep`` does both in o
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -134,9 +135,7 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
     bar = SweepProgress(len(todo), enabled=progress)
 
     def record(h: str, point: Point, outcome: Outcome) -> None:
-        if outcome.results is not None:  # the run's folder first: a row in the CSV has its folder
-            outcome.results.info.setdefault("sweep", {})["point_hash"] = h
-            outcome.results.save(Path(output) / RUNS / h)
+        keep_run(output, h, outcome)  # the run's folder first: a row in the CSV has its folder
         store.append(h, point, outcome.status, outcome.error, outcome.wall_s, outcome.values)
         bar.update(outcome.status == OK)
 
@@ -148,7 +147,8 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
             if serial:
                 report = run_serial(plan.job, todo, record)
             elif workers is None and scheduler is None and can_run_locally(start_method):
-                report = run_local_first(plan.job, todo, record, method=start_method)
+                report = run_local_first(plan.job, todo, record, method=start_method,
+                                         keep=functools.partial(keep_run, output))
             else:
                 report = run_dask(plan.job, todo, record, workers=workers, scheduler=scheduler,
                                   method=start_method, client=client)
@@ -160,6 +160,15 @@ def execute(plan: SweepPlan, output: str | Path, workers: int | None = None, sch
         if plan.job.bundle is not None:
             discard(plan.job.bundle.hash)  # this process's copy (warm-up, serial runs)
     return report, len(plan.points) - len(todo), failed_before + report.failed
+
+
+def keep_run(output: str | Path, h: str, outcome: Outcome) -> None:
+    """Save a kept run's results into OUTPUT/runs/<point hash>/ (``keep_results``) and let
+    go of them; nothing for an outcome without results."""
+    if outcome.results is not None:
+        outcome.results.info.setdefault("sweep", {})["point_hash"] = h
+        outcome.results.save(Path(output) / RUNS / h)
+        outcome.results = None
 
 
 def stored_count(plan: SweepPlan, output: str | Path) -> int:

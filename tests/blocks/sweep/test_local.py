@@ -162,3 +162,15 @@ def test_a_local_process_that_dies_before_its_first_point_stops_the_sweep_with_a
     monkeypatch.setattr(local, "_serve", lambda *_: os._exit(5))
     with pytest.raises(SweepError, match=r"ended before its first point \(exit code 5\) \(hint: --workers N"):
         run_sweep(TOY, grid_points({"prop.k": [1, 2]}), METRICS, tmp_path / "s", t_end="50 ms", progress=False)
+
+
+def test_kept_results_of_local_runs_have_their_folders_and_match_their_rows(tmp_path):
+    from blocks import Results
+
+    points = grid_points({"prop.k": [1, 2, 3, 4]})
+    summary = run_sweep(TOY, points, METRICS, tmp_path / "s", t_end="50 ms", progress=False, keep_results=True)
+    assert summary.report.local == 4
+    for h, row in rows(tmp_path / "s").items():
+        kept = Results.load(tmp_path / "s" / "runs" / h)
+        assert kept.info["sweep"]["point_hash"] == h and kept.info["sweep"]["status"] == row["status"] == "ok"
+        assert float(row["y"]) == float(kept["plant.y"][1][-1, 0])
