@@ -20,8 +20,8 @@ import statistics
 import time
 from typing import Any, Callable
 
-from .queue import SharedQueue
 from .errors import SweepError
+from .queue import SharedQueue
 from .runner import Outcome, Record, SweepJob, SweepReport, default_workers, one_line, run_point
 from .store import FAILED, OK
 
