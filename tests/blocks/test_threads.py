@@ -24,7 +24,7 @@ from blocks.registry import block_types
 from .kernel_library import function
 
 TOY = Path(__file__).resolve().parents[2] / "diagrams" / "toy.yaml"
-ROUNDS = 4
+ROUNDS = 5
 
 
 def assert_same(a, b) -> None:

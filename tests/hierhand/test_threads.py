@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[2]
 REGRASP = ROOT / "diagrams" / "regrasp.yaml"
 REGRASP_FMU = ROOT / "diagrams" / "regrasp_fmu.yaml"
 HEAVIER = {"plant.object.mass": 0.33}
-ROUNDS = 3
+ROUNDS = 5
 
 
 def assert_same(a, b) -> None:
@@ -38,43 +38,38 @@ def run(path: Path, overrides=None) -> blocks.Results:
     return blocks.simulate(blocks.load_diagram(path, overrides=overrides))
 
 
-def in_threads(jobs) -> list:
-    """Each of ``jobs`` (callables) in a thread of its own, all at once."""
+def in_threads_as_serial(jobs, serial) -> None:
+    """Each of ``jobs`` (callables) in a thread of its own, all at once, ROUNDS times: job i
+    gives ``serial[i]``'s samples every time."""
     with ThreadPoolExecutor(len(jobs)) as pool:
-        futures = [pool.submit(job) for job in jobs]
-        return [f.result() for f in futures]
+        for _ in range(ROUNDS):
+            futures = [pool.submit(job) for job in jobs]
+            for future, expected in zip(futures, serial):
+                assert_same(future.result(), expected)
 
 
 def test_two_equal_hands_at_once_give_the_serial_samples():
     serial = run(REGRASP)
-    for _ in range(ROUNDS):
-        for r in in_threads([lambda: run(REGRASP)] * 2):
-            assert_same(r, serial)
+    in_threads_as_serial([lambda: run(REGRASP)] * 2, [serial] * 2)
 
 
 def test_one_diagram_simulated_in_two_threads_at_once_gives_the_serial_samples():
     """Both runs step the one plant block's model, each with its own scratch."""
     d = blocks.load_diagram(REGRASP)
     serial = blocks.simulate(d)
-    for _ in range(ROUNDS):
-        for r in in_threads([lambda: blocks.simulate(d)] * 2):
-            assert_same(r, serial)
+    in_threads_as_serial([lambda: blocks.simulate(d)] * 2, [serial] * 2)
 
 
 def test_two_different_hands_at_once_give_their_serial_samples():
     serial = [run(REGRASP), run(REGRASP, HEAVIER)]
     assert not np.array_equal(serial[0]["plant.obj"][1], serial[1]["plant.obj"][1])
-    for _ in range(ROUNDS):
-        for r, s in zip(in_threads([lambda: run(REGRASP), lambda: run(REGRASP, HEAVIER)]), serial):
-            assert_same(r, s)
+    in_threads_as_serial([lambda: run(REGRASP), lambda: run(REGRASP, HEAVIER)], serial)
 
 
 def test_the_fmu_plant_in_two_threads_at_once_gives_the_serial_samples():
     pytest.importorskip("fmpy")
     serial = run(REGRASP_FMU)
-    for _ in range(ROUNDS):
-        for r in in_threads([lambda: run(REGRASP_FMU)] * 2):
-            assert_same(r, serial)
+    in_threads_as_serial([lambda: run(REGRASP_FMU)] * 2, [serial] * 2)
 
 
 def test_a_run_steps_with_a_scratch_of_its_own():
