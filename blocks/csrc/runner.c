@@ -112,7 +112,9 @@ static void gil_for(gil *g, const int64_t *s)
 }
 
 /* Another thread with a Python thread state exists: one that could take a released GIL.
-   Read with the GIL held, under which thread states are linked and unlinked. */
+   Read with the GIL held, once per call: Python threads start and end under it; a C
+   thread whose first PyGILState_Ensure is under way may be missed, and then this call
+   holds the GIL throughout, as every call did before. */
 static int other_threads(void)
 {
     PyThreadState *self = PyThreadState_Get();
@@ -290,7 +292,7 @@ static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t n
     long long k = PyLong_AsLongLong(args[0]), next_k = PyLong_AsLongLong(args[1]);
     if ((k == -1 || next_k == -1) && PyErr_Occurred())
         return NULL;
-    int signals = _PyOS_IsMainThread();
+    int signals = _PyOS_IsMainThread(); /* intrcheck.h: PyErr_CheckSignals' own test of the thread */
     gil g = {NULL, signals, !signals || other_threads()};
     PyObject *result = run_events(r, &g, k, next_k);
     gil_hold(&g);
