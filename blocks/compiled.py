@@ -9,10 +9,12 @@ buffer of a compiled reader when it is computed, a compiled block's outputs into
 Python readers' inputs after each C call that computed them (copies, because the buffer
 changes in place and a Python block may keep what it was given). An input with a default
 has a buffer of its own too, which holds the default until its source first fires.
-Loggers of compiled blocks are filled in C.
+Loggers of compiled blocks are filled in C. A C call releases the GIL over the steps of
+kernels that say they need none (``Kernel.nogil``), so runs in other threads go on meanwhile.
 
 A kernel with a ``bind`` is bound to its block's state once per run, here, after every
-other check has chosen it. An update that returns ``END_RUN`` is handed to the
+other check has chosen it; the bound kernel gets that state when it is a flat float64
+array (the plant's, whose bound context is the run's scratch) and NULL otherwise (an FMU's). An update that returns ``END_RUN`` is handed to the
 executor's ``end`` while the C call goes on; a kernel's ``RAISED`` exception comes back
 in the failure.
 """
@@ -42,6 +44,12 @@ EXACT_TICKS = 2**53
 def failure(code: int, which: int, t: float, phase: str) -> BaseException:
     """The exception of a failure code whose block names no ``Kernel.error``."""
     return BlockError(f"compiled {phase} failed at t={t:.10g} s with code {code} (detail {which})")
+
+
+def flat(state: Any) -> bool:
+    """A state a kernel updates in place: a flat, C-contiguous, writable float64 array."""
+    return (isinstance(state, np.ndarray) and state.dtype == np.float64 and state.ndim == 1
+            and state.flags.c_contiguous and state.flags.writeable)
 
 
 class CompiledBlock:
@@ -95,9 +103,7 @@ class CompiledSide:
                 continue  # an input default of another width: the Python methods meet it as they would
             state = states[index[name]]
             if state is not None:
-                if kernel.bind is None and not (isinstance(state, np.ndarray) and state.dtype == np.float64
-                                                and state.ndim == 1 and state.flags.c_contiguous
-                                                and state.flags.writeable):
+                if kernel.bind is None and not flat(state):
                     continue
                 if name in updated and not kernel.update:
                     continue
@@ -110,7 +116,7 @@ class CompiledSide:
                     self.failure = (name, exc)
                     self.blocks.clear()
                     return
-                state = None
+                state = state if flat(state) else None
             self.blocks[name] = CompiledBlock(name, block, kernel, state, len(self.blocks))
         if not self.blocks:
             return
@@ -123,7 +129,8 @@ class CompiledSide:
                                 0 if cb.state is None else address(cb.state), address(cb.pointers),
                                 address(cb.out), cb.width, 0 if cb.rows is None else address(cb.rows),
                                 0 if cb.rows is None else cb.rows.shape[0],
-                                schedule.period_ticks[cb.name] or 0] for cb in self.blocks.values()],
+                                schedule.period_ticks[cb.name] or 0, int(cb.kernel.nogil)]
+                               for cb in self.blocks.values()],
                               dtype=np.int64)
 
     def exact_ticks(self) -> bool:

@@ -7,12 +7,21 @@ whose blocks all have kernels in one C call (no Python between the 1 ms hits of 
 controller and a plant, say). A block without a kernel runs through its Python methods
 as before; both kinds mix freely in one diagram.
 
-A block whose state is a live external object (an FMU instance) rather than a flat array
-gives its Kernel a ``bind``: the executor calls ``bind(state)`` once per run and uses the
-Kernel it returns, whose context is that run's own (the C functions keep what changes in
-it, and get no state pointer). Its functions may call back into Python (the executor
-holds the GIL), return ``RAISED`` with a Python exception set, and an update may return
-``END_RUN`` to end the run as ``EndRun`` does.
+A block whose kernel writes anything besides its state (an FMU instance's time and
+outputs, the plant's scratch) gives its Kernel a ``bind``: the executor calls
+``bind(state)`` once per run and uses the Kernel it returns, whose context is that run's
+own. The bound functions get the state when it is a flat float64 array (the plant's), and
+NULL otherwise (an FMU's live instance, whose changes they keep in the context).
+Functions may call back into Python (the executor holds the GIL for them), return
+``RAISED`` with a Python exception set, and an update may return ``END_RUN`` to end the
+run as ``EndRun`` does.
+
+A kernel that needs no GIL says so with ``nogil``: its functions call nothing of Python's
+C API and write only the state, their outputs and a context no other run uses at the
+same time (a constant one, or one ``bind`` made for this run). The executor then runs
+them with the GIL released, so that threads that simulate diagrams (a thread pool, a
+Dask worker's threads, a GUI beside a run) run in parallel; it holds the GIL for the
+others, such as the FMU kernel that calls back into Python.
 """
 
 from __future__ import annotations
@@ -58,7 +67,8 @@ class Kernel:
     functions compute what the Python methods compute (to round-off; a run uses one or
     the other for all of a block's hits). ``error`` makes the exception for a failure
     code, and the ``EndRun`` for ``END_RUN`` (None: ``blocks.compiled.failure``, a
-    message with the code).
+    message with the code). ``nogil``: the functions may run without the GIL (see the
+    module's docstring; what a bound kernel says is what counts).
     """
 
     context: int
@@ -68,3 +78,4 @@ class Kernel:
     owners: tuple[Any, ...] = field(default=(), repr=False)
     error: ErrorFactory | None = field(default=None, repr=False)
     bind: Callable[[Any], Kernel] | None = field(default=None, repr=False)
+    nogil: bool = False

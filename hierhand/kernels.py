@@ -4,7 +4,9 @@ The adapters live in C (``hierhand/csrc/python/py_kernels.c``) and call the very
 the blocks' Python methods call, so either path gives the same bits. ``KERNELS`` holds
 their addresses by ``"Block.phase"`` (``"HandPlant.advance"``); a block's ``kernel()``
 packs its context (the addresses of its model and parameter arrays) with ``context``
-and ``blocks.kernel.address``.
+and ``blocks.kernel.address``. The adapters call no Python and write only the state, the
+outputs and the plant's ``Scratch`` (one per run, made by its Kernel's ``bind``), so every
+Kernel says ``nogil``: the executor runs them with the GIL released.
 """
 
 from __future__ import annotations

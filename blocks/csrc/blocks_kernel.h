@@ -10,7 +10,8 @@
  * - ctx is Kernel.context, passed back unchanged; the kernel only reads through it
  *   (except a per-run context, below).
  * - state is the block's state, the flat float64 array initial_state() returned (NULL
- *   for a stateless block); update and advance change it in place.
+ *   for a stateless block, or one whose state is not such an array); update and advance
+ *   change it in place.
  * - inputs[i] points at input port i, in the order of Block.inputs, of its declared
  *   width; the kernel only reads them, and they stay put during the call.
  * - out receives all output ports one after the other, in the order of Block.outputs.
@@ -25,13 +26,20 @@
  *   and the block asks to end the run (its Python update raises EndRun); the executor
  *   finishes the tick and ends the run at the block's next hit, taking the reason from
  *   Kernel.error(BLK_END_RUN, which, t, 'update'). BLK_RAISED: the kernel has set a
- *   Python exception (only a kernel that runs with the GIL and Python's C API, as the
- *   executor's calls do), which becomes the step's error as it is, a KeyboardInterrupt
- *   the run's interrupt.
- * - A block whose state is an external object rather than a flat array (an FMU instance)
- *   gives its Kernel a bind(state): the executor calls it once per run and uses the Kernel
- *   it returns, whose context belongs to that run; that kernel gets NULL as state, keeps
- *   what changes in its context and may write there.
+ *   Python exception (only a kernel that runs with the GIL, one without nogil, below),
+ *   which becomes the step's error as it is, a KeyboardInterrupt the run's interrupt.
+ * - A kernel that writes anything besides its state (an FMU instance's time and outputs,
+ *   the plant's scratch) gives its Kernel a bind(state): the executor calls it once per run
+ *   and uses the Kernel it returns, whose context belongs to that run and may be written.
+ *   That kernel gets the state as above: the flat array (the plant's), else NULL (an FMU's
+ *   live instance, whose changes it keeps in its context).
+ * - The GIL: the executor holds it around a kernel's calls unless the Kernel says nogil.
+ *   A nogil kernel calls nothing of Python's C API (so never returns BLK_RAISED) and
+ *   writes only its state, its outputs and a context no other run uses at the same time
+ *   (no static buffers, no scratch shared through a constant context: give such scratch
+ *   a bind, or keep it on the stack); the executor then runs it with the GIL released, so
+ *   that threads that simulate diagrams run in parallel. The Ctrl-C checks between events
+ *   take the GIL back, and a kernel that looks for Ctrl-C itself must hold it.
  * - A kernel computes what the block's Python methods compute. Within a run the executor
  *   uses a block's kernel for all of its hits or for none, so the two need not round
  *   alike; a block whose Python methods call the same C code (the hand's blocks) matches

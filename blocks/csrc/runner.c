@@ -15,6 +15,17 @@
  * ends at, finishes the event and runs no event from that tick on. A kernel that returns
  * BLK_RAISED has set a Python exception; the failure carries it.
  *
+ * The GIL: a call releases it over the ops whose kernels say they may run without it
+ * (Kernel.nogil, a slot's S_NOGIL; blocks_kernel.h), so that threads running diagrams run
+ * in parallel, and holds it for the others (the FMU kernel calls back into Python) and for
+ * whatever touches Python objects: a failure's tuple, on_end, the Ctrl-C checks. Copies
+ * leave it as it is. PyErr_CheckSignals does nothing on a thread that does not handle
+ * signals, so there the checks are skipped and a stretch of such ops runs released from
+ * its first op to the end of the call; on the thread that handles them (the main one) the
+ * GIL is taken back for each check, between events and between the chunks of an advance,
+ * as before. That thread releases it only while another thread exists (one that has a
+ * Python thread state) that could take it.
+ *
  * Time is k * num / den in double, as the Python executor computes it: both are exact
  * integers below 2^53 (the executor checks), so the division rounds the same way.
  */
@@ -33,8 +44,9 @@ enum { OP_OUTPUT = 0, OP_UPDATE = 1, OP_ADVANCE = 2, OP_COPY = 3 };
 /* op row: [op, slot, a, b]: output/advance log the entries a..b-1 of the log table;
    copy: [OP_COPY, width, destination, source] */
 enum { OP_CODE, OP_SLOT, OP_A, OP_B, OP_N };
-/* slot row: one per block with a kernel */
-enum { S_OUTPUT, S_UPDATE, S_ADVANCE, S_CTX, S_STATE, S_INPUTS, S_OUT, S_WIDTH, S_ROWS, S_ROWS_CAP, S_PERIOD, S_N };
+/* slot row: one per block with a kernel; S_NOGIL: its functions may run without the GIL */
+enum { S_OUTPUT, S_UPDATE, S_ADVANCE, S_CTX, S_STATE, S_INPUTS, S_OUT, S_WIDTH, S_ROWS, S_ROWS_CAP, S_PERIOD, S_NOGIL,
+       S_N };
 /* event row: [tick offset from the first event, first op, end of ops] */
 enum { E_OFFSET, E_START, E_END, E_N };
 /* log row: [buffer, width, first column in the block's outputs, capacity (rows), decimate];
@@ -74,15 +86,62 @@ static void log_row(const RunnerObject *r, Py_ssize_t entry, const double *outpu
     c[C_HITS]++;
 }
 
+/* The GIL over one call: released (saved non-NULL) over ops whose kernels may run without
+   it; signals: this thread handles signals, so Ctrl-C checks need the GIL; release: it may
+   be released at all (off the signals thread, or while another thread could take it). */
+typedef struct {
+    PyThreadState *saved;
+    int signals, release;
+} gil;
+
+static void gil_hold(gil *g)
+{
+    if (g->saved != NULL) {
+        PyEval_RestoreThread(g->saved);
+        g->saved = NULL;
+    }
+}
+
+/* The GIL as the kernels of slot s need it: released for a nogil slot, held otherwise. */
+static void gil_for(gil *g, const int64_t *s)
+{
+    if (!s[S_NOGIL])
+        gil_hold(g);
+    else if (g->saved == NULL && g->release)
+        g->saved = PyEval_SaveThread();
+}
+
+/* Another thread with a Python thread state exists: one that could take a released GIL.
+   Read with the GIL held, once per call: Python threads start and end under it; a C
+   thread whose first PyGILState_Ensure is under way may be missed, and then this call
+   holds the GIL throughout, as every call did before. */
+static int other_threads(void)
+{
+    PyThreadState *self = PyThreadState_Get();
+    PyThreadState *first = PyInterpreterState_ThreadHead(PyThreadState_GetInterpreter(self));
+    return first != self || PyThreadState_Next(first) != NULL;
+}
+
+/* A Ctrl-C check: nonzero with KeyboardInterrupt (or the handler's exception) set, the GIL
+   held. Skipped off the signals thread, where PyErr_CheckSignals does nothing. */
+static int interrupted(gil *g)
+{
+    if (!g->signals)
+        return 0;
+    gil_hold(g);
+    return PyErr_CheckSignals() != 0;
+}
+
 /* What an op ended with: done, a block's failure (a tuple to return), or an exception set
-   (an interrupt between the chunks of an advance). */
+   (an interrupt between the chunks of an advance); the GIL is held unless done. */
 typedef struct {
     PyObject *failure;
     int raised;
 } op_end;
 
-static op_end failure(int code, int which, Py_ssize_t op, int64_t tick)
+static op_end failure(gil *g, int code, int which, Py_ssize_t op, int64_t tick)
 {
+    gil_hold(g);
     PyObject *raised = Py_None;
     Py_INCREF(raised);
     if (code == BLK_RAISED) {
@@ -106,10 +165,11 @@ static op_end failure(int code, int which, Py_ssize_t op, int64_t tick)
 
 /* An update at tick ke asked to end the run: on_end records it and says where the run
    ends; no event of this call runs from there on. */
-static op_end end_request(RunnerObject *r, int which, Py_ssize_t op, int64_t ke)
+static op_end end_request(RunnerObject *r, gil *g, int which, Py_ssize_t op, int64_t ke)
 {
     if (r->on_end == NULL || r->on_end == Py_None)
-        return failure(BLK_END_RUN, which, op, ke);
+        return failure(g, BLK_END_RUN, which, op, ke);
+    gil_hold(g);
     PyObject *end = PyObject_CallFunction(r->on_end, "niL", op, which, (long long)ke);
     if (end == NULL)
         return (op_end){NULL, 1};
@@ -126,7 +186,7 @@ static const op_end DONE = {NULL, 0};
 
 /* Step a block from tick ke to tick next in chunks of at most its rows capacity; Ctrl-C
    is looked for between chunks (r->reached then says how far the block got). */
-static op_end advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int64_t ke, int64_t next)
+static op_end advance(RunnerObject *r, gil *g, const int64_t *op, Py_ssize_t index, int64_t ke, int64_t next)
 {
     const int64_t *s = r->slots + op[OP_SLOT] * S_N;
     blk_advance_fn fn = (blk_advance_fn)(intptr_t)s[S_ADVANCE];
@@ -138,6 +198,7 @@ static op_end advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int6
     int64_t n = (next - ke) / period, stepped = 0;
     while (n > 0) {
         int m = (int)(n < cap ? n : cap), done = 0, which = 0;
+        gil_for(g, s);
         int code = fn((const void *)(intptr_t)s[S_CTX], tick_time(r, ke + stepped * period), state, inputs, m, rows,
                       &done, &which);
         int logged = code ? (done < 0 ? 0 : done > m ? m : done) : m;
@@ -145,11 +206,11 @@ static op_end advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int6
             for (int64_t e = op[OP_A]; e < op[OP_B]; e++)
                 log_row(r, (Py_ssize_t)e, rows + i * width);
         if (code)
-            return failure(code, which, index, ke + (stepped + logged) * period);
+            return failure(g, code, which, index, ke + (stepped + logged) * period);
         memcpy(out, rows + (m - 1) * width, (size_t)width * sizeof(double));
         n -= m;
         stepped += m;
-        if (n > 0 && PyErr_CheckSignals() != 0) {
+        if (n > 0 && interrupted(g)) {
             r->reached = ke + stepped * period;
             return (op_end){NULL, 1};
         }
@@ -158,7 +219,7 @@ static op_end advance(RunnerObject *r, const int64_t *op, Py_ssize_t index, int6
 }
 
 /* One op at event tick ke whose advances reach next. */
-static op_end run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next)
+static op_end run_op(RunnerObject *r, gil *g, Py_ssize_t index, int64_t ke, int64_t next)
 {
     const int64_t *op = r->ops + index * OP_N;
     if (op[OP_CODE] == OP_COPY) {
@@ -166,12 +227,13 @@ static op_end run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next
         return DONE;
     }
     if (op[OP_CODE] == OP_ADVANCE)
-        return advance(r, op, index, ke, next);
+        return advance(r, g, op, index, ke, next);
     const int64_t *s = r->slots + op[OP_SLOT] * S_N;
     const void *ctx = (const void *)(intptr_t)s[S_CTX];
     double *state = (double *)(intptr_t)s[S_STATE];
     const double *const *inputs = (const double *const *)(intptr_t)s[S_INPUTS];
     int which = 0, code;
+    gil_for(g, s);
     if (op[OP_CODE] == OP_OUTPUT) {
         double *out = (double *)(intptr_t)s[S_OUT];
         code = ((blk_output_fn)(intptr_t)s[S_OUTPUT])(ctx, tick_time(r, ke), state, inputs, out, &which);
@@ -181,9 +243,40 @@ static op_end run_op(RunnerObject *r, Py_ssize_t index, int64_t ke, int64_t next
     } else {
         code = ((blk_update_fn)(intptr_t)s[S_UPDATE])(ctx, tick_time(r, ke), state, inputs, &which);
         if (code == BLK_END_RUN)
-            return end_request(r, which, index, ke);
+            return end_request(r, g, which, index, ke);
     }
-    return code ? failure(code, which, index, ke) : DONE;
+    return code ? failure(g, code, which, index, ke) : DONE;
+}
+
+/* The events from tick k before next_k (runner_run); NULL with an exception set, a
+   failure tuple, or Py_None (a borrowed reference: the caller takes one). */
+static PyObject *run_events(RunnerObject *r, gil *g, int64_t k, int64_t next_k)
+{
+    r->stop = next_k;
+    for (Py_ssize_t e = 0; e < r->n_events; e++) {
+        const int64_t *ev = r->events + e * E_N;
+        int64_t ke = k + ev[E_OFFSET];
+        if (e > 0 && ke >= next_k) /* the first event always runs: a final one has k == next_k */
+            break;
+        int64_t next = e + 1 < r->n_events ? k + ev[E_N + E_OFFSET] : next_k;
+        if (next > next_k)
+            next = next_k;
+        for (int64_t i = ev[E_START]; i < ev[E_END]; i++) {
+            op_end end = run_op(r, g, (Py_ssize_t)i, ke, next);
+            if (end.raised)
+                return NULL;
+            if (end.failure != NULL) {
+                r->reached = ke;
+                return end.failure;
+            }
+        }
+        r->reached = next;
+        if (r->stop < next_k)
+            next_k = r->stop;
+        if (e + 1 < r->n_events && interrupted(g))
+            return NULL;
+    }
+    return Py_None;
 }
 
 /* run(k, next_k): None, or (code, which, op index, tick, exception) of the first failure
@@ -199,31 +292,13 @@ static PyObject *runner_run(RunnerObject *r, PyObject *const *args, Py_ssize_t n
     long long k = PyLong_AsLongLong(args[0]), next_k = PyLong_AsLongLong(args[1]);
     if ((k == -1 || next_k == -1) && PyErr_Occurred())
         return NULL;
-    r->stop = next_k;
-    for (Py_ssize_t e = 0; e < r->n_events; e++) {
-        const int64_t *ev = r->events + e * E_N;
-        int64_t ke = k + ev[E_OFFSET];
-        if (e > 0 && ke >= next_k) /* the first event always runs: a final one has k == next_k */
-            break;
-        int64_t next = e + 1 < r->n_events ? k + ev[E_N + E_OFFSET] : next_k;
-        if (next > next_k)
-            next = next_k;
-        for (int64_t i = ev[E_START]; i < ev[E_END]; i++) {
-            op_end end = run_op(r, (Py_ssize_t)i, ke, next);
-            if (end.raised)
-                return NULL;
-            if (end.failure != NULL) {
-                r->reached = ke;
-                return end.failure;
-            }
-        }
-        r->reached = next;
-        if (r->stop < next_k)
-            next_k = r->stop;
-        if (e + 1 < r->n_events && PyErr_CheckSignals() != 0)
-            return NULL;
-    }
-    Py_RETURN_NONE;
+    int signals = _PyOS_IsMainThread(); /* intrcheck.h: PyErr_CheckSignals' own test of the thread */
+    gil g = {NULL, signals, !signals || other_threads()};
+    PyObject *result = run_events(r, &g, k, next_k);
+    gil_hold(&g);
+    if (result == Py_None)
+        Py_INCREF(result);
+    return result;
 }
 
 static PyObject *runner_reached(RunnerObject *r, void *closure)

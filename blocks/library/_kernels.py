@@ -7,7 +7,8 @@ block's Python method computes: elementwise arithmetic, in the same order, to th
 bit; matrix-vector products by library.c's own definition (each row summed in column
 order from its first product, no fused multiply-add), which equals numpy's
 ``ndarray.dot`` for single-term rows and to round-off otherwise. Kernels exist for any
-size: the context holds the matrices.
+size: the context holds the matrices. The kernels only read their context and keep
+their scratch on the stack (or in memory of their own call), so they say ``nogil``.
 """
 
 from __future__ import annotations
@@ -49,6 +50,7 @@ def make_kernel(context: np.ndarray, output: str | None = None, update: str | No
         advance=table[advance] if advance else 0,
         owners=(context, *owners),
         error=error,
+        nogil=True,
     )
 
 

@@ -167,6 +167,7 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
             update=KERNELS["GraspReflex.update"],
             owners=(ctx, model, params),
             error=_kernel_error,
+            nogil=True,
         )
 
     def initial_state(self) -> np.ndarray:

@@ -151,6 +151,7 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
             output=KERNELS["ManipulationPD.output"],
             owners=(ctx, model, params, waypoints, meta),
             error=self._kernel_error,
+            nogil=True,
         )
 
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BaseException:

@@ -88,4 +88,5 @@ class Suppresser(DescribesHandPorts, Block):
     def kernel(self) -> Kernel | None:
         """``output`` in C: the same native law on the parameters packed in ``__init__``
         (stateless, no period needed)."""
-        return Kernel(context=address(self._params), output=KERNELS["Suppresser.output"], owners=(self._params,))
+        return Kernel(context=address(self._params), output=KERNELS["Suppresser.output"], owners=(self._params,),
+                      nogil=True)

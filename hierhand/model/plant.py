@@ -10,6 +10,7 @@ and ``advance`` equals n times ``update`` then ``output``, bit for bit.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from typing import Any, Mapping
 
@@ -20,7 +21,7 @@ from blocks.block import Block, BlockError
 from blocks.kernel import Kernel
 
 from .. import _native
-from ..kernels import KERNELS, model_address
+from ..kernels import KERNELS
 from .hand import Hand
 from .handfile import SECTIONS, default_hand_dict, merge_with_default, parse_hand
 from .layout import (
@@ -61,6 +62,7 @@ _PORT_COLUMNS = [(name, (slice(None), sl)) for name, sl in _PORT_SLICES]  # read
 _ZERO3 = np.zeros(3)
 _ZERO3.flags.writeable = False
 _advance, _step, _output = _native.advance, _native.step, _native.output
+_KERNEL_FUNCTIONS = {phase: KERNELS[f"HandPlant.{phase}"] for phase in ("output", "update", "advance")}
 
 
 @dataclass(frozen=True)
@@ -235,20 +237,24 @@ class HandPlant(DescribesHandPorts, Block):
 
     def kernel(self) -> Kernel | None:
         """The C step functions (``hierhand/csrc/python/py_kernels.c``): the native calls of
-        ``output``, ``update`` and ``advance`` on the bound model, whose scratch they use;
-        None before ``bind``. The output row's ports lie one after the other in the order
-        of ``outputs``, and the inputs are ``tau``, ``f_ext``, as the kernel convention wants."""
+        ``output``, ``update`` and ``advance`` on the bound model; None before ``bind``.
+        Its ``bind`` gives each run a ``Scratch`` of its own as the context (the steps
+        write their scratch there), so runs in several threads share nothing but the
+        constant model and run without the GIL. The output row's ports lie one after the
+        other in the order of ``outputs``, and the inputs are ``tau``, ``f_ext``, as the
+        kernel convention wants."""
         model = self._model
         if model is None:
             return None
-        return Kernel(
-            context=model_address(model),
-            output=KERNELS["HandPlant.output"],
-            update=KERNELS["HandPlant.update"],
-            advance=KERNELS["HandPlant.advance"],
-            owners=(model,),
-            error=self._kernel_error,
-        )
+        return Kernel(context=0, bind=functools.partial(self._bound_kernel, model), nogil=True,
+                      **_KERNEL_FUNCTIONS)
+
+    def _bound_kernel(self, model: _native.Model, state: np.ndarray) -> Kernel:
+        """``Kernel.bind``: the kernel of one run, stepping ``state`` with a fresh scratch."""
+        self._check_state(state)
+        scratch = _native.Scratch(model)
+        return Kernel(context=scratch.address, owners=(scratch,), error=self._kernel_error, nogil=True,
+                      **_KERNEL_FUNCTIONS)
 
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BlockError:
         """The kernel's failure as the Python methods raise it (``t``: the failing step's

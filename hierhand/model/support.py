@@ -62,4 +62,4 @@ class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
     def kernel(self) -> Kernel | None:
         """``output`` in C: the force while ``t < until``, zero from then on."""
         ctx = np.concatenate((self.force, [self.until]))
-        return Kernel(context=address(ctx), output=KERNELS["ObjectSupport.output"], owners=(ctx,))
+        return Kernel(context=address(ctx), output=KERNELS["ObjectSupport.output"], owners=(ctx,), nogil=True)

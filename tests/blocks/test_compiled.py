@@ -3,15 +3,13 @@
 A diagram runs the same whether a block goes through its kernel or its Python methods:
 the same logged samples to the last bit, the same status when a block fails, the same
 end when a Python block ends the run. The test kernels (``kernel_sources/leak.c``) are
-compiled here with the calling convention's header; their Python twins below compute
-the same arithmetic in numpy.
+compiled with the calling convention's header by the ``library`` fixture (conftest.py);
+their Python twins below compute the same arithmetic in numpy.
 """
 
 from __future__ import annotations
 
-import ctypes
-import subprocess
-from pathlib import Path
+import threading
 
 import numpy as np
 import pytest
@@ -20,26 +18,7 @@ from blocks import Block, BlockError, EndRun, loads_diagram, simulate
 from blocks.kernel import Kernel
 from blocks.registry import block_types
 
-from .fmu.build import compiler
-
-SOURCES = Path(__file__).parent / "kernel_sources"
-HEADERS = Path(__file__).resolve().parents[2] / "blocks" / "csrc"
-
-
-@pytest.fixture(scope="module")
-def library(tmp_path_factory):
-    if compiler() is None:
-        pytest.skip("no C compiler to build the test kernels")
-    target = tmp_path_factory.mktemp("kernels") / "leak.so"
-    cmd = [compiler(), "-shared", "-fPIC", "-O2", "-ffp-contract=off", f"-I{HEADERS}", str(SOURCES / "leak.c"),
-           "-o", str(target), "-lm"]
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    assert done.returncode == 0, done.stderr
-    return ctypes.CDLL(str(target))
-
-
-def function(lib, name: str) -> int:
-    return ctypes.cast(getattr(lib, name), ctypes.c_void_p).value
+from .kernel_library import function
 
 
 CALLS: dict[str, int] = {}
@@ -178,8 +157,9 @@ class Ticker(Block):
     type_name = "TestTicker"
     lib = None
 
-    def __init__(self, at=1e9):
+    def __init__(self, at=1e9, nogil=False):
         self.params = np.array([at], dtype=float)
+        self.nogil = nogil
         self.inputs, self.outputs, self.feedthrough = {}, {"y": 1}, False
 
     def initial_state(self):
@@ -196,7 +176,8 @@ class Ticker(Block):
 
     def kernel(self):
         return Kernel(context=self.params.ctypes.data, output=function(self.lib, "ticker_output"),
-                      advance=function(self.lib, "ticker_advance"), owners=(self.params, self.lib))
+                      advance=function(self.lib, "ticker_advance"), owners=(self.params, self.lib),
+                      nogil=self.nogil)
 
 
 @pytest.fixture(autouse=True)
@@ -316,19 +297,28 @@ log: [a.y, k.y, {signal: z.sum, decimate: 7}]
         assert "block 'z' (TestLeak), signal z.y advance: x[0] past the limit" in compiled.status
 
 
-def test_ctrl_c_in_a_long_compiled_advance_stops_after_the_chunk_it_came_in():
+@pytest.mark.parametrize("nogil", [False, True])
+def test_ctrl_c_in_a_long_compiled_advance_stops_after_the_chunk_it_came_in(nogil):
     """No block fires after t = 0, so the run is one advance in C, in chunks of
     ADVANCE_CHUNK hits; SIGINT in the third chunk stops the run at its end, everything up
-    to there logged."""
+    to there logged. The same with the GIL released around the chunks (a nogil kernel,
+    while another thread waits): the check between chunks takes it back."""
     from blocks.simulate import ADVANCE_CHUNK
 
     text = f"""
 time: {{t_end: 1000 s}}
 blocks:
-  tick: {{type: TestTicker, period: 1 ms, params: {{at: {2 * ADVANCE_CHUNK + 5}}}}}
+  tick: {{type: TestTicker, period: 1 ms, params: {{at: {2 * ADVANCE_CHUNK + 5}, nogil: {nogil}}}}}
 log: [tick.y]
 """
-    r = simulate(loads_diagram(text, filename="ticker.yaml"))
+    done = threading.Event()
+    waiting = threading.Thread(target=done.wait)
+    waiting.start()
+    try:
+        r = simulate(loads_diagram(text, filename="ticker.yaml"))
+    finally:
+        done.set()
+        waiting.join()
     reached = 3 * ADVANCE_CHUNK
     assert r.interrupted and r.status == f"interrupted at t={reached * 1e-3:.9g} s", r.status
     t, y = r["tick.y"]

@@ -51,13 +51,20 @@ def _row(block, outputs):
     return np.concatenate([np.asarray(outputs[port], dtype=np.float64).ravel() for port in block.outputs])
 
 
+def _run_kernel(block):
+    """The Kernel a run uses: the block's, bound to a fresh state where it has a bind (the
+    plant's, whose run gets a scratch of its own)."""
+    kernel = block.kernel()
+    return kernel if kernel.bind is None else kernel.bind(block.initial_state())
+
+
 def _width(block):
     return sum(block.outputs.values())
 
 
 def _check_output(block, t, state, given):
     """The kernel's output equals ``block.output``; returns the Python outputs."""
-    kernel = block.kernel()
+    kernel = _run_kernel(block)
     listed, mapping = _inputs(block, given)
     expected = block.output(t, None if state is None else state.copy(), mapping)
     out = np.full(_width(block), np.nan)
@@ -70,7 +77,7 @@ def _check_output(block, t, state, given):
 
 def _check_update(block, t, state, given):
     """The kernel's update (in place) equals ``block.update``; returns the new state."""
-    kernel = block.kernel()
+    kernel = _run_kernel(block)
     listed, mapping = _inputs(block, given)
     expected = np.array(block.update(t, state.copy(), mapping), dtype=np.float64)
     mine = state.copy()
@@ -88,11 +95,12 @@ def test_every_block_of_the_regrasp_diagram_has_a_kernel(diagram):
                             "ObjectSupport.output"}
     assert all(isinstance(a, int) and a != 0 for a in kernels.values())
     plant, reflex = b["plant"].kernel(), b["reflex"].kernel()
-    assert plant.output and plant.update and plant.advance and plant.context
-    assert reflex.output and reflex.update and not reflex.advance
+    assert plant.output and plant.update and plant.advance and plant.bind and plant.nogil
+    assert _run_kernel(b["plant"]).context and _run_kernel(b["plant"]).nogil
+    assert reflex.output and reflex.update and not reflex.advance and reflex.nogil
     for name in ("manip", "suppress", "support"):
         k = b[name].kernel()
-        assert k.output and not k.update and not k.advance and k.context
+        assert k.output and not k.update and not k.advance and k.context and k.nogil
 
 
 def test_blocks_not_bound_have_no_kernel():
@@ -130,7 +138,7 @@ def test_kernels_equal_the_python_methods_along_a_regrasp(diagram):
             checked_update = True
         # the plant's stretch to the next reflex hit: Python's advance against the kernel's
         listed, mapping = _inputs(plant, plant_in)
-        kernel = plant.kernel()
+        kernel = _run_kernel(plant)
         rows = np.full((steps, N_OUTPUTS), np.nan)
         mine = x.copy()
         code, done, which = call("advance", kernel.advance, kernel.context, t, mine, listed, rows, steps)
@@ -160,12 +168,12 @@ def test_the_suppresser_takes_any_torques(diagram):
 
 
 def _kernel_error(block, code, which, t, phase):
-    return block.kernel().error(code, which, t, phase)
+    return _run_kernel(block).error(code, which, t, phase)
 
 
 def test_a_non_finite_torque_fails_as_the_python_step_does(diagram):
     plant = _blocks(diagram)["plant"]
-    kernel = plant.kernel()
+    kernel = _run_kernel(plant)
     x = plant.initial_state()
     tau = np.zeros(9)
     tau[4] = np.nan
@@ -191,7 +199,7 @@ def test_a_non_finite_torque_fails_as_the_python_step_does(diagram):
 
 def test_a_blow_up_part_way_through_an_advance_keeps_the_rows_before_it(diagram):
     plant = _blocks(diagram)["plant"]
-    kernel = plant.kernel()
+    kernel = _run_kernel(plant)
     x = plant.initial_state()
     tau = np.full(9, 1e150)  # finite, but the state leaves the doubles after a few steps
     listed, mapping = _inputs(plant, {"tau": tau})
@@ -217,7 +225,7 @@ def test_a_blow_up_part_way_through_an_advance_keeps_the_rows_before_it(diagram)
 
 def test_a_bad_state_fails_in_the_output_as_in_python(diagram):
     plant = _blocks(diagram)["plant"]
-    kernel = plant.kernel()
+    kernel = _run_kernel(plant)
     x = plant.initial_state()
     x[10] = np.inf  # qd[1]
     with pytest.raises(BlockError) as python:

@@ -6,7 +6,11 @@
  * functions of py_plant.c and py_control.c), with the same arguments, so results are equal
  * to the last bit. The blocks' kernel() methods (Python) build the contexts:
  *
- * - HandPlant: the bound Model object itself (model_address(model)); its scratch is used.
+ * - HandPlant: a Scratch object of the run (its Kernel's bind makes one per run): the
+ *   stepping Model, read only, and the hh_work the steps write.
+ *
+ * None calls Python's C API or writes anything but the state, the outputs and a Scratch,
+ * so the blocks' Kernels say nogil and the executor runs them with the GIL released.
  * - GraspReflex: uintptr_t[2] = {Model object, params};
  * - ManipulationPD: uintptr_t[5] = {Model object, params, waypoints, meta, capacity};
  * - Suppresser: the params (HH_SUPPRESS_N_PARAMS doubles);
@@ -27,6 +31,62 @@
 #include "../control.h"
 #include "blocks_kernel.h"
 
+/* -- Scratch: one run's hh_work for a Model ---------------------------------------------- */
+
+static PyObject *scratch_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
+{
+    static char *keywords[] = {"model", NULL};
+    PyObject *obj;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "O:Scratch", keywords, &obj))
+        return NULL;
+    ModelObject *model = hh_py_model(obj, "model");
+    if (model == NULL)
+        return NULL;
+    if (!(model->model.body[HH_B_DT] > 0.0)) {
+        PyErr_SetString(PyExc_ValueError, "Scratch: the model has no step; make one with Model.with_dt(dt)");
+        return NULL;
+    }
+    ScratchObject *self = (ScratchObject *)type->tp_alloc(type, 0);
+    if (self == NULL)
+        return NULL;
+    if (hh_work_init(&self->work, model->model.npts) != 0) {
+        Py_DECREF(self);
+        return PyErr_NoMemory();
+    }
+    self->model = (ModelObject *)Py_NewRef(model);
+    return (PyObject *)self;
+}
+
+static void scratch_dealloc(ScratchObject *self)
+{
+    hh_work_free(&self->work);
+    Py_XDECREF(self->model);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static PyObject *scratch_address(ScratchObject *self, void *closure)
+{
+    (void)closure;
+    return PyLong_FromVoidPtr(self);
+}
+
+static PyGetSetDef scratch_getset[] = {
+    {"address", (getter)scratch_address, NULL,
+     "the address of this object: the context of the plant's kernel (keep the Scratch alive while it runs)", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
+PyTypeObject hh_py_scratch_type = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hierhand._native.Scratch",
+    .tp_basicsize = sizeof(ScratchObject),
+    .tp_dealloc = (destructor)scratch_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "Scratch(model): the scratch of one run of the plant's compiled kernel, stepping model (a stepping "
+              "Model, kept alive); its address is that kernel's context.",
+    .tp_getset = scratch_getset,
+    .tp_new = scratch_new,
+};
+
 /* -- HandPlant: inputs tau (9), f_ext (3); out: the output row (HH_N_OUTPUTS) ---------------- */
 
 static int plant_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
@@ -34,25 +94,25 @@ static int plant_output(const void *ctx, double t, const double *state, const do
 {
     (void)t;
     (void)inputs;
-    ModelObject *self = (ModelObject *)(uintptr_t)ctx;
-    return hh_output(&self->model, &self->work, state, out, which);
+    ScratchObject *run = (ScratchObject *)(uintptr_t)ctx;
+    return hh_output(&run->model->model, &run->work, state, out, which);
 }
 
 static int plant_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
 {
     (void)t;
-    ModelObject *self = (ModelObject *)(uintptr_t)ctx;
+    ScratchObject *run = (ScratchObject *)(uintptr_t)ctx;
     int done;
-    return hh_step(&self->model, &self->work, state, inputs[0], inputs[1], &done, which);
+    return hh_step(&run->model->model, &run->work, state, inputs[0], inputs[1], &done, which);
 }
 
 static int plant_advance(const void *ctx, double t, double *state, const double *const *inputs, int n, double *rows,
                          int *done, int *which)
 {
     (void)t;
-    ModelObject *self = (ModelObject *)(uintptr_t)ctx;
+    ScratchObject *run = (ScratchObject *)(uintptr_t)ctx;
     long stepped = 0;
-    int code = hh_advance(&self->model, &self->work, state, inputs[0], inputs[1], (long)n, rows, HH_N_OUTPUTS,
+    int code = hh_advance(&run->model->model, &run->work, state, inputs[0], inputs[1], (long)n, rows, HH_N_OUTPUTS,
                           &stepped, which);
     /* hh_advance counts the failing update; the rows before it are complete (as
        HandPlant.advance: written = max(done - 1, 0)) */

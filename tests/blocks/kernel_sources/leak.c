@@ -102,3 +102,30 @@ int ticker_advance(const void *ctx, double t, double *state, const double *const
     *done = n;
     return 0;
 }
+
+/* Gate: stateless; its output waits until another thread opens the gate, which that thread
+   can only do while the run has released the GIL. ctx: [open, waiting, patience (s)]: the
+   output sets waiting (a test's handshake, the one write through a context here), then
+   waits for open and gives 1; code 1 when patience runs out first. */
+#include <time.h>
+
+static double seconds(void)
+{
+    struct timespec now;
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    return (double)now.tv_sec + 1e-9 * (double)now.tv_nsec;
+}
+
+int gate_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                int *which)
+{
+    (void)t, (void)state, (void)inputs, (void)which;
+    volatile double *gate = (volatile double *)ctx;
+    double start = seconds();
+    gate[1] = 1.0;
+    while (gate[0] == 0.0)
+        if (seconds() - start > gate[2])
+            return 1;
+    out[0] = 1.0;
+    return 0;
+}
