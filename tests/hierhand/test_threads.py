@@ -66,10 +66,13 @@ def test_two_different_hands_at_once_give_their_serial_samples():
     in_threads_as_serial([lambda: run(REGRASP), lambda: run(REGRASP, HEAVIER)], serial)
 
 
-def test_the_fmu_plant_in_two_threads_at_once_gives_the_serial_samples():
+def test_the_fmu_plant_in_two_threads_at_once_gives_the_serial_samples(tmp_path):
     pytest.importorskip("fmpy")
-    serial = run(REGRASP_FMU)
-    in_threads_as_serial([lambda: run(REGRASP_FMU)] * 2, [serial] * 2)
+    from hierhand.fmu_export import export_plant_fmu
+
+    exported = {"plant.path": str(export_plant_fmu(tmp_path / "plant.fmu", fmi=2))}  # a clone has no fmu/
+    serial = run(REGRASP_FMU, exported)
+    in_threads_as_serial([lambda: run(REGRASP_FMU, exported)] * 2, [serial] * 2)
 
 
 def test_a_run_steps_with_a_scratch_of_its_own():
