@@ -84,40 +84,24 @@ class CompiledSide:
         self.owners: list[Any] = []
         self.logged: list = []
         self.failure: tuple[str, BaseException] | None = None
-        """A block whose ``kernel()`` raised, and what: the run reports it as that block's failure."""
+        """A block whose ``kernel()`` or kernel ``bind`` raised, and what: the run reports it
+        as that block's failure."""
         if NativeRunner is None or not self.exact_ticks():
             return
         updated = {b for p in (*schedule.programs, schedule.initial) for b in p.update}
         for name, spec in diagram.blocks.items():
-            block = spec.block
+            state = states[index[name]]
             try:
-                kernel = block.kernel()
+                kernel = self.usable_kernel(spec.block, inputs[name], state, name in updated,
+                                            name in schedule.advanced)
+                if kernel is not None and kernel.bind is not None:
+                    kernel, state = kernel.bind(state), (state if flat(state) else None)
             except Exception as exc:
                 self.failure = (name, exc)
                 self.blocks.clear()
                 return
-            if not isinstance(kernel, Kernel) or not kernel.output:
-                continue
-            if any(not (isinstance(v := inputs[name][p], np.ndarray) and v.shape == (w,) and v.dtype == np.float64)
-                   for p, w in block.inputs.items()):
-                continue  # an input default of another width: the Python methods meet it as they would
-            state = states[index[name]]
-            if state is not None:
-                if kernel.bind is None and not flat(state):
-                    continue
-                if name in updated and not kernel.update:
-                    continue
-            if name in schedule.advanced and not kernel.advance:
-                continue
-            if kernel.bind is not None:
-                try:
-                    kernel = kernel.bind(state)
-                except Exception as exc:
-                    self.failure = (name, exc)
-                    self.blocks.clear()
-                    return
-                state = state if flat(state) else None
-            self.blocks[name] = CompiledBlock(name, block, kernel, state, len(self.blocks))
+            if kernel is not None:
+                self.blocks[name] = CompiledBlock(name, spec.block, kernel, state, len(self.blocks))
         if not self.blocks:
             return
         self.inputs = inputs
@@ -132,6 +116,22 @@ class CompiledSide:
                                 schedule.period_ticks[cb.name] or 0, int(cb.kernel.nogil)]
                                for cb in self.blocks.values()],
                               dtype=np.int64)
+
+    @staticmethod
+    def usable_kernel(block: Any, inputs: dict, state: Any, updated: bool, advanced: bool) -> Kernel | None:
+        """The block's kernel if it offers every function the schedule needs of it and its
+        inputs and state are what the kernel reads; else None (the block runs in Python)."""
+        kernel = block.kernel()
+        if not isinstance(kernel, Kernel) or not kernel.output:
+            return None
+        if any(not (isinstance(v := inputs[p], np.ndarray) and v.shape == (w,) and v.dtype == np.float64)
+               for p, w in block.inputs.items()):
+            return None  # an input default of another width: the Python methods meet it as they would
+        if state is not None and ((kernel.bind is None and not flat(state)) or (updated and not kernel.update)):
+            return None
+        if advanced and not kernel.advance:
+            return None
+        return kernel
 
     def exact_ticks(self) -> bool:
         tick = self.s.base_tick
