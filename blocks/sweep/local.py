@@ -85,19 +85,20 @@ def _serve(job: SweepJob, queue: SharedQueue, stop: Any, conn: Any, keep: Keep |
             taken = queue.take_indices(1)
             if not taken:
                 break
-            conn.send(("start", taken[0]))
-            outcome = run_point(job, queue.items[taken[0]][1])
+            index = taken[0]
+            point_hash, point = queue.items[index]
+            conn.send(("start", index))
+            outcome = run_point(job, point)
             if keep is not None:
                 try:
-                    keep(queue.items[taken[0]][0], outcome)
+                    keep(point_hash, outcome)
                 except Exception:  # the sweep's process tries again, and reports it
                     pass
             try:
-                conn.send(("done", taken[0], outcome))
+                conn.send(("done", index, outcome))
             except (pickle.PicklingError, TypeError, AttributeError) as exc:  # as a Dask task's result would fail
-                conn.send(("done", taken[0], Outcome(FAILED, one_line(f"the run's outcome cannot be sent back: "
-                                                                      f"{type(exc).__name__}: {exc}"),
-                                                     outcome.wall_s)))
+                conn.send(("done", index, Outcome(FAILED, one_line(f"the run's outcome cannot be sent back: "
+                                                                   f"{type(exc).__name__}: {exc}"), outcome.wall_s)))
     except (BrokenPipeError, EOFError, KeyboardInterrupt):  # the sweep's process has gone
         pass
     finally:
@@ -121,8 +122,7 @@ class LocalRunner:
         self.began = False
         """Whether the latest process took a point (one that dies before is not restarted)."""
         self.walls: list[float] = []
-        """Wall times of the runs this runner finished."""
-        self.ran = 0
+        """Wall times of the runs this runner finished (or died under), one per point."""
 
     @property
     def alive(self) -> bool:
@@ -171,7 +171,6 @@ class LocalRunner:
 
     def _take(self, index: int, outcome: Outcome) -> None:
         self.walls.append(outcome.wall_s)
-        self.ran += 1
         self.record(index, outcome)
 
     def _ended(self) -> None:
@@ -236,6 +235,6 @@ def run_local_first(job: SweepJob, todo: list[tuple[str, Any]], record: Record, 
                 break
     finally:
         runner.close()
-    report.local = runner.ran
+    report.local = len(runner.walls)
     report.wall_s = report.run_s = time.perf_counter() - t0
     return report
