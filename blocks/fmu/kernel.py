@@ -187,13 +187,14 @@ class KernelRun:
         return 0
 
     def set_failed(self, t: float, status: int) -> int:
-        inst = self.instance
-        self.block.step_calls(inst, t, _raise, call_failed(inst.writes[0].function, status))
-        return 0
+        return self.transfer_failed(self.instance.writes[0], t, status)
 
     def get_failed(self, t: float, status: int) -> int:
-        inst = self.instance
-        self.block.step_calls(inst, t, _raise, call_failed(inst.reads[0].function, status))
+        return self.transfer_failed(self.instance.reads[0], t, status)
+
+    def transfer_failed(self, transfer: Any, t: float, status: int) -> int:
+        """A set or get call returned ``status``: the failure the block's update raises for it."""
+        self.block.step_calls(self.instance, t, _raise, call_failed(transfer.function, status))
         return 0
 
     def stepped(self, t: float, status: int) -> int:
