@@ -17,7 +17,7 @@ import numpy as np
 
 from . import compiled
 from .kernel import Kernel, address
-from .optable import ADVANCE, L_CAPACITY, L_WIDTH, LC_HITS, OP_A, OP_CODE, UPDATE, OpTable
+from .optable import ADVANCE, L_CAPACITY, L_WIDTH, LC_ROWS, OP_A, OP_CODE, UPDATE, OpTable
 
 KERNEL_COLUMNS = ("output", "update", "advance", "context", "state", "nogil")
 """A run's kernel rows, one per block (all zero for a Python block), as the host reads them."""
@@ -26,7 +26,7 @@ KERNEL_COLUMNS = ("output", "update", "advance", "context", "state", "nogil")
 class Binding:
     """What one run of ``table`` owns: states, input mappings, kernels, arena and logs."""
 
-    def __init__(self, diagram: Any, table: OpTable, use_kernels: bool = True):
+    def __init__(self, diagram: Any, table: OpTable):
         self.diagram, self.table = diagram, table
         names = table.names
         specs = [diagram.blocks[n].block for n in names.blocks]
@@ -51,7 +51,7 @@ class Binding:
         self.kernels: list[Kernel | None] = [None] * len(specs)
         self.failure: tuple[str, BaseException] | None = None
         """A block whose ``kernel()`` or kernel ``bind`` raised, and what."""
-        if use_kernels and compiled.native() is not None:
+        if compiled.native() is not None:
             self.choose_kernels()
 
     def choose_kernels(self) -> None:
@@ -91,7 +91,4 @@ class Binding:
 
     def rows_logged(self, entry: int) -> np.ndarray:
         """The rows log entry ``entry`` (a row of the logs table) holds."""
-        return self.logs[entry][:int(self.counters[entry, 0])]
-
-    def hits_logged(self, entry: int) -> int:
-        return int(self.counters[entry, LC_HITS])
+        return self.logs[entry][:int(self.counters[entry, LC_ROWS])]

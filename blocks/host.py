@@ -14,14 +14,12 @@ from typing import Callable
 from .binding import Binding
 from .compiled import native
 from .kernel import END_RUN, RAISED
-from .optable import ADVANCE, OP_A, OP_CODE, OUTPUT
+from .optable import OP_A, OP_CODE, PHASES
 from .outcome import Outcome, stopped
 from .python_blocks import PythonSide
 
 COMPLETE, FAILED, STOPPED, BAD = range(4)
 """``blk_outcome.status`` (core.h)."""
-
-PHASES = {OUTPUT: "output", ADVANCE: "advance"}
 
 
 def python_spec(side: PythonSide, b: int) -> tuple:
@@ -54,7 +52,7 @@ def run_native(binding: Binding, progress: Callable[[int], None] | None) -> Outc
     if status == BAD:
         raise RuntimeError(f"the op table could not run: {message}")
     b = int(table.ops[op, OP_A])
-    phase = PHASES.get(int(table.ops[op, OP_CODE]), "update")
+    phase = PHASES[int(table.ops[op, OP_CODE])]
     if code != RAISED and not (code == END_RUN and error is not None):
         error = binding.kernel_error(b, code, which, tick, phase)
     return stopped(names[b], phase, tick, error, reached, binding.kernels[b] is None, end_request)

@@ -62,6 +62,9 @@ LC_ROWS, LC_HITS = range(2)
 """The columns of each table (core.h's BLK_* names without the prefix), and of a run's
 log counters."""
 
+PHASES = ("output", "update", "advance")
+"""The phase of a block's op, by op code, as failures name it."""
+
 TABLES = ("header", "blocks", "inputs", "ports", "ops", "copies", "programs", "events", "logs", "selections")
 WIDTHS = (7, 9, 2, 3, 5, 3, 3, 2, 5, 1)
 """The tables in core.h's order, and their row widths."""

@@ -7,10 +7,11 @@ and the log entries, so that what a run does can be read off before running it.
 
 from __future__ import annotations
 
-from .optable import (ADVANCE, B_FIRST_INPUT, B_FIRST_PORT, B_N_INPUTS, B_N_PORTS, B_PERIOD, B_ROWS, B_ROWS_CAPACITY, B_WIDTH, C_DST,
-                      C_SRC, C_WIDTH, COPY, E_PROGRAM, E_TICK, H_ARENA, H_FINAL, H_HYPERPERIOD, H_INITIAL, H_N_TICKS,
-                      H_TICK_DEN, H_TICK_NUM, I_OFFSET, I_WIDTH, L_BLOCK, L_CAPACITY, L_COLUMN, L_DECIMATE, L_WIDTH,
-                      OP_A, OP_B, OP_C, OP_CODE, OP_D, OUTPUT, P_OFFSET, P_WIDTH, UPDATE, OpTable)
+from .optable import (ADVANCE, B_FIRST_INPUT, B_FIRST_PORT, B_N_INPUTS, B_N_PORTS, B_PERIOD, B_ROWS,
+                      B_ROWS_CAPACITY, B_WIDTH, C_DST, C_SRC, C_WIDTH, COPY, E_PROGRAM, E_TICK, H_ARENA, H_FINAL,
+                      H_HYPERPERIOD, H_INITIAL, H_N_TICKS, H_TICK_DEN, H_TICK_NUM, I_OFFSET, I_WIDTH, L_BLOCK,
+                      L_CAPACITY, L_COLUMN, L_DECIMATE, L_WIDTH, OP_A, OP_B, OP_C, OP_CODE, OP_D, OUTPUT, P_OFFSET,
+                      P_WIDTH, UPDATE, OpTable)
 
 MAX_TICKS_SHOWN = 6
 """How many of the ticks a program runs at are listed before '...'."""

@@ -37,7 +37,7 @@ class PythonSide:
     empty = staticmethod(np.empty)
     ndarray = np.ndarray
     end_run = EndRun
-    """What the C host creates input arrays with, checks outputs against, catches."""
+    """What the C host creates input arrays with, checks outputs against, and catches."""
 
     def __init__(self, binding: Binding):
         self.binding = binding
@@ -83,10 +83,10 @@ class PythonSide:
         binding = self.binding
         self.refresh(b)
         out = binding.blocks[b].output(t, binding.states[b], binding.inputs[b])
-        binding.arena[self.flat_offsets(b, selection)] = self.outputs_checked(b, out, selection)
-
-    def flat_offsets(self, b: int, selection: int) -> np.ndarray:
-        return np.concatenate([np.arange(o, o + w) for _, o, w in self.ports_of(b, selection)] or [np.zeros(0, int)])
+        values, at = self.outputs_checked(b, out, selection), 0
+        for _, offset, width in self.ports_of(b, selection):
+            binding.arena[offset:offset + width] = values[at:at + width]
+            at += width
 
     def outputs_checked(self, b: int, out: Any, selection: int) -> np.ndarray:
         """The values of the ports of ``selection`` in ``out`` (what ``output`` returned), one

@@ -24,12 +24,9 @@ from .kernel import END_RUN
 from .optable import (B_FIRST_INPUT, B_N_INPUTS, B_OUT, B_PERIOD, B_ROWS, B_ROWS_CAPACITY, B_WIDTH, C_DST, C_SRC,
                       C_WIDTH, COPY, E_PROGRAM, E_TICK, H_FINAL, H_HYPERPERIOD, H_INITIAL, H_N_TICKS, I_OFFSET,
                       I_WIDTH, L_CAPACITY, L_COLUMN, L_DECIMATE, L_WIDTH, LC_HITS, LC_ROWS, OP_A, OP_B, OP_C, OP_CODE,
-                      OP_D, OUTPUT, UPDATE)
+                      OP_D, OUTPUT, PHASES, UPDATE)
 from .outcome import Outcome, stopped
 from .python_blocks import PythonSide
-
-PHASES = ("output", "update", "advance")
-
 
 class _Stop(Exception):
     """Carries the outcome of a run that stopped at an op."""
