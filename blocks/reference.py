@@ -19,6 +19,7 @@ from __future__ import annotations
 from typing import Callable
 
 from .binding import Binding
+from .block import EndRun
 from .compiled import native
 from .kernel import END_RUN
 from .optable import (B_FIRST_INPUT, B_N_INPUTS, B_OUT, B_PERIOD, B_ROWS, B_ROWS_CAPACITY, B_WIDTH, C_DST, C_SRC,
@@ -94,21 +95,20 @@ class ReferenceLoop:
         """Program ``p`` at tick ``k``, its advances stepping to ``next_k``."""
         first, end, _ = self.t.programs[p]
         self.reached = k
-        for index in range(first, end):
-            op = self.ops[index]
+        for op in self.ops[first:end]:
             if op[OP_CODE] == OUTPUT:
-                self.output(index, op, k)
+                self.output(op, k)
             elif op[OP_CODE] == UPDATE:
-                self.update(index, op, k)
+                self.update(op, k)
             elif op[OP_CODE] == COPY:
                 self.copy(op)
             else:
-                self.advance(index, op, k, next_k)
+                self.advance(op, k, next_k)
         self.reached = next_k
 
     # -- one function per op kind ---------------------------------------------------------
 
-    def output(self, index: int, op: list[int], k: int) -> None:
+    def output(self, op: list[int], k: int) -> None:
         """A block's outputs at tick k into the arena, then the log entries of the op."""
         b = op[OP_A]
         t = self.t.time(k)
@@ -120,7 +120,7 @@ class ReferenceLoop:
         for entry in range(op[OP_B], op[OP_C]):
             self.log(entry, row)
 
-    def update(self, index: int, op: list[int], k: int) -> None:
+    def update(self, op: list[int], k: int) -> None:
         """A block's update at tick k; one that asks to end the run moves the end."""
         b = op[OP_A]
         t = self.t.time(k)
@@ -130,7 +130,7 @@ class ReferenceLoop:
             code, which = self.kernel_call(op, k, "update", self.b.kernels[b].update, t, None)
             if code == END_RUN:
                 end = self.guarded(op, k, lambda: self.b.kernel_error(b, END_RUN, which, k, "update"), python=False)
-                if not isinstance(end, self.python.end_run):
+                if not isinstance(end, EndRun):
                     self.fail(op, k, end, python=False)
             else:
                 self.checked(op, k, (code, which))
@@ -140,7 +140,7 @@ class ReferenceLoop:
                 self.end_request = (self.t.names.blocks[b], end.reason, k)
             self.end_at_next_hit(b)
 
-    def advance(self, index: int, op: list[int], k: int, next_k: int) -> None:
+    def advance(self, op: list[int], k: int, next_k: int) -> None:
         """A block stepped from tick k to next_k in chunks of at most its rows' capacity,
         each from the time of its first tick; every row logged, the last one its outputs."""
         b = op[OP_A]
