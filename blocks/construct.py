@@ -70,14 +70,19 @@ class Placed:
 
 
 def deep_merge(base: Mapping, top: Mapping) -> dict:
-    """``top`` over ``base``: nested mappings merge key by key, anything else replaces."""
-    out = {k: copy.deepcopy(v) for k, v in base.items()}
+    """``top`` over ``base``: nested mappings merge key by key, anything else replaces.
+    Values are copied, except blocks (a block reference given as the block itself)."""
+    out = {k: _copied(v) for k, v in base.items()}
     for key, value in top.items():
         if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
             out[key] = deep_merge(out[key], value)
         else:
-            out[key] = copy.deepcopy(value)
+            out[key] = _copied(value)
     return out
+
+
+def _copied(value: Any) -> Any:
+    return value if isinstance(value, Block) else copy.deepcopy(value)
 
 
 def type_ref(cls: type[Block]) -> str:
@@ -111,15 +116,14 @@ class Constructor:
             for name in level.failed:
                 self.failed.add(level.flat(name))
         instances = self.instances()
-        for level in self.top.levels():
-            for local, entry in level.blocks.items():
-                name = level.flat(local)
-                order_of.append(name)
-                p = self.place(level, name, entry)
-                if p is None or not self.check_references(p, instances):
-                    self.failed.add(name)
-                else:
-                    placed[name] = p
+        for level, local, entry in self.top.placed():
+            name = level.flat(local)
+            order_of.append(name)
+            p = self.place(level, name, entry)
+            if p is None or not self.check_references(p, instances):
+                self.failed.add(name)
+            else:
+                placed[name] = p
         order, cycles = build_order({n: {k: b.target for k, b in p.references.items() if not b.stand_in}
                                      for n, p in placed.items()})
         cyclic = {r.block for cycle in cycles for r in cycle}

@@ -155,6 +155,7 @@ class Composite:
     """``""`` for the top diagram, else the subsystem's path (``ctrl``, ``ctrl.inner``)."""
     diagram_name: str
     file: str | None
+    """The YAML file it was read from; None for a level built in Python."""
     line: int | None = None
     """Where the including diagram names the subsystem (None for the top)."""
     including_file: str | None = None
@@ -163,15 +164,25 @@ class Composite:
     blocks: tuple[str, ...] = ()
     subsystems: tuple[str, ...] = ()
     wires: tuple[Connection, ...] = ()
+    log: tuple[LogEntry, ...] = ()
+    """The signals it asks to log (those of its subsystems by path: ``ctrl.integ.y``)."""
     inputs: dict[str, DiagramPort] = field(default_factory=dict)
     outputs: dict[str, DiagramPort] = field(default_factory=dict)
     references: dict[str, DeclaredReference] = field(default_factory=dict)
     """The block references it leaves to its includer (``references:``)."""
     bindings: dict[str, str] = field(default_factory=dict)
-    """For a subsystem: each of its references -> the block it is bound to (``bind:``)."""
+    """For a subsystem: each of its references -> the block it is bound to, by path."""
+    bind: dict[str, str] = field(default_factory=dict)
+    """For a subsystem: its entry's ``bind`` as written (names in the including level)."""
     params: dict[str, Any] = field(default_factory=dict)
     """For a subsystem: the overrides it was given, by dotted path inside it (``prop.k``),
     from its entry's ``params`` and from ``--set``."""
+
+    @property
+    def origin(self) -> str:
+        """Where it comes from, for people: its file as the including entry names it, its
+        file, or ``built in Python``."""
+        return self.source or self.file or "built in Python"
 
     def name_of(self, path: str) -> str:
         """``path`` (a block or subsystem inside this level) as this level's file names it."""
@@ -304,7 +315,7 @@ class Diagram:
 
     def composition(self) -> dict[str, dict]:
         """Each subsystem's file and the overrides it was given (for run.json)."""
-        return {path: {"diagram": sub.source or sub.file, "name": sub.diagram_name,
+        return {path: {"diagram": sub.origin, "name": sub.diagram_name,
                        **({"params": jsonable(sub.params)} if sub.params else {}),
                        **({"bind": dict(sub.bindings)} if sub.bindings else {})}
                 for path, sub in self.subsystems.items()}

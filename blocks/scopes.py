@@ -86,6 +86,8 @@ class Level:
     """Block (local name) -> the overrides that reach it, lowest rank first."""
     params: dict[str, Any] = field(default_factory=dict)
     """For a subsystem: the overrides routed into it, by dotted path inside it."""
+    order: list[str] = field(default_factory=list)
+    """Its blocks and subsystems in the order written."""
 
     def flat(self, local: str) -> str:
         """The path name of this level's ``local`` block or subsystem (``ctrl.integ``)."""
@@ -110,6 +112,15 @@ class Level:
 
     def has(self, local: str) -> bool:
         return local in self.blocks or local in self.subsystems or local in self.failed
+
+    def placed(self) -> Iterator[tuple["Level", str, BlockEntry]]:
+        """(level, name, entry) of every block, in the flat diagram's order: a subsystem's
+        blocks where its entry is written."""
+        for name in self.order:
+            if name in self.blocks:
+                yield self, name, self.blocks[name]
+            elif name in self.subsystems:
+                yield from self.subsystems[name].placed()
 
     def levels(self) -> Iterator["Level"]:
         """This level and every level inside it, in the order their blocks stand."""
@@ -174,8 +185,10 @@ class _Expander:
                     "a reference stands for a block the including diagram binds; give it another name"))
                 level.failed.add(name)
             elif isinstance(entry, SubsystemEntry):
+                level.order.append(name)
                 self.subsystem(level, entry, chain)
             else:
+                level.order.append(name)
                 level.blocks[name] = entry
                 self.count(level, entry.site, 1)
 
@@ -193,6 +206,8 @@ class _Expander:
                 level.failed.add(name)
                 return
             ctx.files.update(read)
+        elif inner.texts and Path(inner.file).is_file():  # a builder read from a file, given in Python
+            ctx.files.setdefault(_relative_dir(Path(inner.file), self.root.base_dir), Path(inner.file))
         if any(inner is b for b in chain):
             names = [b.label for b in chain[next(i for i, b in enumerate(chain) if b is inner):]]
             ctx.add(entry.site.issue(f"subsystem '{path}': {inner.label} includes itself: "
@@ -243,16 +258,13 @@ def _relative_dir(folder: Path, top: Path) -> str:
 
 def route_overrides(ctx: BuildContext, top: Level) -> None:
     """Give every block the overrides that reach it: the caller's at the top, each
-    subsystem entry's ``params`` inside its subsystem."""
-    for key, value in ctx.overrides.items():
-        route(ctx, top, str(key).split("."), Override((), value, key, CLI_RANK))
+    subsystem entry's ``params`` inside its subsystem; the lowest rank first, so that
+    each subsystem's ``params`` (what it was given from outside) ends with the winner."""
+    given: list[tuple[Level, Override]] = []
     for level in top.levels():
-        if level.entry is None:
+        if level.entry is None or level.entry.params is None:
             continue
-        params = level.entry.params
-        if params is None:
-            continue
-        site = level.entry.site
+        params, site = level.entry.params, level.entry.site
         if not isinstance(params, Mapping):
             ctx.add(site.issue(f"{level.describe()}: 'params' must be a mapping of block.param paths to values",
                                "params: {prop.k: 2.0}", key="params"))
@@ -263,10 +275,12 @@ def route_overrides(ctx: BuildContext, top: Level) -> None:
                 ctx.add(inner_site.issue(f"{level.describe()}: params key {key!r} is not a block.param path",
                                          key=key))
                 continue
-            route(ctx, level, key.split("."), Override((), value, key, -level.parent.depth, inner_site))
-    for level in top.levels():
-        for overrides in level.overrides.values():
-            overrides.sort(key=lambda o: o.rank)
+            given.append((level, Override((), value, key, -level.parent.depth, inner_site)))
+    given += [(top, Override((), value, key, CLI_RANK)) for key, value in ctx.overrides.items()]
+    for level, ov in sorted(given, key=lambda g: g[1].rank):
+        if level.entry is not None:
+            level.params[ov.key] = ov.value
+        route(ctx, level, str(ov.key).split("."), ov)
 
 
 def _nested(site: Site, key: str) -> Site:

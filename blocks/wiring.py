@@ -62,7 +62,9 @@ class Wiring:
         """id of a flat connection -> the wire it comes from, as its file writes it."""
         self.wires: dict[str, list[Connection]] = {}
         self.driven: dict[str, set[Endpoint]] = {}
-        """Level path -> the (local name, port) its connections drive."""
+        """Level path -> the (block path, port) its connections drive."""
+        self.logged: dict[str, list[LogEntry]] = {}
+        """Level path -> the signals it asks to log."""
 
     def file_of(self, site: Site) -> str | None:
         return site.file if site.file != self.top.file else None
@@ -340,12 +342,14 @@ class Wiring:
         logged: set[str] = set()
         for level in self.top.levels():
             here: set[str] = set()
+            asked = self.logged.setdefault(level.path, [])
             for request in level.builder.logs:
                 for entry in self.log_request(level, request):
                     if entry.signal in here:
                         self.ctx.add(request.site.issue(f"signal '{entry.signal}' is logged twice"))
                         continue
                     here.add(entry.signal)
+                    asked.append(entry)
                     if entry.signal not in logged:
                         logged.add(entry.signal)
                         entries.append(entry)
@@ -355,9 +359,9 @@ class Wiring:
         site = request.site
         file = self.file_of(site)
         if request.every:
-            return [LogEntry(name, port, 1, site.line, file) for sub in level.levels()
-                    for name in (sub.flat(n) for n in sub.blocks) if name in self.specs
-                    for port in self.specs[name].block.outputs]
+            inside = {sub.flat(n) for sub in level.levels() for n in sub.blocks}
+            return [LogEntry(name, port, 1, site.line, file) for name, spec in self.specs.items() if name in inside
+                    for port in spec.block.outputs]
         decimate = request.decimate
         if not isinstance(decimate, int) or isinstance(decimate, bool) or decimate < 1:
             self.ctx.add(site.issue(f"log decimate must be a positive integer, got {decimate!r}", key="decimate"))
@@ -412,11 +416,13 @@ class Wiring:
         entry = level.entry
         references = {n: DeclaredReference(n, _type_text(r.stand_in), r.site.line)
                       for n, r in level.references.items()}
-        return Composite(level.path, name, level.file, entry.site.line if entry else None,
-                         level.parent.file if level.parent else None, entry.source if entry else None,
-                         tuple(level.flat(n) for n in level.blocks), tuple(s.path for s in level.subsystems.values()),
-                         tuple(self.wires.get(level.path, ())), inputs, outputs, references,
-                         {n: b.target for n, b in level.bindings.items() if b is not None}, dict(level.params))
+        return Composite(level.path, name, level.file if level.builder.texts else None,
+                         entry.site.line if entry else None, level.parent.file if level.parent else None,
+                         entry.source if entry else None, tuple(level.flat(n) for n in level.blocks),
+                         tuple(s.path for s in level.subsystems.values()), tuple(self.wires.get(level.path, ())),
+                         tuple(self.logged.get(level.path, ())), inputs, outputs, references,
+                         {n: b.target for n, b in level.bindings.items() if b is not None},
+                         dict(entry.bind or {}) if entry else {}, dict(level.params))
 
     def diagram_port(self, name: str, signals: list[Endpoint], kind: str, site: Site) -> DiagramPort:
         blocks = [(self.specs[b].block, p) for b, p in signals]
