@@ -119,6 +119,8 @@ class Constructor:
         for level, local, entry in self.top.placed():
             name = level.flat(local)
             order_of.append(name)
+            if name in self.failed:
+                continue
             p = self.place(level, name, entry)
             if p is None or not self.check_references(p, instances):
                 self.failed.add(name)

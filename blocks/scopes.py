@@ -130,7 +130,7 @@ class Level:
 
     def describe(self) -> str:
         """``subsystem 'ctrl' (pi.yaml)`` for messages."""
-        source = self.entry.source if self.entry is not None and self.entry.source else self.builder.file
+        source = self.entry.source if self.entry is not None and self.entry.source else self.builder.label
         return f"subsystem '{self.path}' ({source})"
 
 
