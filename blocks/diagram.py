@@ -264,10 +264,10 @@ class Diagram:
             parts.append(f"inputs ({', '.join(root.inputs)})")
         if root.references:
             parts.append(f"block references ({', '.join(root.references)})")
+        use = f"ctrl: {{diagram: {Path(root.file).name}}}" if root.file else "DiagramBuilder.add_subsystem"
         return self.issue(None, f"diagram '{self.name}' has {' and '.join(parts)} that an including "
                           "diagram gives it: it runs only as a subsystem",
-                          f"use it as a block of another diagram: ctrl: {{diagram: {Path(self.file).name}}}, "
-                          "and connect its inputs there")
+                          f"use it as a block of another diagram ({use}) and connect its inputs there")
 
     def driver_of(self, block: str, port: str) -> Connection | None:
         """The connection feeding input ``block.port``, if any."""

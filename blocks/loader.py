@@ -53,7 +53,7 @@ def read_builder(path: str | Path, trust: bool = False, files: Mapping[str, str 
     except YamlSourceError as exc:
         raise DiagramError([Issue(str(path), exc.line, exc.message, exc.hint)]) from None
     builder = _FrontEnd(reading, str(path), path.parent, trust).parse(text)
-    reading.cache[_identity(path)] = builder
+    reading.top = (path, builder)
     return builder
 
 
@@ -79,6 +79,16 @@ class _Reading:
     def __init__(self, files_map: dict[str, Path]):
         self.files_map = files_map
         self.cache: dict[Path, DiagramBuilder] = {}
+        self.top: tuple[Path, DiagramBuilder] | None = None
+        """The top diagram's file, put in ``cache`` once a subsystem is read (a file that
+        includes the top one is then the top one, and closes a chain)."""
+
+    def known(self, path: Path) -> DiagramBuilder | None:
+        """The builder of the file ``path`` if it was read in this load."""
+        if self.top is not None:
+            self.cache.setdefault(_identity(self.top[0]), self.top[1])
+            self.top = None
+        return self.cache.get(_identity(path))
 
 
 class IncludedFile:
@@ -101,7 +111,7 @@ class IncludedFile:
                                            "(Python: trust=True) if you trust this diagram", key="diagram")])
         ref = scope.ref(rel)
         real = self.reading.files_map.get(ref, target)
-        found = self.reading.cache.get(_identity(real))
+        found = self.reading.known(real)
         if found is not None:
             return found, {ref: real}
         try:

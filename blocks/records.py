@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from .diagram import FileScope
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Site:
     """Where part of a diagram was said: a file and line, and for YAML the mapping it was
     written as (a ``LineDict``), whose keys know their own lines."""

@@ -205,8 +205,9 @@ class Wiring:
             if sources is None or targets is None:
                 continue
             for dst in targets:
-                c = Connection(sources[0], sources[1], dst[0], dst[1], wire.delay, wire.initial, wire.line,
-                               wire.file)
+                same = sources == (wire.src_block, wire.src_port) and dst == (wire.dst_block, wire.dst_port)
+                c = wire if same else Connection(sources[0], sources[1], dst[0], dst[1], wire.delay, wire.initial,
+                                                 wire.line, wire.file)
                 self.connections.append(c)
                 self.written[id(c)] = wire
         ports = self.ports_of(level)

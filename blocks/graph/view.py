@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 from ..diagram import Composite, Connection, Diagram
 from ..schedule import Schedule
-from .rates import MIXED_COLOR, Rate, effective_rate, rate_colors, rate_line
+from .rates import MIXED_COLOR, Rate, rate_colors, rate_line
 
 SEVERAL_RATES = "subsystem of several rates"
 """The legend's entry for the colour of a subsystem box whose blocks run at different rates

@@ -9,8 +9,10 @@ problem is reported at the file and line it is written at.
 
 from __future__ import annotations
 
+import csv
 import json
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -20,11 +22,10 @@ import pytest
 
 import blocks
 from blocks import DiagramError, load_diagram, simulate
-from blocks.sweep import grid_points, run_sweep
+from blocks.sweep import grid_points, parse_metrics, run_sweep
 from blocks.sweep.plan import execute, prepare
-from blocks.sweep import parse_metrics
 
-from .test_builder import same_results, structure
+from .test_builder import structure
 
 ROOT = Path(__file__).resolve().parents[2]
 TOY = ROOT / "diagrams" / "toy.yaml"
@@ -115,7 +116,7 @@ def test_a_diagram_with_inputs_validates_on_its_own_and_refuses_to_run(toy):
         simulate(pi, t_end="10 ms")
     assert str(info.value) == (f"{toy.parent / 'lib' / 'pi.yaml'}: diagram 'pi' has inputs (e) that an including "
                                "diagram gives it: it runs only as a subsystem (hint: use it as a block of another "
-                               "diagram: ctrl: {diagram: pi.yaml}, and connect its inputs there)")
+                               "diagram (ctrl: {diagram: pi.yaml}) and connect its inputs there)")
     proc = cli("run", "lib/pi.yaml", "--t-end", "10 ms", "-o", "out", cwd=toy.parent)
     assert proc.returncode == 2 and "runs only as a subsystem" in proc.stderr and "Traceback" not in proc.stderr
     assert not (toy.parent / "out").exists()
@@ -299,7 +300,7 @@ def test_a_file_that_includes_itself_is_refused_with_the_chain(tmp_path):
 def test_the_input_limits_hold_for_every_file(tmp_path, monkeypatch):
     import blocks.limits
     import blocks.scopes
-    import blocks.yamlsource
+    import blocks.yamlsource  # the limits are read where they are used
 
     chain = {f"d{i}.yaml": f"blocks:\n  next: {{diagram: d{i + 1}.yaml}}\n" for i in range(40)}
     chain["d40.yaml"] = "blocks:\n  g: {type: Constant}\n"
@@ -468,14 +469,10 @@ def test_a_sweep_sets_parameters_inside_a_subsystem_and_ships_its_files(tmp_path
                                                               "lib/gains/prop.yaml": "tree/lib/gains/prop.yaml"}
     expected = {k: simulate(load_diagram(TOY, overrides={"prop.k": k}), t_end="0.1 s")["plant.y"][1][-1, 0]
                 for k in (1.0, 2.0)}
-    import shutil
-
     shutil.rmtree(tmp_path / "proj")  # the points read the bundle, not the client's files
     monkeypatch.chdir(tmp_path)
     report, skipped, failed = execute(plan, tmp_path / "out", serial=True, progress=False)
     assert (report.ran, failed) == (2, 0)
-    import csv
-
     with open(tmp_path / "out" / "sweep.csv", newline="") as f:
         rows = {float(r["ctrl.prop.k"]): r for r in csv.DictReader(f)}
     assert {k: float(r["y"]) for k, r in rows.items()} == expected
