@@ -112,6 +112,9 @@ def test_a_linear_system_matches_its_closed_form_and_fmpy_with_cvode(me, fmi):
     assert np.abs(ours(r, "x") - theirs["x"]).max() < 1e-8
     tighter = run(path, "tolerance: 1e-10", source=STEP_INPUT)
     assert np.abs(ours(tighter, "x") - exact[:, 0]).max() < 5e-9
+    ramp = run(path, "tolerance: 1e-9", source="{type: Ramp, period: 0.1 s, params: {slope: 1.0}}")
+    held = ramp["src.y"][1][:, 0]                                # a new input at every hit: an event at each
+    assert np.abs(ours(ramp, "x") - oscillator(t, held)[:, 0]).max() < 2e-7
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
