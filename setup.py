@@ -71,8 +71,10 @@ setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/fmu.c"],
-            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/fmu.h"],
+            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/fmu.c",
+                     f"{BLOCKS_CSRC}/fmu_me.c"],
+            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/fmu.h",
+                     f"{BLOCKS_CSRC}/fmu_me.h"],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),
