@@ -173,7 +173,7 @@ class CompiledSide:
         for cb in self.blocks.values():
             first = len(rows)
             for lg in loggers[cb.name]:
-                port = lg.name.split(".", 1)[1]
+                port = lg.name.rsplit(".", 1)[1]
                 rows.append([address(lg.buf), cb.block.outputs[port], cb.offsets[port], lg.buf.shape[0],
                              lg.decimate])
                 self.logged.append(lg)

@@ -92,6 +92,9 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
             raise DiagramError([diagram.issue(None, f"t_end: {exc}")]) from None
         if t_end <= 0:
             raise DiagramError([diagram.issue(None, f"t_end must be positive, got {t_end}")])
+    refused = diagram.open_issue()
+    if refused is not None:
+        raise DiagramError([refused])
     schedule = build_schedule(diagram, t_end)
     log_bytes = sum(8 * diagram.width(e.signal) * -(-schedule.hit_count(e.block, schedule.n_ticks) // e.decimate)
                     for e in diagram.log)
@@ -405,7 +408,7 @@ class _Run:
         blk = self.d.blocks[name].block
         publish = tuple(blk.outputs) if ports is None else ports
         targets = self.hold_targets(name, publish) + [f for f in self.fanout[name] if f[2] in publish]
-        loggers = [(lg, lg.name.split(".", 1)[1]) for lg in self.loggers[name]] if log else []
+        loggers = [(lg, lg.name.rsplit(".", 1)[1]) for lg in self.loggers[name]] if log else []
         v = code.bind
         block = v(name)
         value: dict[str, str] = {}
@@ -478,7 +481,7 @@ class _Run:
         by_port: dict[str, list[tuple[dict, str]]] = {}
         for d, dp, sp in self.hold_targets(name, ports) + self.fanout[name]:
             by_port.setdefault(sp, []).append((d, dp))
-        loggers = [(lg.add_rows, lg.name.split(".", 1)[1]) for lg in self.loggers[name]]
+        loggers = [(lg.add_rows, lg.name.rsplit(".", 1)[1]) for lg in self.loggers[name]]
         lines = ["while n > 0:",
                  f"    m = n if n <= {v(ADVANCE_CHUNK)} else {v(ADVANCE_CHUNK)}",
                  f"    {state}, rows = {v(blk.advance)}((k + done * {period}) * {num} / {den}, {state}, "
@@ -738,6 +741,8 @@ class _Run:
             "parameters": self.d.parameters(),
             "versions": dict(package_versions()),
         }
+        if self.d.subsystems:
+            info["subsystems"] = self.d.composition()
         if labels:
             info["element_labels"] = labels
         if units:
