@@ -73,8 +73,8 @@ setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/{name}.c" for name in ("host", "core", "library", "fmu")],
-            depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "fmu")],
+            sources=[f"{BLOCKS_CSRC}/{name}.c" for name in ("host", "core", "library", "fmu", "fmu_me")],
+            depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "fmu", "fmu_me")],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),

@@ -156,6 +156,8 @@ def info(diagram: Diagram, schedule: Schedule, t_end: Fraction, status: str, wal
         "parameters": diagram.parameters(),
         "versions": dict(package_versions()),
     }
+    if diagram.subsystems:
+        record["subsystems"] = diagram.composition()
     if labels:
         record["element_labels"] = labels
     if units:

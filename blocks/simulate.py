@@ -69,6 +69,9 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     both give the same samples.
     """
     t_end = _end_time(diagram, t_end)
+    refused = diagram.open_issue()
+    if refused is not None:
+        raise DiagramError([refused])
     schedule = build_schedule(diagram, t_end)
     log_bytes = sum(8 * diagram.width(e.signal) * -(-schedule.hit_count(e.block, schedule.n_ticks) // e.decimate)
                     for e in diagram.log)

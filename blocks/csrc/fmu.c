@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "fmu.h"
+#include "fmu_me.h"
 
 /* The FMI functions the step calls (the FMI 2.0 and 3.0 signatures; statuses are ints,
    ok 0 and warning 1). */
@@ -150,11 +151,6 @@ static int fmu_update(const void *ctx, double t, double *state, const double *co
     return 0;
 }
 
-typedef struct {
-    const char *name;
-    int value;
-} named;
-
 static const named slots[] = {
     {"slow", FMU_SLOW}, {"check", FMU_CHECK}, {"hook", FMU_HOOK}, {"log_arm", FMU_LOG_ARM}, {"log_arg", FMU_LOG_ARG},
     {"values", FMU_VALUES}, {"inputs", FMU_INPUTS}, {"width", FMU_WIDTH}, {"started", FMU_STARTED},
@@ -168,7 +164,7 @@ static const named kinds[] = {{"output", FMU_SLOW_OUTPUT}, {"update", FMU_SLOW_U
                               {"set", FMU_SLOW_SET}, {"step", FMU_SLOW_STEP}, {"get", FMU_SLOW_GET}, {NULL, 0}};
 
 /* {name: value} of a table of names, or NULL with an exception. */
-static PyObject *names(const named *table)
+PyObject *blk_names(const named *table)
 {
     PyObject *found = PyDict_New();
     for (const named *e = table; found != NULL && e->name != NULL; e++) {
@@ -182,7 +178,7 @@ static PyObject *names(const named *table)
 
 PyObject *blk_fmu_kernel(void)
 {
-    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
-                         PyLong_FromVoidPtr((void *)fmu_update), "slots", names(slots), "values", names(values),
-                         "kinds", names(kinds));
+    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
+                         PyLong_FromVoidPtr((void *)fmu_update), "slots", blk_names(slots), "values", blk_names(values),
+                         "kinds", blk_names(kinds), "model_exchange", blk_fmu_me_functions());
 }

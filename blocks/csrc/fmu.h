@@ -53,7 +53,17 @@ enum {
 };
 
 /* {"output": address, "update": address, "slots": {name: index}, "values": {...},
-   "kinds": {...}}: the kernel's functions and its context's layout. */
+   "kinds": {...}, "model_exchange": {...} (fmu_me.h)}: the kernel's functions and its
+   context's layout, and the model-exchange integration's. */
 PyObject *blk_fmu_kernel(void);
+
+/* A name and its value, in the tables of names that describe a context's layout. */
+typedef struct {
+    const char *name;
+    int value;
+} named;
+
+/* {name: value} of a table of names ending with a NULL name, or NULL with an exception. */
+PyObject *blk_names(const named *table);
 
 #endif

@@ -1,14 +1,19 @@
-"""FMU import: an FMI 2.0 or 3.0 co-simulation FMU as a block, through fmpy's low-level API.
+"""FMU import: an FMI 2.0 or 3.0 co-simulation or model-exchange FMU as a block, through fmpy's low-level API.
 
 In a diagram::
 
     blocks:
       plant:
         type: FMU
-        period: 10 ms                          # the communication step size (required)
+        period: 10 ms                          # the interval between the hits (default: the FMU's step)
         params:
           path: fmus/first_order.fmu           # relative to the diagram's folder
           start_values: {a: 0.9, "z[2]": 1.0, gains: [1, 2, 3]}
+      ball:
+        type: FMU
+        period: 10 ms
+        params: {path: fmus/BouncingBall.fmu, interface: model_exchange,  # the default for an ME-only FMU
+                 solver: cvode, tolerance: 1e-6}                          # or solver: euler, substep: 1 ms
     connections:
       - ctrl.y -> plant.u
       - plant.y -> ctrl.u
@@ -31,11 +36,14 @@ vector) names with every character other than letters, digits and ``_`` replaced
 String, Binary and Clock variables are not ports (``port_hint`` says so when a diagram
 names one); give String inputs values with ``start_values``.
 
-Co-simulation semantics. The block has no feedthrough: ``output(t)`` returns the FMU
-outputs at communication point ``t`` (read after the previous ``doStep``), and
-``update(t)`` sets the inputs seen at ``t`` and calls ``doStep(t, period)``. Inputs are
-therefore held over each communication step and an output never depends on the input of
-the same instant, which makes the diagram free of algebraic loops through FMUs and the
+Interface. An FMU offering co-simulation runs as co-simulation, one offering only model
+exchange as model exchange; ``interface: model_exchange`` (or ``co_simulation``) chooses.
+
+Semantics, both interfaces. The block has no feedthrough: ``output(t)`` returns the FMU
+outputs at the hit ``t`` (read at the end of the previous step), and ``update(t)`` sets
+the inputs seen at ``t`` and steps the FMU to the next hit ``t + period``. Inputs are
+therefore held over each step (zero-order hold) and an output never depends on the input
+of the same instant, which makes the diagram free of algebraic loops through FMUs and the
 result independent of the evaluation order (the usual Jacobi co-simulation scheme). The
 first output, at the block's first hit ``t0`` (its offset), is the FMU's initial output
 after initialisation with start time ``t0``, with the inputs set before initialisation
@@ -43,11 +51,30 @@ ends, as in FMPy. At t = 0 the blocks feeding the inputs the FMU's initial outpu
 on (its InitialUnknowns) are computed first (``initial_feedthrough``), unless that closes a
 loop, in which case the input keeps its start value there.
 
+Co-simulation. A step is ``doStep(t, period)``. The FMU's step rules are its own: a
+``fixedInternalStepSize`` is informative (``validate`` shows it); an FMU that says it
+cannot vary its communication step (``canHandleVariableCommunicationStepSize`` false)
+takes only the step it declares (its DefaultExperiment stepSize, else its fixed internal
+step), so another period is refused at load time; a step the FMU refuses at run time (an
+error status) fails the run with its message.
+
+Model exchange (``exchange``, ``solvers``). The block integrates the model from hit to
+hit with ``solver: cvode`` (SUNDIALS' CVode as fmpy ships it: BDF, relative
+``tolerance``, root finding on the event indicators) or ``solver: euler`` (forward Euler
+with a fixed ``substep`` that divides the period; state events located by bisection to
+``tolerance`` times the sub-step). Defaults: the DefaultExperiment's tolerance (else
+1e-5) and stepSize (made to divide the period; else the period). As fmpy's ME simulation
+does, it handles time events (nextEventTime), state events (an event indicator changing
+sign) and step events (completedIntegratorStep), each with event mode and event
+iteration, and restarts the solver after each; inputs that changed at a hit are set in
+event mode too (an external event). Outputs are read at the hits, after any event there.
+
 Termination. An FMU that asks to end the simulation (FMI 2: ``fmi2Discard`` with
-``fmi2Terminated``; FMI 3: ``terminateSimulation``) ends the run with ``EndRun``: the run
-is complete and stops at the end of that communication step, where the FMU's outputs are
-those it reached (at ``lastSuccessfulTime``). A discard without that request, an early
-return or an error status is a failure.
+``fmi2Terminated``; FMI 3: ``terminateSimulation``; in model exchange, terminateSimulation
+from event iteration or completedIntegratorStep) ends the run with ``EndRun``: the run is
+complete and stops at the end of that step, where the FMU's outputs are those it reached
+(at ``lastSuccessfulTime``, or the time of the request). A discard without that request,
+an early return or an error status is a failure.
 
 Loading and running. Loading a diagram reads only the archive's member list and its
 modelDescription.xml (``description.read_description``): ``hierhand validate`` and ``graph``
@@ -62,12 +89,13 @@ instances are freed when the block goes away, at process exit, or by ``FMU.close
 instance that failed is freed, never reused. The state cannot be copied or checkpointed
 (FMU get/set state is not used).
 
-Errors. Problems with the file, its modelDescription and a period the FMU cannot step
-are raised at load time (ValueError, which the diagram loader reports as
-``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, and a
-failing ``doStep``, raise ``BlockError`` naming the FMU, the time and the status, with the
-FMU's recent log messages; the executor keeps the results up to that point. Ctrl-C inside
-an FMU call is a KeyboardInterrupt, never an FMU failure (see ``interrupt``).
+Errors. Problems with the file, its modelDescription, the parameters and a period the FMU
+cannot step are raised at load time (ValueError, which the diagram loader reports as
+``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, a
+failing ``doStep`` or model-exchange call, and a failing solver raise ``BlockError``
+naming the FMU, the function, the time and the status, with the FMU's recent log
+messages; the executor keeps the results up to that point. Ctrl-C inside an FMU call or
+the integration is a KeyboardInterrupt, never an FMU failure (see ``interrupt``).
 
 Modules, one concept each:
 
@@ -77,8 +105,12 @@ Modules, one concept each:
 - ``ports``: variables grouped into ports, element labels, initial dependencies;
 - ``start_values``: what start values may set, their conversion and checks;
 - ``pool``: the instances of one FMU, reused across runs;
-- ``instance``: one FMU instance with its preallocated per-step calls, FMI 2 and 3;
-- ``kernel``: the compiled steady step (blocks/csrc/fmu.c) of an FMU with Float64 ports only;
+- ``instance``: one FMU instance with its preallocated value transfers, FMI 2 and 3;
+- ``cosimulation``: a co-simulation instance's step (doStep and what its status says);
+- ``exchange``: a model-exchange instance's step (integration, events, event iteration);
+- ``solvers``: the integration settings, CVode and Euler over the C loops of blocks/csrc/fmu_me.c;
+- ``sundials``: the SUNDIALS (CVode) functions of fmpy's libraries, declared for ``solvers``;
+- ``kernel``: the compiled steady step (blocks/csrc/fmu.c) of a co-simulation FMU with Float64 ports only;
 - ``log_messages``: the FMUs' log messages and the FMI 2 logger proxy;
 - ``interrupt``: Ctrl-C inside FMU calls;
 - ``description``: reading a modelDescription without running code (``hierhand fmu info``);

@@ -1,14 +1,17 @@
-"""The FMU block, and its run state: an FMI 2.0 / 3.0 co-simulation FMU as a block.
+"""The FMU block, and its run state: an FMI 2.0 / 3.0 co-simulation or model-exchange FMU as a block.
 
 ``FMU`` is what a diagram's ``type: FMU`` makes (the semantics are in the package
 docstring). Making it reads and checks the FMU's modelDescription and the block's
-``start_values`` and runs none of the FMU's code, so loading, ``validate`` and ``graph``
-are safe. ``initial_state()`` gives each run an ``FMUState``: a handle to one instance of
-the block's pool, taken at the run's first ``output`` or ``update``. ``output`` returns the
-outputs at the current communication point; ``update`` sets the inputs, steps and reads
-the outputs of the next point. Failures become BlockErrors naming the FMU, the time and
-the status, with the FMU's recent log; a request to terminate becomes ``EndRun``; Ctrl-C
-inside an FMU call stays a KeyboardInterrupt (``interrupt``).
+parameters and runs none of the FMU's code, so loading, ``validate`` and ``graph`` are
+safe; binding it to its period checks the period against the FMU's step rules
+(co-simulation) or the solver's sub-step (model exchange). ``initial_state()`` gives each
+run an ``FMUState``: a handle to one instance of the block's pool, taken at the run's
+first ``output`` or ``update``. ``output`` returns the outputs at the current hit;
+``update`` steps the FMU to the next hit with the inputs held (a doStep, or the model
+integrated by the block's solver) and reads the outputs there. Failures become
+BlockErrors naming the FMU, the time and the status, with the FMU's recent log; a request
+to terminate becomes ``EndRun``; Ctrl-C inside an FMU call stays a KeyboardInterrupt
+(``interrupt``).
 """
 
 from __future__ import annotations
@@ -28,13 +31,14 @@ from . import interrupt
 from .instance import Instance
 from .kernel import fmu_kernel
 from .log_messages import status_name
-from .model import float_or_none
+from .model import INTERFACES, float_or_none
 from .pool import PooledModel
+from .solvers import DEFAULT_TOLERANCE, CallFailed, Integration, SolverError, integration, solver_choice
 from .start_values import assignments, input_starts, start_of
 
-STEP_TOLERANCE = Fraction(1, 10**6)
-"""How far (in internal steps) a period may miss a whole multiple of an FMU's fixed internal
-step; the exported hand plant accepts the same."""
+SAME_STEP = Fraction(1, 10**9)
+"""How far (relative) a period may be from the step of an FMU that cannot vary its
+communication step and still count as that step."""
 
 
 class FMUState:
@@ -78,7 +82,8 @@ class FMUState:
 
 
 class FMU(Block):
-    """An FMI 2.0 / 3.0 co-simulation FMU; its period is the communication step.
+    """An FMI 2.0 / 3.0 FMU: co-simulation (its period the communication step) or model
+    exchange (integrated between its hits by the block's solver).
 
     Parameters
     ----------
@@ -89,14 +94,25 @@ class FMU(Block):
         FMU variable names to start values (parameters, inputs, variables with an
         exact/approx start); a vector 'x' for x[1], x[2], ... or an FMI 3 array takes a list
     tolerance : float
-        relative tolerance passed to the FMU's solver; default: the FMU's
-        DefaultExperiment tolerance, if any
+        relative tolerance: passed to the FMU, and for model exchange the solver's (CVode's
+        relative tolerance; Euler locates state events to it times the sub-step); default:
+        the FMU's DefaultExperiment tolerance, for model exchange else 1e-5
+    interface : str
+        'co_simulation' or 'model_exchange'; default: co-simulation where the FMU offers
+        it, else model exchange
+    solver : str
+        model exchange only: 'cvode' (SUNDIALS' CVode as fmpy ships it, the default) or
+        'euler' (forward Euler with a fixed sub-step)
+    substep : duration
+        'solver: euler' only: the sub-step, which must divide the period; default: the
+        FMU's DefaultExperiment stepSize (made to divide the period), else the period
     """
     time_varying = True
     path_params = ("path",)
 
     def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
-                 tolerance: float | None = None):
+                 tolerance: float | None = None, interface: str | None = None, solver: str | None = None,
+                 substep: Any = None):
         if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
             raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
         file = Path(path).expanduser()
@@ -119,11 +135,22 @@ class FMU(Block):
             tolerance = float_or_none(tolerance)
             if tolerance is None:
                 raise ValueError("parameter 'tolerance' must be a positive number")
+        if interface is not None and interface not in INTERFACES:
+            raise ValueError(f"parameter 'interface' must be one of {', '.join(INTERFACES)}, got {interface!r}")
+        self._solver, self._substep = solver_choice(solver, substep)
         self.path = resolved
-        self._model = PooledModel(resolved, shown)
+        self._model = PooledModel(resolved, shown, interface)
         model = self._model
+        if not model.exchange and (solver is not None or substep is not None):
+            given = "solver" if solver is not None else "substep"
+            other = ("ask for 'interface: model_exchange' to integrate it with the block's solver"
+                     if model.md.modelExchange is not None else "it has no model-exchange interface")
+            raise ValueError(f"parameter '{given}' is for model-exchange FMUs; {shown} runs as co-simulation, "
+                             f"with its own solver ({other})")
         self._assignments = assignments(model, start_values)
         self.tolerance = tolerance if tolerance is not None else model.default_tolerance
+        if model.exchange and self.tolerance is None:
+            self.tolerance = DEFAULT_TOLERANCE
         self.inputs = {p.name: p.width for p in model.inputs.values()}
         self.outputs = {p.name: p.width for p in model.outputs.values()}
         self.input_defaults = input_starts(model, self._assignments)
@@ -131,6 +158,8 @@ class FMU(Block):
         self.feedthrough = False
         self.initial_feedthrough = model.initial_reads
         self._step = 0.0
+        self.integration: Integration | None = None
+        """How a model-exchange FMU is integrated between the hits, once the block has its period."""
 
     @property
     def fmi_version(self) -> str:
@@ -141,10 +170,23 @@ class FMU(Block):
         """The FMU's DefaultExperiment stepSize, if it declares one."""
         return self._model.default_step
 
+    @property
+    def interface(self) -> str:
+        """The interface the block runs: 'co-simulation' or 'model exchange'."""
+        return self._model.interface
+
     def describe(self) -> str:
-        given = len(self._assignments)
-        return (f"FMI {self.fmi_version} co-simulation {self._model.shown}"
-                + (f" ({given} start value{'s' if given != 1 else ''} set)" if given else ""))
+        model, given = self._model, len(self._assignments)
+        notes = [f"{given} start value{'s' if given != 1 else ''} set"] if given else []
+        if model.exchange:
+            if self.integration is not None:
+                notes.append(self.integration.describe())
+            states, indicators = model.states, model.indicators
+            notes.append(f"{states} continuous state{'s' if states != 1 else ''}, {indicators} event "
+                         f"indicator{'s' if indicators != 1 else ''}")
+        elif model.fixed_step is not None:
+            notes.append(f"fixed internal step {format_duration(model.fixed_step)}, informative")
+        return f"FMI {self.fmi_version} {model.interface} {model.shown}" + (f" ({'; '.join(notes)})" if notes else "")
 
     def parameter_values(self) -> dict[str, Any]:
         """Every parameter variable (causality ``parameter``) with the value a run starts
@@ -196,27 +238,40 @@ class FMU(Block):
         return spec.source
 
     def bind(self, period: Fraction | None) -> None:
-        """The period is the communication step; without one, the FMU's default step
-        (DefaultExperiment stepSize) is used, and the diagram schedules the block at it.
-        An FMU with a fixed internal step needs a whole multiple of it."""
+        """The period is the communication step (co-simulation) or the interval between the
+        hits at which the inputs are set and the outputs read (model exchange); without one,
+        the FMU's default step (DefaultExperiment stepSize) is used, and the diagram
+        schedules the block at it. A co-simulation FMU that cannot vary its communication
+        step takes only the step it declares; for model exchange the period must be a whole
+        number of Euler sub-steps."""
         given = period is not None
+        model = self._model
         if period is None:
-            period = self._model.default_step
+            period = model.default_step
             if period is None:
-                raise ValueError("an FMU block needs a period, its communication step size (the FMU "
+                raise ValueError("an FMU block needs a period, the interval between its hits (the FMU "
                                  "declares no default step size: add e.g. 'period: 1 ms')")
-        fixed = self._model.fixed_step
-        if fixed is not None:
-            count = period / fixed
-            if count < 1 or abs(count - round(count)) > STEP_TOLERANCE:
-                which = "period" if given else "default step (DefaultExperiment stepSize)"
-                near = max(1, round(count)) * fixed
-                raise ValueError(f"the {which} {format_duration(period)} is not a whole multiple of the "
-                                 f"fixed internal step {format_duration(fixed)} of {self._model.shown}, "
-                                 f"so the FMU would refuse every step; use a multiple of it, e.g. "
-                                 f"'period: {format_duration(near)}'")
+        if model.exchange:
+            self.integration = integration(self._solver, self._substep, model.default_step, self.tolerance, period)
+            model.integration = self.integration
+        else:
+            self._check_step(period, given)
         super().bind(period)
         self._step = float(period)
+
+    def _check_step(self, period: Fraction, given: bool) -> None:
+        """ValueError if the co-simulation FMU says it cannot vary its communication step
+        (canHandleVariableCommunicationStepSize false) and the period is not the step it
+        declares (its DefaultExperiment stepSize, else its fixed internal step)."""
+        model = self._model
+        declared = model.default_step or model.fixed_step
+        if model.can_vary_step or declared is None or abs(period - declared) <= SAME_STEP * declared:
+            return
+        which = "period" if given else "default step"
+        source = "DefaultExperiment stepSize" if model.default_step else "fixedInternalStepSize"
+        raise ValueError(f"the {which} {format_duration(period)} is not the step {format_duration(declared)} of "
+                         f"{model.shown} (its {source}), which cannot vary its communication step "
+                         f"(canHandleVariableCommunicationStepSize is false); use 'period: {format_duration(declared)}'")
 
     def is_stateful(self) -> bool:  # without instantiating the FMU, as initial_state() would
         return True
@@ -264,8 +319,7 @@ class FMU(Block):
 
     def _step_from(self, t: float, state: FMUState, inst: Instance, inputs: Mapping[str, Signal]) -> None:
         inst.arm()
-        inst.write(inputs, t)
-        self.stepped(t, state, inst, inst.do_step(t, self._step))
+        self.stepped(t, state, inst, inst.step(inputs, t, self._step))
 
     def stepped(self, t: float, state: FMUState, inst: Instance, outcome: tuple[bool, bool, float]) -> None:
         """The rest of a step from ``t`` once doStep returned ``outcome`` (terminate
@@ -316,11 +370,14 @@ class FMU(Block):
 
 
 def _reason(exc: BaseException, t: float | None = None, h: float | None = None) -> str:
+    """What failed, for a failure's message: the FMI function, when, and its status."""
     function = getattr(exc, "function", None)
     status = getattr(exc, "status", None)
     if function is None:
-        return f"{type(exc).__name__}: {exc}" if not isinstance(exc, BlockError) else str(exc)
+        return str(exc) if isinstance(exc, (BlockError, SolverError)) else f"{type(exc).__name__}: {exc}"
     label = status_name(status)
+    if isinstance(exc, CallFailed):
+        return f"{function} at t={exc.time:.9g} s returned status '{label}'"
     if function.endswith("DoStep") and t is not None:
         return f"{function} at t={t:.9g} s (step {h:.9g} s) returned status '{label}'"
     return f"{function} returned status '{label}'"

@@ -119,7 +119,14 @@ def describe_fmu(path: str | Path) -> str:
     lines.append(f"  platforms: {', '.join(description.platforms()) or 'none (no binaries)'}")
     step = description.fixed_step()
     if step is not None:
-        lines.append(f"  fixed internal step: {float(step):g} s (communication steps must be multiples)")
+        lines.append(f"  fixed internal step: {float(step):g} s (informative)")
+    cs = md.coSimulation
+    if cs is not None and not cs.canHandleVariableCommunicationStepSize:
+        lines.append("  communication step: fixed (canHandleVariableCommunicationStepSize is false)")
+    if md.modelExchange is not None:
+        completed = "needs" if md.modelExchange.needsCompletedIntegratorStep else "does not need"
+        lines.append(f"  model exchange: {md.numberOfContinuousStates} continuous states, "
+                     f"{md.numberOfEventIndicators} event indicators; {completed} completedIntegratorStep")
     de = md.defaultExperiment
     if de is not None:
         parts = [f"{k} {getattr(de, a)}" for k, a in (("start", "startTime"), ("stop", "stopTime"),

@@ -1,22 +1,24 @@
-"""One FMU instance: an fmpy slave made ready for the per-step calls of a run.
+"""One FMU instance: an fmpy instance made ready for the per-step calls of a run.
 
 An instance loads the FMU's binary from the extracted archive, instantiates it with our
 callbacks (the C library's calloc and free, with no Python in between that Ctrl-C could
 break, and the log callback of ``log_messages``) and preallocates its value transfers:
 for each group of ports of one FMI type, the value references, the C buffer and a numpy
 view of it, bound with the instance into one call (``Transfer``). The per-step calls,
-``write``, ``do_step`` and ``read``, then only move values: they call the FMU's C
-functions directly and check the status here, because fmpy's Python wrappers (and, for
-FMI 3's doStep, its fresh output arguments) cost more than the call; a failing call
-raises fmpy's own ``FMICallException``, as the wrappers would.
+``write`` and ``read`` around the interface's ``step``, then only move values: they call
+the FMU's C functions directly and check the status here, because fmpy's Python wrappers
+cost more than the call; a failing call raises fmpy's own ``FMICallException``, as the
+wrappers would.
 
 Values are checked on their way: an integer or Boolean input takes only values its type
 holds, and a 64-bit integer output that a float64 port cannot hold exactly (beyond 2^53)
 stops the run, each as a BlockError naming port, value and time.
 
 ``FMI2Instance`` and ``FMI3Instance`` hold what differs between the FMI versions: the
-slave class, instantiation with its callbacks, initialisation and doStep (with the FMI 2
-status queries after a discard). Instances are pooled and reused by ``pool.PooledModel``.
+fmpy class, instantiation with its callbacks and initialisation. What differs between the
+interfaces, a step from one hit to the next, is in ``cosimulation`` (doStep) and
+``exchange`` (the model integrated between the hits). Instances are pooled and reused by
+``pool.PooledModel``.
 """
 
 from __future__ import annotations
@@ -24,7 +26,6 @@ from __future__ import annotations
 import collections
 import functools
 import itertools
-import math
 import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -57,6 +58,15 @@ class Binary:
     library: Path
     in_groups: list[Group]
     out_groups: list[Group]
+    exchange: bool = False
+    """Whether the instance runs the FMU's model-exchange interface (else co-simulation)."""
+    integration: Any = None
+    """How a model-exchange FMU is integrated (``solvers.Integration``)."""
+    states: int = 0
+    indicators: int = 0
+    completed_step: bool = False
+    """Model exchange: the numbers of continuous states and event indicators, and whether
+    the FMU needs completedIntegratorStep."""
 
 
 @dataclass
@@ -78,11 +88,6 @@ class Transfer:
     vrs: Any
 
 
-def new_instance(model: Binary) -> Instance:
-    """An instance of the FMU ``model`` (BlockError if its binary does not load or instantiate)."""
-    return (FMI2Instance if model.major == 2 else FMI3Instance)(model)
-
-
 def call_failed(function: str, status: int) -> Exception:
     """The exception for an FMI call that returned ``status`` (worse than warning): fmpy's,
     as its own wrappers raise it."""
@@ -92,7 +97,7 @@ def call_failed(function: str, status: int) -> Exception:
 
 
 class Instance:
-    """One fmpy slave with its preallocated value transfers and its recent log messages."""
+    """One fmpy instance with its preallocated value transfers and its recent log messages."""
 
     value_counts = False
     """Whether the get and set functions also take the number of values (FMI 3)."""
@@ -132,40 +137,29 @@ class Instance:
         self.reads = self._transfers(model.out_groups, "Get")
         self.writes = self._transfers(model.in_groups, "Set")
 
-    # -- what differs between FMI 2 and FMI 3 ----------------------------------------------
+    # -- what differs between FMI 2 and FMI 3, and between the interfaces ------------------
+
+    fmpy_class = ""
+    """The name of the fmpy class of the instance (``FMU2Slave``, ``FMU3Model``, ...)."""
 
     def _load(self, fmpy: Any, kwargs: dict[str, str]) -> Any:
-        """The fmpy slave, its binary loaded."""
-        raise NotImplementedError
+        """The fmpy instance, its binary loaded."""
+        module = fmpy.fmi2 if self.model.major == 2 else fmpy.fmi3
+        return getattr(module, self.fmpy_class)(**kwargs)
 
     def _instantiate(self, who: str) -> None:
-        """Instantiate the slave, its log messages going to ``self.messages`` as ``who``'s."""
+        """Instantiate, the log messages going to ``self.messages`` as ``who``'s."""
         raise NotImplementedError
 
     def _initialise(self, t: float, tolerance: float | None) -> None:
         """Enter initialisation mode with start time ``t``."""
         raise NotImplementedError
 
-    def do_step(self, t: float, h: float) -> tuple[bool, bool, float]:
-        """One doStep; (terminate requested, returned early, last successful time).
-        Raises fmpy's FMICallException for an error status, or for a discard that is not a
-        request to terminate, as fmpy's own call does."""
-        return self.outcome(self.call_do_step(t, h), t, h)
-
-    def call_do_step(self, t: float, h: float) -> int:
-        """The doStep call itself; its status (FMI 3's flags land in ``step_flags``)."""
+    def step(self, inputs: Mapping[str, Signal], t: float, h: float) -> tuple[bool, bool, float]:
+        """From the hit at ``t`` to the next, ``t + h``, with ``inputs`` held over it:
+        (terminate requested, returned early, the time reached). Raises fmpy's
+        FMICallException (or another exception) for a call that failed."""
         raise NotImplementedError
-
-    def outcome(self, status: int, t: float, h: float) -> tuple[bool, bool, float]:
-        """What a doStep from ``t`` that returned ``status`` did, as ``do_step`` says it
-        (a compiled kernel makes the call and asks here when it was not a plain success)."""
-        raise NotImplementedError
-
-    def do_step_address(self) -> int:
-        """The C address of the FMU's doStep."""
-        import ctypes
-
-        return ctypes.cast(self._do_step, ctypes.c_void_p).value
 
     def arm(self) -> None:
         """Before a call into the FMU: the interrupt hook in place."""
@@ -215,6 +209,10 @@ class Instance:
         self.write(inputs, t)
         s.exitInitializationMode()
         self.started = True
+        self._initialised(t, inputs)
+
+    def _initialised(self, t: float, inputs: Mapping[str, Signal]) -> None:
+        """After initialisation mode, at start time ``t``: what the interface does next."""
 
     def read(self, t: float) -> dict[str, Signal]:
         """Fresh float64 outputs at time ``t``: one copy per group, each port a view of it."""
@@ -294,10 +292,7 @@ class Instance:
 
 
 class FMI2Instance(Instance):
-    """An FMI 2.0 co-simulation instance."""
-
-    def _load(self, fmpy: Any, kwargs: dict[str, str]) -> Any:
-        return fmpy.fmi2.FMU2Slave(**kwargs)
+    """An FMI 2.0 instance: instantiated with our callbacks, logging through fmpy's proxy."""
 
     def _instantiate(self, who: str) -> None:
         import ctypes
@@ -315,7 +310,6 @@ class FMI2Instance(Instance):
         addLoggerProxy(ctypes.byref(callbacks))
         fmi2_buffers[self.serial] = (self.messages, who)
         self.slave.instantiate(callbacks=callbacks)
-        self._do_step = self.slave._functions["fmi2DoStep"]
 
     def arm(self) -> None:
         """Before a call into the FMU: the interrupt hook and our logger in place."""
@@ -326,65 +320,19 @@ class FMI2Instance(Instance):
         self.slave.setupExperiment(tolerance=tolerance, startTime=t)
         self.slave.enterInitializationMode()
 
-    def call_do_step(self, t: float, h: float) -> int:
-        return self._do_step(self.component, t, h, 1)
-
-    def outcome(self, status: int, t: float, h: float) -> tuple[bool, bool, float]:
-        if status == 2 and self._terminated():
-            return True, False, self._last_time(t + h)
-        if status > 1:
-            raise call_failed("fmi2DoStep", status)
-        return False, False, t + h
-
-    def _terminated(self) -> bool:
-        """After a discard: whether the FMU asks to end the simulation (fmi2Terminated)."""
-        import ctypes
-
-        flag = ctypes.c_int(0)
-        fn = self.slave._functions.get("fmi2GetBooleanStatus")
-        return fn is not None and fn(self.component, 3, ctypes.byref(flag)) <= 1 and bool(flag.value)
-
-    def _last_time(self, default: float) -> float:
-        """After a discard: how far the step got (fmi2LastSuccessfulTime), else ``default``."""
-        import ctypes
-
-        value = ctypes.c_double(default)
-        fn = self.slave._functions.get("fmi2GetRealStatus")
-        if fn is None or fn(self.component, 2, ctypes.byref(value)) > 1 or not math.isfinite(value.value):
-            return default
-        return value.value
-
 
 class FMI3Instance(Instance):
-    """An FMI 3.0 co-simulation instance."""
+    """An FMI 3.0 instance: its log messages come formatted to a callback of its own."""
 
     value_counts = True
 
-    def _load(self, fmpy: Any, kwargs: dict[str, str]) -> Any:
-        return fmpy.fmi3.FMU3Slave(**kwargs)
-
     def _instantiate(self, who: str) -> None:
-        import ctypes
-
         messages = self.messages
 
         def log3(env, status, category, message):
             record(messages, status, category, message, who)
 
         self.slave.instantiate(logMessage=interrupt.callback(log3))
-        self._do_step = self.slave._functions["fmi3DoStep"]
-        flags = [ctypes.c_bool(), ctypes.c_bool(), ctypes.c_bool(), ctypes.c_double()]
-        self.step_flags = flags
-        self._step_refs = [ctypes.byref(f) for f in flags]
 
     def _initialise(self, t: float, tolerance: float | None) -> None:
         self.slave.enterInitializationMode(tolerance=tolerance, startTime=t)
-
-    def call_do_step(self, t: float, h: float) -> int:
-        return self._do_step(self.component, t, h, True, *self._step_refs)
-
-    def outcome(self, status: int, t: float, h: float) -> tuple[bool, bool, float]:
-        if status > 1:
-            raise call_failed("fmi3DoStep", status)
-        _, terminate, early, last = self.step_flags
-        return terminate.value, early.value, last.value

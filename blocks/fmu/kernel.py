@@ -1,8 +1,10 @@
 """The FMU block's compiled kernel (``blocks/csrc/fmu.c``): the steady step in C, the rest in Python.
 
-``fmu_kernel(block)`` offers a kernel when every port of the FMU is Float64 (FMI 2 Real,
-FMI 3 Float64); ports of other types keep their range checks and conversions in Python,
-so such an FMU runs through the block's Python methods. The kernel's state is a live
+``fmu_kernel(block)`` offers a kernel for a co-simulation FMU whose ports are all Float64
+(FMI 2 Real, FMI 3 Float64); ports of other types keep their range checks and conversions
+in Python, so such an FMU runs through the block's Python methods, as does a
+model-exchange FMU (whose integration between the hits runs in C of its own, fmu_me.c,
+see ``solvers``). The kernel's state is a live
 instance, so it has a ``bind``: each run gets a ``KernelRun``, whose int64 table is the C
 functions' context (its layout from ``blocks._native.fmu_kernel()``) and whose float64
 values hold the FMU's time, step and held outputs.
@@ -45,11 +47,12 @@ def native() -> dict[str, Any] | None:
 
 
 def fmu_kernel(block: Any) -> Kernel | None:
-    """The FMU block's kernel, to ``bind`` to each run's FMUState; None unless every
-    port is Float64."""
+    """The FMU block's kernel, to ``bind`` to each run's FMUState; None unless the FMU
+    runs as co-simulation and every port is Float64."""
     layout = native()
     model = block._model
-    if layout is None or any(p.kind.name != "Float64" for p in (*model.inputs.values(), *model.outputs.values())):
+    if layout is None or model.exchange or any(
+            p.kind.name != "Float64" for p in (*model.inputs.values(), *model.outputs.values())):
         return None
     return Kernel(context=0, output=layout["output"], update=layout["update"],
                   bind=functools.partial(KernelRun.bound, block, layout))

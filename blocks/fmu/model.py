@@ -2,11 +2,14 @@
 
 ``Model`` reads the archive's member list and modelDescription.xml (through
 ``description.read_description``; nothing is extracted, no code runs) and checks what the
-FMU block needs before a diagram is accepted: FMI 2.0 or 3.0, a co-simulation interface,
-no execution tool, a binary for this platform. It keeps what the block and its instances
-use: the ports and their FMI-type groups, the variables that start values may set, the
-default experiment and the fixed internal step. Problems are ValueErrors, which the
-diagram loader reports as ``file:line: block 'x' (FMU): ...``.
+FMU block needs before a diagram is accepted: FMI 2.0 or 3.0, the interface it runs
+(co-simulation where the FMU offers it, else model exchange, or the one the diagram asks
+for), no execution tool, a binary for this platform. It keeps what the block and its
+instances use: the ports and their FMI-type groups, the variables that start values may
+set, the default experiment, the co-simulation step rules (fixed internal step, whether
+the communication step may vary) and the model-exchange sizes (continuous states, event
+indicators). Problems are ValueErrors, which the diagram loader reports as
+``file:line: block 'x' (FMU): ...``.
 """
 
 from __future__ import annotations
@@ -19,6 +22,13 @@ from typing import Any
 from .description import read_description
 from .port_types import KINDS, NOT_PORTS
 from .ports import group_variables, groups, initial_reads, port_name, vectors
+
+
+CO_SIMULATION = "co_simulation"
+MODEL_EXCHANGE = "model_exchange"
+INTERFACES = {CO_SIMULATION: "co-simulation", MODEL_EXCHANGE: "model exchange"}
+"""The interfaces the block runs, by the name a diagram's ``interface`` parameter gives them,
+in words."""
 
 
 def import_fmpy():
@@ -36,7 +46,7 @@ def import_fmpy():
 class Model:
     """What the modelDescription of the FMU at ``path`` says (``shown`` names it in messages)."""
 
-    def __init__(self, path: Path, shown: str):
+    def __init__(self, path: Path, shown: str, interface: str | None = None):
         self.path = path
         self.shown = shown
         fmpy = import_fmpy()
@@ -48,17 +58,12 @@ class Model:
             raise ValueError(f"{shown} is an FMI {md.fmiVersion} FMU; the FMU block supports FMI 2.0 "
                              "and 3.0")
         self.major = major
-        if md.coSimulation is None:
-            others = [k for k, v in (("model exchange", md.modelExchange),
-                                     ("scheduled execution", md.scheduledExecution)) if v is not None]
-            raise ValueError(f"{shown} has no co-simulation interface (it provides only "
-                             f"{' and '.join(others) or 'no interface'}); the FMU block runs FMI 2.0 "
-                             "and 3.0 co-simulation FMUs (not model exchange, not scheduled execution "
-                             "or clocks), so export the model for co-simulation")
-        cs = md.coSimulation
-        self.identifier = cs.modelIdentifier
-        self.once_per_process = bool(cs.canBeInstantiatedOnlyOncePerProcess)
-        if cs.needsExecutionTool:
+        self.exchange = self._interface(interface) == MODEL_EXCHANGE
+        """Whether the block runs the FMU's model-exchange interface (else co-simulation)."""
+        element = md.modelExchange if self.exchange else md.coSimulation
+        self.identifier = element.modelIdentifier
+        self.once_per_process = bool(element.canBeInstantiatedOnlyOncePerProcess)
+        if element.needsExecutionTool:
             raise ValueError(f"{shown} needs its execution tool (a tool-coupling FMU), which cannot "
                              "run here")
         platform = fmpy.platform if major == 2 else fmpy.platform_tuple
@@ -73,6 +78,12 @@ class Model:
                              f"{library.rsplit('/', 1)[1]}); {detail}")
         self.library = library
         self.fixed_step = description.fixed_step()
+        """The fixed internal step a co-simulation FMU declares (informative, not enforced)."""
+        self.can_vary_step = bool(md.coSimulation.canHandleVariableCommunicationStepSize) \
+            if md.coSimulation is not None else True
+        self.states = md.numberOfContinuousStates if self.exchange else 0
+        self.indicators = md.numberOfEventIndicators if self.exchange else 0
+        self.completed_step = bool(md.modelExchange.needsCompletedIntegratorStep) if self.exchange else False
         self.guid = md.guid or ""
         de = md.defaultExperiment
         self.default_step = fraction_or_none(de.stepSize if de else None)
@@ -89,6 +100,29 @@ class Model:
         self.in_groups = groups(self.inputs)
         self.out_groups = groups(self.outputs)
         self.vectors = vectors(md.modelVariables, self.variables)
+
+    @property
+    def interface(self) -> str:
+        """The interface the block runs, in words: 'co-simulation' or 'model exchange'."""
+        return "model exchange" if self.exchange else "co-simulation"
+
+    def _interface(self, asked: str | None) -> str:
+        """The interface to run: ``asked`` (a value of ``INTERFACES``), else co-simulation
+        where the FMU offers it, else model exchange; ValueError if the FMU lacks it."""
+        md = self.md
+        offered = [name for name, element in ((CO_SIMULATION, md.coSimulation), (MODEL_EXCHANGE, md.modelExchange))
+                   if element is not None]
+        if asked is None and offered:
+            return offered[0]
+        if asked in offered:
+            return asked
+        if not offered:
+            other = "scheduled execution" if md.scheduledExecution is not None else "no interface"
+            raise ValueError(f"{self.shown} has neither a co-simulation nor a model-exchange interface (it "
+                             f"provides only {other}); the FMU block runs FMI 2.0 and 3.0 co-simulation and "
+                             "model-exchange FMUs, not scheduled execution")
+        raise ValueError(f"{self.shown} has no {INTERFACES[asked]} interface (it provides only "
+                         f"{INTERFACES[offered[0]]}); drop 'interface: {asked}' to run it as {INTERFACES[offered[0]]}")
 
     def _not_ports(self, variables: list) -> dict[str, str]:
         """Why each variable that is not a port is not one, by the port name it would have."""

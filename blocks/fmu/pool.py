@@ -22,7 +22,9 @@ from pathlib import Path
 from ..block import BlockError
 from .archive import ArchiveError, extract_archive
 from .description import MODEL_DESCRIPTION
-from .instance import Binary, Instance, new_instance
+from .cosimulation import CoSimulation2, CoSimulation3
+from .exchange import ModelExchange2, ModelExchange3
+from .instance import Binary, Instance
 from .model import Model
 
 
@@ -34,7 +36,7 @@ class PooledModel(Model):
     instance is acquired, that is when a run starts.
     """
 
-    def __init__(self, path: Path, shown: str):
+    def __init__(self, path: Path, shown: str, interface: str | None = None):
         self.lock = threading.Lock()
         self.extract_lock = threading.Lock()
         self.idle: list[Instance] = []
@@ -44,7 +46,10 @@ class PooledModel(Model):
         self.binary: Binary | None = None
         self._dirs: list[str] = []
         self._cleanup = weakref.finalize(self, _remove_model, self.idle, self._dirs)
-        super().__init__(path, shown)
+        self.integration = None
+        """How the block integrates a model-exchange FMU (``solvers.Integration``), set when
+        the block is bound to its period."""
+        super().__init__(path, shown, interface)
 
     def acquire(self) -> Instance:
         with self.lock:
@@ -81,7 +86,8 @@ class PooledModel(Model):
                     raise BlockError(f"{self.shown} has changed since the diagram was loaded; load it again")
                 self.dir = folder
                 self.binary = Binary(self.shown, self.major, self.identifier, self.guid, folder,
-                                     folder / self.library, self.in_groups, self.out_groups)
+                                     folder / self.library, self.in_groups, self.out_groups, self.exchange,
+                                     self.integration, self.states, self.indicators, self.completed_step)
         return self.binary
 
     def release(self, inst: Instance) -> None:
@@ -104,6 +110,14 @@ class PooledModel(Model):
             inst.free()
         if not live:
             self._cleanup()
+
+
+def new_instance(model: Binary) -> Instance:
+    """An instance of the FMU ``model`` for its interface and FMI version (BlockError if
+    its binary does not load or instantiate)."""
+    kinds = {(False, 2): CoSimulation2, (False, 3): CoSimulation3, (True, 2): ModelExchange2,
+             (True, 3): ModelExchange3}
+    return kinds[model.exchange, model.major](model)
 
 
 def _remove_model(idle: list, directories: list[str]) -> None:

@@ -85,8 +85,7 @@ log: [plant.y]
 """
 
 
-FIXED_STEP = XML.replace("<ModelVariables>", '<VendorAnnotations><Tool name="a tool"><CoSimulation '
-                         'fixedInternalStepSize="0.04"/></Tool></VendorAnnotations>\n  <ModelVariables>')
+FIXED_STEP = XML.replace('canHandleVariableCommunicationStepSize="true"', 'canHandleVariableCommunicationStepSize="false"')
 BOMB = {"resources__zeros.bin": b"\0" * (8 << 20)}  # 8 MiB that deflate about 1000 times
 
 CASES = [
@@ -94,10 +93,10 @@ CASES = [
          r"sub/d\.yaml:5: block 'plant' \(FMU\): FMU file not found: looked at /\S+/sub/fmus/plant\.fmu "
          r"\(in a diagram, a relative path is resolved against the diagram's folder",
          files={"sub/d.yaml": diagram("fmus/plant.fmu"), "fmus/plant.fmu": fmu()}),
-    Case("fmu-period-off-the-fixed-step-fails-validate", ("validate", "d.yaml"), 2,
-         r"d\.yaml:5: block 'plant' \(FMU\): the period 100 ms is not a whole multiple of the fixed "
-         r"internal step 40 ms",
-         files={"d.yaml": diagram(), "plant.fmu": fmu(xml=FIXED_STEP)}),
+    Case("fmu-period-off-the-step-of-a-fixed-step-fmu-fails-validate", ("validate", "d.yaml"), 2,
+         r"d\.yaml:5: block 'plant' \(FMU\): the period 50 ms is not the step 100 ms of FMU 'plant\.fmu' "
+         r"\(its DefaultExperiment stepSize\), which cannot vary its communication step",
+         files={"d.yaml": diagram(period="50 ms"), "plant.fmu": fmu(xml=FIXED_STEP)}),
     Case("fmu-zip-bomb-refused-by-validate", ("validate", "d.yaml"), 2,
          r"d\.yaml:5: block 'plant' \(FMU\): unsafe FMU archive, not extracted: .*'resources/zeros\.bin' "
          r"inflates from \d+ to 8388608 bytes or more, more than 200 times",

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import io
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -47,7 +48,7 @@ def compile_library(target: Path, *sources: str, defines: dict[str, str] | None 
     ``defines`` become ``-D`` options. Returns the library's bytes."""
     flags = [f"-D{k}={v}" for k, v in (defines or {}).items()]
     cmd = [compiler(), "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *flags,
-           *(str(SOURCES / s) for s in sources), "-o", str(target)]
+           *(str(SOURCES / s) for s in sources), "-o", str(target), "-lm"]
     done = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise RuntimeError(f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}")
@@ -94,14 +95,42 @@ def interrupting_library(build: Path, status: int, at: float = 0.2) -> bytes:
                            defines={"SIGINT_AT": repr(at), "SIGINT_STATUS": str(status)})
 
 
-def typed_fmu(build: Path, fmi: int, members: dict[str, bytes | str] | None = None) -> Path:
+def typed_library(build: Path, fmi: int) -> bytes:
+    """The library of the conformance FMU ``typed_fmi2.c`` / ``typed_fmi3.c``, built in ``build``."""
+    return compile_library(build / f"Typed{fmi}{EXT}", f"typed_fmi{fmi}.c", f"fmi{fmi}_unsupported.c",
+                           defines={"STEP_STATUS": "1"} if fmi == 2 else {"TYPED_ACCESSORS": "1", "MODEL_EXCHANGE": "1"})
+
+
+def typed_fmu(build: Path, fmi: int, members: dict[str, bytes | str] | None = None,
+              only: str | None = None) -> Path:
     """The conformance FMU of ``typed_fmi2.c`` / ``typed_fmi3.c`` (a port of every type of
-    that FMI version, terminating at its parameter ``stop_at``), with extra ``members``."""
+    that FMI version, terminating at its parameter ``stop_at``), with extra ``members``.
+    It offers co-simulation and model exchange, or only the interface ``only`` names
+    (``CoSimulation`` or ``ModelExchange``)."""
     identifier = f"Typed{fmi}"
-    sources = (f"typed_fmi{fmi}.c", f"fmi{fmi}_unsupported.c")
-    library = compile_library(build / f"{identifier}{EXT}", *sources,
-                              defines={"STEP_STATUS": "1"} if fmi == 2 else {"TYPED_ACCESSORS": "1"})
+    library = typed_library(build, fmi)
     platform = fmpy.platform if fmi == 2 else fmpy.platform_tuple
-    files = {"modelDescription.xml": (SOURCES / f"typed_fmi{fmi}.xml").read_text(),
-             f"binaries/{platform}/{identifier}{EXT}": library, **(members or {})}
-    return zip_files(build / f"typed{fmi}.fmu", files)
+    xml = (SOURCES / f"typed_fmi{fmi}.xml").read_text()
+    if only is not None:
+        other = {"CoSimulation": "ModelExchange", "ModelExchange": "CoSimulation"}[only]
+        xml = re.sub(rf"\s*<{other} [^>]*/>", "", xml)
+    files = {"modelDescription.xml": xml, f"binaries/{platform}/{identifier}{EXT}": library, **(members or {})}
+    return zip_files(build / f"typed{fmi}{only or ''}.fmu", files)
+
+
+ME_MODELS = ("linear", "bouncing", "stair")
+"""The model-exchange test models of ``sources/`` (``me_model.h``), each an FMI 2 and an FMI 3 FMU."""
+
+
+def me_fmu(build: Path, model: str, fmi: int, defines: dict[str, str] | None = None, name: str | None = None) -> Path:
+    """The model-exchange FMU of the test model ``model`` (``linear``, ``bouncing`` or ``stair``)
+    for FMI version ``fmi``: the model's source with the FMI wrapper ``me_fmi2.c`` / ``me_fmi3.c``
+    (``defines`` become ``-D`` options), and its ``<model>_fmi<fmi>.xml``."""
+    identifier = f"{model.capitalize()}{fmi}"
+    wrapper = {"MODEL_EXCHANGE": "1", "NO_CO_SIMULATION": "1"} if fmi == 3 else {}
+    library = compile_library(build / f"{name or identifier}{EXT}", f"{model}.c", f"me_fmi{fmi}.c",
+                              f"fmi{fmi}_unsupported.c", defines={**wrapper, **(defines or {})})
+    platform = fmpy.platform if fmi == 2 else fmpy.platform_tuple
+    files = {"modelDescription.xml": (SOURCES / f"{model}_fmi{fmi}.xml").read_text(),
+             f"binaries/{platform}/{identifier}{EXT}": library}
+    return zip_files(build / f"{name or identifier}.fmu", files)

@@ -23,7 +23,7 @@ from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, s
 
 fmpy = pytest.importorskip("fmpy")
 
-from .build import fmi2_files, zip_files  # noqa: E402
+from .build import compile_library, fmi2_files, zip_files  # noqa: E402
 
 
 def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
@@ -330,22 +330,48 @@ log: [f.y]
 
 
 @pytest.mark.parametrize("version", [2, 3])
-def test_a_period_off_the_fixed_internal_step_is_a_load_error(fmus, version):
-    """Such an FMU refuses every step; that must show at load time, not once a run has started."""
+def test_a_fixed_internal_step_is_shown_and_not_enforced(fmus, version):
+    """fixedInternalStepSize is informative (FMI 3): a period that is no multiple of it
+    loads and runs, and validate says what the FMU declares."""
     path = fmus.with_fixed_step(version, "0.04", f"fixed{version}.fmu")
-    msg = load_error(lambda: diagram(path, period="0.1 s"))
-    assert msg.startswith("fmu.yaml:5: block 'f' (FMU): the period 100 ms is not a whole multiple of the "
-                          "fixed internal step 40 ms"), msg
-    assert "use a multiple of it, e.g. 'period: 80 ms'" in msg
-    assert diagram(path, period="0.2 s").blocks["f"].period == Fraction(1, 5)
-    # the default step (DefaultExperiment stepSize 0.1) must be a multiple too
-    text = f"""
-time: {{t_end: 0.5 s}}
-blocks:
-  f: {{type: FMU, params: {{path: '{path}'}}}}
-"""
-    assert "the default step (DefaultExperiment stepSize) 100 ms is not a whole multiple" in load_error(
-        lambda: loads_diagram(text))
+    d = diagram(path, period="0.1 s")
+    assert d.blocks["f"].block.describe() == (f"FMI {version}.0 co-simulation FMU '{path}' "
+                                              "(fixed internal step 40 ms, informative)")
+    results = simulate(d)
+    assert results.complete and len(results["f.y"][0]) == 11
+
+
+@pytest.mark.parametrize("version", [2, 3])
+def test_an_fmu_that_cannot_vary_its_step_takes_only_the_step_it_declares(fmus, version):
+    """canHandleVariableCommunicationStepSize="false": the period must be its
+    DefaultExperiment stepSize (0.1 s), else its fixed internal step."""
+    xml = (fmus.xml2 if version == 2 else fmus.xml3).replace('canHandleVariableCommunicationStepSize="true"',
+                                                               'canHandleVariableCommunicationStepSize="false"')
+    path = fmus.make(f"fixed_step{version}.fmu", xml, version=version)
+    msg = load_error(lambda: diagram(path, period="50 ms"))
+    assert msg.startswith("fmu.yaml:5: block 'f' (FMU): the period 50 ms is not the step 100 ms of FMU '"), msg
+    assert ("(its DefaultExperiment stepSize), which cannot vary its communication step "
+            "(canHandleVariableCommunicationStepSize is false); use 'period: 100 ms'") in msg, msg
+    assert diagram(path, period="0.1 s").blocks["f"].period == Fraction(1, 10)
+    text = f"time: {{t_end: 0.5 s}}\nblocks:\n  f: {{type: FMU, params: {{path: '{path}'}}}}\n"
+    assert loads_diagram(text).blocks["f"].period == Fraction(1, 10)   # the default step is the declared one
+    if version == 3:
+        internal = xml.replace('<DefaultExperiment startTime="0" stopTime="1" stepSize="0.1"/>', "").replace(
+            "<CoSimulation ", '<CoSimulation fixedInternalStepSize="0.02" ')
+        path = fmus.make("fixed_internal3.fmu", internal, version=3)
+        assert "is not the step 20 ms of" in load_error(lambda: diagram(path, period="0.1 s"))
+        assert diagram(path, period="20 ms").blocks["f"].period == Fraction(1, 50)
+
+
+def test_a_step_the_fmu_refuses_at_run_time_fails_the_run_with_its_message(fmus, tmp_path):
+    library = compile_library(tmp_path / f"internal{fmpy.sharedLibraryExtension}", "first_order_fmi2.c",
+                              "fmi2_unsupported.c", defines={"INTERNAL_STEP": "0.04"})
+    path = zip_files(tmp_path / "internal.fmu", fmi2_files(library))
+    results = simulate(diagram(path, period="0.1 s"))
+    assert results.status.startswith("failed at t=0 s: block 'f' (FMU) update: FMU '"), results.status
+    assert ("fmi2DoStep at t=0 s (step 0.1 s) returned status 'error'; FMU log: [error] logStatusError: the step "
+            "0.1 s is not a whole multiple of the internal step 0.04 s") in results.status, results.status
+    assert simulate(diagram(path, period="0.12 s", t_end="0.36 s")).complete
 
 
 def test_a_relative_path_is_resolved_against_the_diagrams_folder(fmus, tmp_path, monkeypatch):
@@ -388,13 +414,15 @@ def test_broken_model_description(fmus):
     assert "has a broken modelDescription.xml" in load_error(lambda: diagram(invalid))
 
 
-def test_model_exchange_only(fmus):
+def test_a_model_exchange_only_fmu_is_taken_as_model_exchange(fmus):
+    """An FMU with only a ModelExchange element is no longer refused for its interface: the
+    check that follows (its binary, here missing) speaks."""
     xml = fmus.xml2.replace('<CoSimulation modelIdentifier="FirstOrder" '
                             'canHandleVariableCommunicationStepSize="true"/>',
-                            '<ModelExchange modelIdentifier="FirstOrder"/>')
+                            '<ModelExchange modelIdentifier="FirstOrderME"/>')
     me = fmus.make("me_only.fmu", xml, binary=False)
     msg = load_error(lambda: diagram(me))
-    assert "has no co-simulation interface (it provides only model exchange)" in msg
+    assert "co-simulation" not in msg and "has no binary for this platform" in msg and "FirstOrderME" in msg, msg
 
 
 def test_no_binary_for_this_platform(fmus):

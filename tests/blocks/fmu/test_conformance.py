@@ -3,16 +3,20 @@
 ``typed_fmi2.c`` / ``typed_fmi3.c`` have an input and an output of every type of their
 FMI version (each output copies its input, at initialisation and in every step), an FMI 3
 alias and matrix output, String / Binary / Clock variables, and ask to terminate when a
-step reaches their parameter ``stop_at``. Checked: every numeric type is a port with an
-exact round trip; values a type cannot hold stop the run; conversions are listed; inputs
-are set before initialisation ends, as FMPy does; termination ends the run as complete;
-archives with identical duplicate members load; CSV columns keep the FMU's indices.
+step reaches their parameter ``stop_at``. Every test runs twice, on the FMUs as
+co-simulation FMUs and as model-exchange FMUs (their other interface removed from the
+modelDescription, so the block picks the one left). Checked: every numeric type is a port
+with an exact round trip; values a type cannot hold stop the run; conversions are listed;
+inputs are set before initialisation ends, as FMPy does; termination ends the run as
+complete; archives with identical duplicate members load; CSV columns keep the FMU's
+indices.
 """
 
 from __future__ import annotations
 
 import csv
 import json
+import re
 import zipfile
 from pathlib import Path
 
@@ -30,13 +34,20 @@ INT_TYPES = {"i8": (-2**7, 2**7 - 1), "u8": (0, 2**8 - 1), "i16": (-2**15, 2**15
              "u16": (0, 2**16 - 1), "i32": (-2**31, 2**31 - 1), "u32": (0, 2**32 - 1)}
 
 
-@pytest.fixture(scope="module")
-def typed(tmp_path_factory) -> dict[int, Path]:
+class TypedFMUs(dict):
+    """The typed FMUs by FMI version, offering only the interface ``fmi_type`` (fmpy's name)."""
+
+    def __init__(self, build: Path, fmi_type: str):
+        super().__init__({fmi: typed_fmu(build, fmi, only=fmi_type) for fmi in (2, 3)})
+        self.fmi_type = fmi_type
+
+
+@pytest.fixture(scope="module", params=["CoSimulation", "ModelExchange"])
+def typed(tmp_path_factory, request) -> TypedFMUs:
     why = build_error()
     if why:
         pytest.skip(why)
-    build = tmp_path_factory.mktemp("typed_fmus")
-    return {2: typed_fmu(build, 2), 3: typed_fmu(build, 3)}
+    return TypedFMUs(tmp_path_factory.mktemp("typed_fmus"), request.param)
 
 
 def fmu_diagram(path: Path, sources: dict[str, float], connections: list[str], t_end: str = "0.3 s",
@@ -204,7 +215,7 @@ def test_initial_outputs_follow_the_connected_inputs_as_in_fmpy(typed, fmi, port
     ours = r[f"fmu.{port}_out"][1][:, 0]
     signal = np.array([(0.0, 3.5), (1.0, 3.5)], dtype=[("time", float), (f"{port}_in", float)])
     theirs = fmpy.simulate_fmu(str(typed[fmi]), stop_time=0.3, output_interval=0.1, input=signal,
-                               output=[f"{port}_out"], fmi_type="CoSimulation")
+                               output=[f"{port}_out"], fmi_type=typed.fmi_type)
     np.testing.assert_array_equal(ours, theirs[f"{port}_out"])
     assert ours[0] == 3.5
 
@@ -302,18 +313,18 @@ def test_csv_columns_of_fmu_vectors_keep_the_fmus_indices(typed, tmp_path):
     assert (again / "signals.csv").read_text() == (tmp_path / "signals.csv").read_text()
 
 
-def test_only_co_simulation_is_supported_and_the_message_says_what_is(typed, tmp_path):
+def test_scheduled_execution_alone_is_refused_and_the_message_says_what_is(typed, tmp_path):
     with zipfile.ZipFile(typed[3]) as zf:
         xml = zf.read("modelDescription.xml").decode()
-    xml = xml.replace('<CoSimulation modelIdentifier="Typed3" canHandleVariableCommunicationStepSize="true"/>',
-                      '<ScheduledExecution modelIdentifier="Typed3"/>')
+    xml = re.sub(r"<(CoSimulation|ModelExchange) [^>]*/>", '<ScheduledExecution modelIdentifier="Typed3"/>', xml)
     path = tmp_path / "clocked.fmu"
     with zipfile.ZipFile(path, "w") as zf:
         zf.writestr("modelDescription.xml", xml)
     with pytest.raises(DiagramError) as info:
         fmu_diagram(path, {}, [])
-    assert "it provides only scheduled execution); the FMU block runs FMI 2.0 and 3.0 co-simulation FMUs " \
-           "(not model exchange, not scheduled execution or clocks)" in str(info.value)
+    assert "has neither a co-simulation nor a model-exchange interface (it provides only scheduled " \
+           "execution); the FMU block runs FMI 2.0 and 3.0 co-simulation and model-exchange FMUs, not " \
+           "scheduled execution" in str(info.value)
 
 
 def test_fmu_info_lists_every_variable_type(typed):

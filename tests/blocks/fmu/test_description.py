@@ -7,9 +7,12 @@ import pytest
 from blocks.fmu.description import FMUInfoError, describe_fmu
 
 
-def test_fmu_info_shows_the_fixed_internal_step(fmus):
-    assert "fixed internal step: 0.04 s" in describe_fmu(fmus.with_fixed_step(3, "0.04", "fixed_info.fmu"))
+def test_fmu_info_shows_the_step_rules(fmus):
+    assert "fixed internal step: 0.04 s (informative)" in describe_fmu(fmus.with_fixed_step(3, "0.04", "fixed_info.fmu"))
     assert "fixed internal step" not in describe_fmu(fmus.fmi3)
+    assert "communication step: fixed" not in describe_fmu(fmus.fmi3)
+    fixed = fmus.make("fixed_comm.fmu", fmus.xml2.replace('canHandleVariableCommunicationStepSize="true"', ""))
+    assert "communication step: fixed (canHandleVariableCommunicationStepSize is false)" in describe_fmu(fixed)
 
 
 def test_fmu_info_lists_interfaces_experiment_and_variables(fmus, tmp_path):

@@ -22,7 +22,7 @@ from blocks.fmu import kernel as fmu_kernel
 
 fmpy = pytest.importorskip("fmpy")
 
-from .build import SOURCES, build_error, compile_library, fmi2_files, zip_files  # noqa: E402
+from .build import SOURCES, build_error, compile_library, fmi2_files, typed_library, zip_files  # noqa: E402
 
 pytestmark = pytest.mark.skipif(fmu_kernel.native() is None, reason="blocks._native is not built")
 
@@ -206,9 +206,7 @@ def terminating(tmp_path_factory) -> dict[int, Path]:
     out = {}
     for fmi in (2, 3):
         identifier = f"Typed{fmi}"
-        library = compile_library(build / f"{identifier}{fmpy.sharedLibraryExtension}", f"typed_fmi{fmi}.c",
-                                  f"fmi{fmi}_unsupported.c",
-                                  defines={"STEP_STATUS": "1"} if fmi == 2 else {"TYPED_ACCESSORS": "1"})
+        library = typed_library(build, fmi)
         platform = fmpy.platform if fmi == 2 else fmpy.platform_tuple
         files = {"modelDescription.xml": float_only((SOURCES / f"typed_fmi{fmi}.xml").read_text(), fmi),
                  f"binaries/{platform}/{identifier}{fmpy.sharedLibraryExtension}": library}

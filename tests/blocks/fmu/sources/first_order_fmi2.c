@@ -8,8 +8,10 @@
  * Value references: a 0, b 1, x0 2, threshold 3, scale 4 (Integer), frozen 5 (Boolean),
  * u 6, y 7, z[1] 8, z[2] 9.
  * Built with FAIL_SET_AT (FAIL_GET_AT), setting u (getting y) fails with fmi2Error, logged,
- * once the FMU's time has reached that value.
+ * once the FMU's time has reached that value. Built with INTERNAL_STEP, doStep refuses
+ * (fmi2Error, logged) a communication step that is not a whole multiple of it.
  */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -161,6 +163,14 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSet
         raise(SIGINT);
         m->cb.logger(m->cb.componentEnvironment, m->name, fmi2OK, "logEvents", "interrupted at t = %g", t);
         if (SIGINT_STATUS != fmi2OK) return SIGINT_STATUS;
+    }
+#endif
+#ifdef INTERNAL_STEP
+    double steps = h / INTERNAL_STEP;
+    if (steps < 0.5 || fabs(steps - floor(steps + 0.5)) > 1e-9 * steps) {
+        m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError",
+                     "the step %g s is not a whole multiple of the internal step %g s", h, INTERNAL_STEP);
+        return fmi2Error;
     }
 #endif
     if (u > threshold) {

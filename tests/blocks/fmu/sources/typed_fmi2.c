@@ -1,10 +1,13 @@
-/* An FMI 2.0 co-simulation FMU with a port of every FMI 2 type, for the conformance tests
- * (built with fmi2_unsupported.c and -DSTEP_STATUS).
+/* An FMI 2.0 FMU with a port of every FMI 2 type, for the conformance tests, for
+ * co-simulation and model exchange (built with fmi2_unsupported.c and -DSTEP_STATUS).
  *
  * Each output copies its input of the same type: at initialisation (so initial outputs
  * follow inputs set before exitInitializationMode) and in every doStep (the inputs of the
- * step's start). The step that reaches the parameter stop_at ends at stop_at and asks to
- * terminate: fmi2Discard, with fmi2Terminated true and fmi2LastSuccessfulTime stop_at.
+ * step's start), or in model exchange at every event (the importer's, when it sets new
+ * inputs). The step that reaches the parameter stop_at ends at stop_at and asks to
+ * terminate: fmi2Discard, with fmi2Terminated true and fmi2LastSuccessfulTime stop_at; in
+ * model exchange stop_at is a time event, at which the FMU asks to terminate. No
+ * continuous states, no event indicators.
  *
  * Value references: Real r_in 0, r_out 1, stop_at 2, time_out 3; Integer i_in 10, i_out 11;
  * Boolean b_in 20, b_out 21; Enumeration e_in 30, e_out 31; String s_in 40.
@@ -50,7 +53,8 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const 
 fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
                               const fmi2CallbackFunctions *cb, fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)resources; (void)visible; (void)loggingOn;
-    if (type != fmi2CoSimulation || strcmp(guid, GUID) != 0) return NULL;
+    (void)type;
+    if (strcmp(guid, GUID) != 0) return NULL;
     Model *m = calloc(1, sizeof(Model));
     m->cb = *cb;
     m->name = strdup(name);
@@ -165,3 +169,31 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *
     *v = ((Model *)c)->last;
     return fmi2OK;
 }
+
+fmi2Status fmi2EnterEventMode(fmi2Component c) { (void)c; return fmi2OK; }
+fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+    Model *m = c;
+    follow_inputs(m);
+    info->newDiscreteStatesNeeded = info->nominalsOfContinuousStatesChanged = fmi2False;
+    info->valuesOfContinuousStatesChanged = fmi2False;
+    info->terminateSimulation = m->time >= m->stop_at;
+    info->nextEventTimeDefined = m->stop_at < 1e300 && m->time < m->stop_at;
+    info->nextEventTime = m->stop_at;
+    return fmi2OK;
+}
+fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { (void)c; return fmi2OK; }
+fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetPrior, fmi2Boolean *enterEventMode,
+                                       fmi2Boolean *terminateSimulation) {
+    (void)c; (void)noSetPrior;
+    *enterEventMode = *terminateSimulation = fmi2False;
+    return fmi2OK;
+}
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) { ((Model *)c)->time = time; return fmi2OK; }
+/* No continuous states and no event indicators: the state functions take empty arrays. */
+#define EMPTY(NAME, CONST) \
+fmi2Status NAME(fmi2Component c, CONST fmi2Real v[], size_t n) { (void)c; (void)v; return n ? fmi2Error : fmi2OK; }
+EMPTY(fmi2SetContinuousStates, const)
+EMPTY(fmi2GetContinuousStates, )
+EMPTY(fmi2GetDerivatives, )
+EMPTY(fmi2GetEventIndicators, )
+EMPTY(fmi2GetNominalsOfContinuousStates, )

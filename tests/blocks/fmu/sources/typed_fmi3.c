@@ -1,10 +1,14 @@
-/* An FMI 3.0 co-simulation FMU with a port of every numeric FMI 3 type, for the
- * conformance tests (built with fmi3_unsupported.c and -DTYPED_ACCESSORS).
+/* An FMI 3.0 FMU with a port of every numeric FMI 3 type, for the conformance tests, for
+ * co-simulation and model exchange (built with fmi3_unsupported.c, -DTYPED_ACCESSORS and
+ * -DMODEL_EXCHANGE).
  *
  * Each output copies its input of the same type: at initialisation (so initial outputs
  * follow inputs set in initialization mode) and in every doStep (the inputs of the step's
- * start). f_out has the alias f_alias; m_out (2x2) is f_in * [[1, 2], [3, 4]]. The step
- * that reaches the parameter stop_at sets terminateSimulation, lastSuccessfulTime stop_at.
+ * start), or in model exchange at every event (the importer's, when it sets new inputs).
+ * f_out has the alias f_alias; m_out (2x2) is f_in * [[1, 2], [3, 4]]. The step that
+ * reaches the parameter stop_at sets terminateSimulation, lastSuccessfulTime stop_at; in
+ * model exchange stop_at is a time event, at which the FMU asks to terminate. No
+ * continuous states, no event indicators.
  *
  * Value references: Float64 f_in 0, f_out 1, stop_at 2, m_out 3 (4 values), time_out 4;
  * UInt64 u64_offset 5;
@@ -169,6 +173,16 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance i, fmi3Boolean on, size_t n, const f
     (void)i; (void)on; (void)n; (void)c; return fmi3OK;
 }
 
+/* A new instance, for either interface (NULL for the wrong token). */
+static Model *new_model(fmi3String token, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    if (strcmp(token, TOKEN) != 0) return NULL;
+    Model *m = calloc(1, sizeof(Model));
+    m->env = env;
+    m->log = log;
+    set_defaults(m);
+    return m;
+}
+
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3String resources,
         fmi3Boolean visible, fmi3Boolean loggingOn, fmi3Boolean eventModeUsed,
         fmi3Boolean earlyReturnAllowed, const fmi3ValueReference required[], size_t nRequired,
@@ -176,12 +190,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
         fmi3IntermediateUpdateCallback intermediateUpdate) {
     (void)name; (void)resources; (void)visible; (void)loggingOn; (void)eventModeUsed;
     (void)earlyReturnAllowed; (void)required; (void)nRequired; (void)intermediateUpdate;
-    if (strcmp(token, TOKEN) != 0) return NULL;
-    Model *m = calloc(1, sizeof(Model));
-    m->env = env;
-    m->log = log;
-    set_defaults(m);
-    return m;
+    return new_model(token, env, log);
 }
 
 void fmi3FreeInstance(fmi3Instance i) { free(i); }
@@ -209,3 +218,40 @@ fmi3Status fmi3DoStep(fmi3Instance i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean 
     *lastSuccessfulTime = m->time;
     return fmi3OK;
 }
+
+fmi3Instance fmi3InstantiateModelExchange(fmi3String name, fmi3String token, fmi3String resources,
+        fmi3Boolean visible, fmi3Boolean loggingOn, fmi3InstanceEnvironment env, fmi3LogMessageCallback log) {
+    (void)name; (void)resources; (void)visible; (void)loggingOn;
+    return new_model(token, env, log);
+}
+
+fmi3Status fmi3EnterEventMode(fmi3Instance i) { (void)i; return fmi3OK; }
+fmi3Status fmi3UpdateDiscreteStates(fmi3Instance i, fmi3Boolean *again, fmi3Boolean *terminate,
+        fmi3Boolean *nominalsChanged, fmi3Boolean *valuesChanged, fmi3Boolean *nextDefined,
+        fmi3Float64 *nextTime) {
+    Model *m = i;
+    follow_inputs(m);
+    *again = *nominalsChanged = *valuesChanged = fmi3False;
+    *terminate = m->time >= m->stop_at;
+    *nextDefined = m->stop_at < 1e300 && m->time < m->stop_at;
+    *nextTime = m->stop_at;
+    return fmi3OK;
+}
+fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance i) { (void)i; return fmi3OK; }
+fmi3Status fmi3CompletedIntegratorStep(fmi3Instance i, fmi3Boolean noSetPrior, fmi3Boolean *enterEventMode,
+                                       fmi3Boolean *terminateSimulation) {
+    (void)i; (void)noSetPrior;
+    *enterEventMode = *terminateSimulation = fmi3False;
+    return fmi3OK;
+}
+fmi3Status fmi3SetTime(fmi3Instance i, fmi3Float64 time) { ((Model *)i)->time = time; return fmi3OK; }
+/* No continuous states and no event indicators: the state functions take empty arrays. */
+#define EMPTY(NAME, CONST) \
+fmi3Status NAME(fmi3Instance i, CONST fmi3Float64 v[], size_t n) { (void)i; (void)v; return n ? fmi3Error : fmi3OK; }
+EMPTY(fmi3SetContinuousStates, const)
+EMPTY(fmi3GetContinuousStates, )
+EMPTY(fmi3GetContinuousStateDerivatives, )
+EMPTY(fmi3GetEventIndicators, )
+EMPTY(fmi3GetNominalsOfContinuousStates, )
+fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance i, size_t *n) { (void)i; *n = 0; return fmi3OK; }
+fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance i, size_t *n) { (void)i; *n = 0; return fmi3OK; }
