@@ -15,6 +15,8 @@ def add(sub, program) -> argparse.ArgumentParser:
                               description="Check DIAGRAM and print blocks, periods, base tick, "
                                           "hyperperiod and execution order.")
     diagram_args(validate)
+    validate.add_argument("--plan", action="store_true",
+                          help="also print the run's op table: blocks, programs of ops, copies and logs, with names")
     validate.set_defaults(handler=cmd_validate)
     return validate
 
@@ -49,6 +51,12 @@ def cmd_validate(args: argparse.Namespace) -> int:
         print(f"  at {at} (mod {format_duration(s.hyperperiod * s.base_tick)}): {s.programs[j].describe()}")
     if not s.event_ticks.size and s.advanced:
         print(f"  no other events: {', '.join(sorted(s.advanced))} advanced from t = 0 to t_end")
+    if args.plan:
+        from blocks.optable import op_table
+        from blocks.optable_text import describe_table
+
+        t_end = t_end if t_end is not None else end_time(args, diagram)
+        print(describe_table(op_table(diagram, build_schedule(diagram, t_end))))
     return EXIT_OK
 
 
