@@ -76,7 +76,7 @@ def test_the_plant_given_once_reaches_the_controllers_inside():
 def test_the_controller_validates_on_its_own_with_a_stand_in_plant():
     d = blocks.load_diagram(HERE / "controller.yaml")
     assert d.open_issue() is not None
-    assert {n: p.width for n, p in d.inputs.items()} == {"q": 9, "qd": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6}
+    assert {n: p.width for n, p in d.inputs.items()} == {"q": 9, "qd": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6, "obj": 3}
     q, tau = d.inputs["q"], d.outputs["tau"]
     assert q.signals == ("reflex.q", "manip.q") and q.units == "rad" and q.labels[:2] == ("thumb.1", "thumb.2")
     assert tau.units == "N m" and tau.width == 9
