@@ -71,10 +71,11 @@ setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/fmu.c",
+            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/lib_math.c",
+                     f"{BLOCKS_CSRC}/lib_dynamic.c", f"{BLOCKS_CSRC}/lib_sources.c", f"{BLOCKS_CSRC}/fmu.c",
                      f"{BLOCKS_CSRC}/fmu_me.c"],
-            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/fmu.h",
-                     f"{BLOCKS_CSRC}/fmu_me.h"],
+            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/lib_common.h",
+                     f"{BLOCKS_CSRC}/fmu.h", f"{BLOCKS_CSRC}/fmu_me.h"],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),

@@ -35,3 +35,9 @@ MAX_FOLDER_NAME = 100
 """Longest folder name made from a diagram's ``name:`` (the default ``runs/<name>``), in
 bytes of UTF-8: file systems refuse names beyond 255 bytes, and a results path must leave
 room for the folder it is in."""
+
+MAX_DATA_BYTES = 64 * 1024 * 1024
+"""Largest NPZ data file a block reads (FromFile), in bytes, and the most its arrays may
+hold once decompressed (64 MiB, 8 million samples): an archive's members are checked
+before anything is decompressed, so a small file that inflates to gigabytes is refused.
+CSV data files are text and read under MAX_YAML_BYTES, as points files are."""
