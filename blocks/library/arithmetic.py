@@ -92,8 +92,10 @@ MATH_FUNCTIONS = {**{f: i for i, f in enumerate(UNARY)}, **{f: 20 + i for i, f i
 
 
 class Math(Elementwise):
-    """A mathematical function, elementwise: of ``u`` for the one-argument functions, of
-    ``u0`` and ``u1`` for the two-argument ones. Outside a function's domain the result is
+    """A mathematical function (exp, log, sqrt, sin, atan2, mod, ...), elementwise.
+
+    Of ``u`` for the one-argument functions, of ``u0`` and ``u1`` for the two-argument
+    ones. Outside a function's domain the result is
     IEEE 754's (log of a negative number is NaN, of 0 is -inf), as C's math library gives.
 
     Parameters

@@ -91,8 +91,9 @@ class ZeroOrderHold(Block):
 
 
 class Memory(UnitDelay):
-    """Outputs its input of the previous hit, at whatever rate it inherits (Simulink's
-    Memory block): the same one-hit delay as UnitDelay, under the name Simulink gives it
+    """Outputs its input of the previous hit, at whatever rate it inherits.
+
+    Simulink's Memory block: the same one-hit delay as UnitDelay, under the name Simulink gives it
     for blocks without a sample time of their own."""
 
 
@@ -127,8 +128,9 @@ class DiscreteDerivative(KernelBlock):
 
 
 class MovingAverage(KernelBlock):
-    """The mean of the last ``window`` inputs (this hit's included), elementwise; before
-    the window has filled, the missing inputs count as ``initial`` (zeros: the FIR filter
+    """The mean of the last ``window`` inputs (this hit's included), elementwise.
+
+    Before the window has filled, the missing inputs count as ``initial`` (zeros: the FIR filter
     ones(window)/window from rest).
 
     Parameters

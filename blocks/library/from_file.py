@@ -22,7 +22,9 @@ METHODS = ("hold", "linear")
 
 
 class FromFile(KernelBlock):
-    """Outputs a time series read from a file: the last sample at or before t ('hold') or
+    """Plays back a time series from a CSV or NPZ file, held or linearly interpolated.
+
+    The output is the last sample at or before t ('hold') or
     the line between the samples around t ('linear'); before the first sample the first
     value, after the last the last value. Equal times make a step (the later row counts).
     A CSV file has the time first and a column per element, with or without a header row

@@ -28,8 +28,8 @@ def output_share(method: str, period: float) -> float:
 
 
 class DiscreteIntegrator(Advancing):
-    """Integrates its input: Simulink's Discrete-Time Integrator with forward Euler, backward
-    Euler or trapezoidal integration, a gain, output limits and an optional reset input.
+    """Integrates its input: Simulink's Discrete-Time Integrator (forward Euler, backward
+    Euler or trapezoidal; gain, limits, reset).
 
     With ``initial_is: output`` (Simulink's default) the first hit outputs ``initial``
     (clipped), and so does a hit that resets: y(0) = IC, then y(n) = y(n-1) + K T u(n-1)
@@ -54,9 +54,9 @@ class DiscreteIntegrator(Advancing):
     upper : scalar or vector
         upper limit of the output and state; inf for none
     reset : {'none', 'rising', 'falling', 'either', 'level'}
-        adds a scalar input ``reset`` that restarts the integral on its rising edge
-        (negative or zero to positive... as Simulink's triggers), falling edge, either
-        edge, or at every hit while it is non-zero
+        adds a scalar input ``reset`` that restarts the integral on its rising edge (from
+        negative to zero or positive, or from zero to positive, as Simulink's triggers),
+        its falling edge, either, or at every hit while it is non-zero
     """
 
     kernel_name = "integrator"

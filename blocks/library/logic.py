@@ -65,8 +65,9 @@ OPERATORS = ("and", "or", "nand", "nor", "xor", "nxor", "not")
 
 
 class Logic(KernelBlock):
-    """A logic operator over its inputs, elementwise: y = 1 if it holds, else 0 (xor: an
-    odd number of true inputs; nxor: an even number). With one input, every operator but
+    """A logic operator (and, or, nand, nor, xor, nxor, not) over its inputs, elementwise.
+
+    y = 1 if it holds, else 0 (xor: an odd number of true inputs; nxor: an even number). With one input, every operator but
     'not' applies across that input's elements (width-1 output), as in Simulink; 'not'
     takes one input and negates each element.
 
@@ -134,8 +135,9 @@ DEFAULTS = ("error", "last")
 
 
 class MultiportSwitch(KernelBlock):
-    """Passes the data input the control names: ``control`` (scalar), truncated toward zero,
-    selects ``u0`` at ``base``, ``u1`` at ``base + 1``, ... (Simulink's Multiport Switch
+    """Passes the data input the control names (Simulink's Multiport Switch).
+
+    ``control`` (scalar), truncated toward zero, selects ``u0`` at ``base``, ``u1`` at ``base + 1``, ... (Simulink's Multiport Switch
     with contiguous data ports; its default is one-based).
 
     Parameters

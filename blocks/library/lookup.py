@@ -60,8 +60,9 @@ class LookupTable1D(KernelBlock):
 
 
 class LookupTable2D(KernelBlock):
-    """y = table(u0, u1), bilinear between breakpoints: ``u0`` indexes the rows, ``u1`` the
-    columns; outside them the edge values ('clip') or the edge cells' planes extended
+    """y = table(u0, u1), bilinear between breakpoints, clipped or extrapolated outside.
+
+    ``u0`` indexes the rows, ``u1`` the columns; outside them the edge values ('clip') or the edge cells' planes extended
     ('linear'). Elementwise over the two inputs. NaN in, NaN out.
 
     Parameters

@@ -50,9 +50,10 @@ class _Random(Advancing):
 
 
 class RandomNumber(_Random):
-    """A new random number at every hit: normally distributed with ``mean`` and
-    ``variance`` (Simulink's Random Number), or uniform in [minimum, maximum). Seeded: the
-    same seed gives the same numbers. Needs a period.
+    """A new seeded random number at every hit, normal or uniform.
+
+    Normally distributed with ``mean`` and ``variance`` (Simulink's Random Number), or
+    uniform in [minimum, maximum). The same seed gives the same numbers. Needs a period.
 
     Parameters
     ----------
@@ -102,8 +103,9 @@ class RandomNumber(_Random):
 
 
 class BandLimitedWhiteNoise(_Random):
-    """White noise for a continuous model: normally distributed numbers of variance
-    power / T at each hit (T the period), so that the noise has the power spectral density
+    """Seeded white noise of a power spectral density, for a continuous model.
+
+    Normally distributed numbers of variance power / T at each hit (T the period), so that the noise has the power spectral density
     ``power`` up to the Nyquist frequency (Simulink's Band-Limited White Noise; choose T
     well below the system's smallest time constant). Seeded. Needs a period.
 

@@ -70,7 +70,9 @@ class _WithPreviousOutput(Elementwise):
 
 
 class RateLimiter(_WithPreviousOutput):
-    """Limits the rate of change: with rate = (u - y_prev) / T, the output is y_prev + T *
+    """Limits the output's rate of change to [falling, rising] units per second.
+
+    With rate = (u - y_prev) / T, the output is y_prev + T *
     rising above the rising rate, y_prev + T * falling below the falling rate, else u
     (Simulink's Rate Limiter in discrete mode; y_prev starts at ``initial``). Needs a period.
 

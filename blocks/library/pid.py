@@ -25,7 +25,9 @@ ANTI_WINDUP = ("none", "clamping", "back_calculation")
 
 class PID(Advancing):
     """A discrete PID controller of its input ``u`` (the error), as Simulink's Discrete PID
-    Controller: C(z) = P + I a(z) + D N / (1 + N b(z)) in parallel form, P times
+    Controller, with output limits, anti-windup, tracking and reset.
+
+    C(z) = P + I a(z) + D N / (1 + N b(z)) in parallel form, P times
     [1 + I a(z) + D N / (1 + N b(z))] in ideal form, a and b the integrator's and the
     filter's rule: forward Euler T/(z-1), backward Euler T z/(z-1), trapezoidal
     (T/2)(z+1)/(z-1). The output may be limited to [lower, upper]; then anti-windup keeps

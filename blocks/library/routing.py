@@ -43,8 +43,9 @@ class Concatenate(KernelBlock):
 
 
 class Mux(Concatenate):
-    """Combines its inputs ``u0, u1, ...`` into one vector ``y``, in order, optionally
-    naming them: the output's elements are then called by the names (``x``, or ``pos.0``,
+    """Combines its inputs ``u0, u1, ...`` into one vector ``y``, optionally naming them.
+
+    With ``labels``, the output's elements are then called by the names (``x``, or ``pos.0``,
     ``pos.1`` for an input of width 2), in CSV columns, plots and ``hierhand blocks``.
 
     Parameters
@@ -96,8 +97,9 @@ _SLICE = re.compile(r"^\s*(-?\d+)?\s*:\s*(-?\d+)?\s*(?::\s*(-?\d+)\s*)?$")
 
 
 class Selector(KernelBlock):
-    """Picks elements of its input ``u`` by index (0-based, in the order given; repeats
-    allowed): ``indices: [2, 0]`` outputs u[2], u[0]; ``indices: "0:3"`` the first three
+    """Picks elements of its input ``u`` by index or slice.
+
+    Indices are 0-based, in the order given, repeats allowed: ``indices: [2, 0]`` outputs u[2], u[0]; ``indices: "0:3"`` the first three
     (Python's slice notation, step included).
 
     Negative indices and open slices (``-1``, ``"2:"``) count from the input's end, so

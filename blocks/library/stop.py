@@ -9,8 +9,9 @@ from blocks.library.kernel_block import KernelBlock
 
 
 class Stop(KernelBlock):
-    """Ends the run at a hit where any element of its input is non-zero (NaN included):
-    its update raises EndRun, so the run finishes that tick, goes on to the block's next
+    """Ends the run when its input is non-zero (Simulink's Stop Simulation).
+
+    At a hit where any element of its input is non-zero (NaN included), its update raises EndRun, so the run finishes that tick, goes on to the block's next
     hit (or t_end, if that comes first) and ends there as at t_end; run.json's
     ``ended_by`` names the block and the element. Connect a Compare or Relational block to
     stop on a condition. It has no outputs; its state says whether it has stopped."""

@@ -51,8 +51,10 @@ class Sine(_Waveform):
 
 
 class Pulse(_Waveform):
-    """Rectangular pulses: ``amplitude`` from delay + j period for duty * period, 0 between
-    them and before ``delay`` (Simulink's time-based Pulse Generator, with the width as a
+    """Rectangular pulses of ``amplitude``, ``duty`` of each ``period``, from ``delay`` on.
+
+    The output is ``amplitude`` from delay + j period for duty * period, 0 between the
+    pulses and before ``delay`` (Simulink's time-based Pulse Generator, with the width as a
     fraction). Tick times are floats, so a time within 1e-9 of a period of an edge counts
     as on it: 0.3 s is the start of the fourth pulse of period 0.1 s.
 
@@ -89,8 +91,10 @@ SWEEPS = ("linear", "logarithmic")
 
 
 class Chirp(_Waveform):
-    """A swept sine: y = amplitude sin(phase(t) + phase0) whose frequency goes from f0 at
-    t = 0 to f1 at ``target_time``, and on at the same rate: linearly (2 pi (f0 t + (f1 -
+    """A swept sine from f0 at t = 0 to f1 at ``target_time`` (Hz), linear or logarithmic.
+
+    y = amplitude sin(phase(t) + phase0), the frequency going from f0 to f1 and on at the
+    same rate: linearly (2 pi (f0 t + (f1 -
     f0) t^2 / (2 T1)), Simulink's Chirp Signal) or logarithmically (exponential in
     frequency), as scipy.signal.chirp's 'linear' and 'logarithmic' (whose cosine is this
     sine with phase -90 degrees).
