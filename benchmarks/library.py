@@ -17,12 +17,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import statistics
-import time
 
 import numpy as np
 
 import blocks
+from scheduler import timed  # the benchmark beside this one: the median of repeated runs
 
 TARGET_RATIO = 3.0
 """Issue 31: a diagram of the new blocks within this many times the hand-written loop."""
@@ -120,15 +119,6 @@ def hand_loop(n_ticks: int) -> np.ndarray:
             xi += Tc * vi
             xf += Tc * d
     return out
-
-
-def timed(fn, repeat: int):
-    times, result = [], None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times), result
 
 
 def main() -> None:
