@@ -18,6 +18,7 @@ from typing import Any, ClassVar, Iterable, Mapping
 
 import numpy as np
 
+from blocks import compiled
 from blocks.block import Block, BlockError, EndRun, Signal
 from blocks.kernel import END_RUN, Kernel
 from blocks.library import _kernels
@@ -124,7 +125,7 @@ class KernelBlock(Block):
     def _kernel_for_python(self) -> Kernel:
         kernel = self.kernel()
         if kernel is None:
-            if not _kernels.functions():
+            if not _kernels.functions() or _native() is None:
                 raise BlockError(f"{type(self).__name__} runs its compiled kernel, and the extension "
                                  "blocks._native is missing (pip install -e . builds it)")
             if self.period is None and self.period_reason is not None:
@@ -170,6 +171,4 @@ class Advancing(KernelBlock):
 
 
 def _native():
-    import blocks._native
-
-    return blocks._native
+    return compiled.native()

@@ -22,7 +22,7 @@ log: [b.y]
 
 def test_without_the_extension_a_signal_block_loads_and_says_why_it_cannot_run(monkeypatch):
     monkeypatch.setattr(_kernels, "functions", lambda: {})
-    monkeypatch.setattr(blocks.compiled, "NativeRunner", None)
+    monkeypatch.setattr(blocks.compiled, "usable_kernel", lambda *args: None)
     diagram = blocks.loads_diagram(DIAGRAM)
     assert diagram.blocks["b"].block.kernel() is None
     results = blocks.simulate(diagram, t_end="2 ms")

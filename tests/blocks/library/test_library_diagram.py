@@ -1,6 +1,7 @@
-"""One diagram with every signal block of the library, run by the executor compiled and in
-Python: the same samples to the last bit (both paths run the blocks' C kernels, the
-executor's own work differs), and every block offers a GIL-free kernel."""
+"""One diagram with every signal block of the library, run by the C core, by the reference
+loop and with every block through its Python methods: the same samples to the last bit
+(all three run the blocks' C kernels; the executors' own work differs), and every block
+offers a GIL-free kernel."""
 
 from __future__ import annotations
 
@@ -136,14 +137,16 @@ def test_compiled_and_python_runs_agree_to_the_bit(tmp_path, monkeypatch):
     d = diagram(tmp_path)
     compiled = blocks.simulate(d)
     assert compiled.complete, compiled.status
+    reference = blocks.simulate(d, engine="reference")
     with monkeypatch.context() as m:
-        m.setattr(blocks.compiled, "NativeRunner", None)
+        m.setattr(blocks.compiled, "usable_kernel", lambda *args: None)
         python = blocks.simulate(d)
-    assert set(compiled) == set(python)
-    for name in compiled:
-        (tc, vc), (tp, vp) = compiled[name], python[name]
-        np.testing.assert_array_equal(tc, tp, err_msg=name)
-        np.testing.assert_array_equal(vc, vp, err_msg=name)
+    for other in (reference, python):
+        assert set(compiled) == set(other)
+        for name in compiled:
+            (tc, vc), (to, vo) = compiled[name], other[name]
+            np.testing.assert_array_equal(tc, to, err_msg=name)
+            np.testing.assert_array_equal(vc, vo, err_msg=name)
     assert np.ptp(compiled["pid.y"][1]) > 0.5 and np.all(np.isfinite(compiled["div.y"][1]))
 
 

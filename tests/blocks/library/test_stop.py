@@ -25,7 +25,7 @@ log: [ramp.y]
 @pytest.mark.parametrize("compiled", [True, False])
 def test_stop_ends_the_run_at_its_next_hit(compiled, monkeypatch):
     if not compiled:
-        monkeypatch.setattr(blocks.compiled, "NativeRunner", None)
+        monkeypatch.setattr(blocks.compiled, "usable_kernel", lambda *args: None)
     results = blocks.simulate(blocks.loads_diagram(DIAGRAM))
     assert results.complete
     ended = results.ended_by
