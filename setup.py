@@ -73,8 +73,10 @@ setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/{name}.c" for name in ("host", "core", "library", "fmu", "fmu_me")],
-            depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "fmu", "fmu_me")],
+            sources=[f"{BLOCKS_CSRC}/{name}.c"
+                     for name in ("host", "core", "library", "lib_math", "lib_dynamic", "lib_sources", "fmu", "fmu_me")],
+            depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "lib_common", "fmu",
+                                                             "fmu_me")],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),

@@ -44,3 +44,9 @@ MAX_SUBSYSTEM_BLOCKS = 200_000
 """Most blocks a diagram's subsystems may add in all. A file that includes another twice,
 which includes another twice, ... doubles the blocks per level: 30 small files would make
 10^9 blocks. A flat diagram of this size loads and plans in about 40 s."""
+
+MAX_DATA_BYTES = 64 * 1024 * 1024
+"""Largest NPZ data file a block reads (FromFile), in bytes, and the most its arrays may
+hold once decompressed (64 MiB, 8 million samples): an archive's members are checked
+before anything is decompressed, so a small file that inflates to gigabytes is refused.
+CSV data files are text and read under MAX_YAML_BYTES, as points files are."""

@@ -1,4 +1,11 @@
-"""Plots of logged signals: one axis per signal, time in seconds, zero-order-hold steps."""
+"""Plots of logged signals: an axis per selection, time in seconds, zero-order-hold steps,
+and the diagram's events marked.
+
+A selection (``blocks.plot_select``) is a signal, some of its elements (``plant.q[fore.1]``),
+or several of those overlaid on one axis (``plant.q[fore.1],ref.y``). Markers
+(``blocks.plot_markers``) show what the diagram makes happen: Step times, and whatever an
+application registers (the hand's task phases).
+"""
 
 from __future__ import annotations
 
@@ -8,6 +15,8 @@ from typing import Sequence
 
 import numpy as np
 
+from .plot_markers import Marker, markers as run_markers
+from .plot_select import Trace, select
 from .results import Results
 
 AXES_PER_PAGE = 6
@@ -17,33 +26,40 @@ FIGURE_WIDTH = 11.0
 AXES_HEIGHT = 2.3
 TITLE_WIDTH = 110
 STOP_MARGIN = 0.02
+MARKER_COLOUR = "dimgray"
+MARKER_GID = "marker"
+"""The gid of every artist that draws a marker (their lines, spans and texts)."""
 
 
 def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | None = None,
-                 title: str | None = None) -> list[Path]:
-    """Write PNG(s) of ``signals`` (default all) to ``path``; more than 6 signals make pages.
+                 title: str | None = None, markers: bool | Sequence[Marker] = True) -> list[Path]:
+    """Write PNG(s) of ``signals`` (selections, see ``blocks.plot_select``; default every
+    logged signal, one per axis) to ``path``; more than 6 axes make pages.
 
     Discrete signals hold between samples, so they are drawn as steps; a signal's last
     value is held to the run's end time (where a block ended it, if one did, as the title
     says), or for a failed or interrupted run to where it stopped, which a vertical line
-    marks with the status. Returns the files written.
+    marks with the status. ``markers``: the events to mark on every axis, or True for the
+    diagram's (``blocks.plot_markers.markers``), False for none.
+    Raises ``SelectionError`` (a ValueError) for a selection of nothing logged. Returns
+    the files written.
     """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = list(signals) if signals else list(results)
-    for name in names:
-        results[name]  # raises a KeyError naming the logged signals
-    if not names:
+    selections = list(signals) if signals else list(results)
+    if not selections:
         raise ValueError("no signals to plot: the run logged none (add a 'log:' list to the diagram)")
+    axes = [select(results, s) for s in selections]
+    events = run_markers(results.info)[0] if markers is True else list(markers or [])
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    pages = [names[i:i + AXES_PER_PAGE] for i in range(0, len(names), AXES_PER_PAGE)]
+    pages = [axes[i:i + AXES_PER_PAGE] for i in range(0, len(axes), AXES_PER_PAGE)]
     written = []
     for number, page in enumerate(pages, start=1):
-        fig = figure(results, page, title)
+        fig = figure(results, page, title, events)
         out = path if len(pages) == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
         fig.savefig(out, dpi=110)
         plt.close(fig)
@@ -51,46 +67,36 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
     return written
 
 
-def figure(results: Results, names: Sequence[str], title: str | None = None):
-    """One page: an axis per signal of ``names``, over the time the run covered.
+def figure(results: Results, selections: Sequence[str | list[Trace]], title: str | None = None,
+           markers: Sequence[Marker] = ()):
+    """One page: an axis per selection (a selection's text, or its traces), over the time
+    the run covered, with ``markers`` drawn on every axis.
 
-    Each axis is labelled with the signal's name and unit; its legend, right of the axis,
-    names the elements as the block does (``thumb.1``), each with its unit where they
+    An axis of one signal is labelled with its name and unit; its legend, right of the
+    axis, names the elements as the block does (``thumb.1``), each with its unit where they
     differ. Elements named ``group.member`` share a colour per group and a line style per
-    member, so nine joints read as three fingers of three. The time axis spans the data:
-    from the first sample to the end time, or to where a failed or interrupted run stopped,
-    which a dashed line marks, with a dot on each element's last sample."""
+    member, so nine joints read as three fingers of three. An axis of several signals
+    names each line ``signal[element]``. The time axis spans the data: from the first
+    sample to the end time, or to where a failed or interrupted run stopped, which a
+    dashed line marks, with a dot on each element's last sample."""
     import matplotlib.pyplot as plt
 
+    axes_traces = [select(results, s) if isinstance(s, str) else list(s) for s in selections]
     end, stop = time_span(results)
-    firsts = [float(results[n][0][0]) for n in names if len(results[n][0])]
+    firsts = [float(results[tr.signal][0][0]) for traces in axes_traces for tr in traces
+              if len(results[tr.signal][0])]
     start = min(firsts, default=0.0)
-    fig, axes = plt.subplots(len(names), 1, sharex=True, squeeze=False, layout="constrained",
-                             figsize=(FIGURE_WIDTH, 1.0 + AXES_HEIGHT * len(names)))
-    for ax, name in zip(axes[:, 0], names):
-        t, v = results[name]
-        last_t, last_v = (t[-1], v[-1]) if len(t) else (None, None)
-        if end is not None and len(t) and t[-1] < end:
-            t, v = np.append(t, end), np.vstack([v, v[-1:]])
-        width = v.shape[1]
-        labels = results.element_labels(name) or [f"[{j}]" for j in range(width)]
-        units = results.units(name)
-        mixed = units is not None and len(set(units)) > 1
-        styles = line_styles(labels)
-        for j in range(width):
-            label = labels[j] + (f" ({units[j] or '?'})" if mixed else "") if width > 1 else None
-            ax.step(t, v[:, j], where="post", label=label, **styles[j])
-        if stop is not None:
-            ax.axvline(stop, color="tab:red", ls="--", lw=1.0)
-            if last_t is not None:
-                ax.scatter(np.full(width, last_t), last_v, s=18, color="tab:red", zorder=5, clip_on=False)
-        ax.set_ylabel(axis_label(name, units))
-        ax.grid(True, alpha=0.3)
-        if 1 < width <= MAX_LEGEND:
+    fig, axes = plt.subplots(len(axes_traces), 1, sharex=True, squeeze=False, layout="constrained",
+                             figsize=(FIGURE_WIDTH, 1.0 + AXES_HEIGHT * len(axes_traces)))
+    for ax, traces in zip(axes[:, 0], axes_traces):
+        lines = _draw_traces(ax, results, traces, end, stop)
+        if 1 < lines <= MAX_LEGEND:
             ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
-                      ncol=1 if width <= LEGEND_ROWS else 2, borderaxespad=0.0, handlelength=2.5)
+                      ncol=1 if lines <= LEGEND_ROWS else 2, borderaxespad=0.0, handlelength=2.5)
+        ax.grid(True, alpha=0.3)
     if end is not None and end > start:  # past a stop a little, so that its line and dots show
         axes[0, 0].set_xlim(start, end + (STOP_MARGIN * (end - start) if stop is not None else 0.0))
+    draw_markers(axes[:, 0], markers)
     if stop is not None:
         axes[0, 0].annotate(results.status.split(": ", 1)[0], xy=(stop, 1.0), xycoords=("data", "axes fraction"),
                             xytext=(0, 3), textcoords="offset points", ha="right", va="bottom",
@@ -102,6 +108,57 @@ def figure(results: Results, names: Sequence[str], title: str | None = None):
         heading += "\n" + textwrap.fill(f"[{note}]", TITLE_WIDTH)
     fig.suptitle(heading)
     return fig
+
+
+def _draw_traces(ax, results: Results, traces: list[Trace], end: float | None, stop: float | None) -> int:
+    """Draw an axis's traces; returns how many lines carry a legend label."""
+    overlaid = len(traces) > 1
+    if overlaid:
+        styles = line_styles([f"{tr.signal}[{label}]" for tr in traces for label in tr.labels])
+    labelled, drawn, shown_units = 0, 0, []
+    for tr in traces:
+        t, v = results[tr.signal]
+        v = v[:, list(tr.columns)]
+        last_t, last_v = (t[-1], v[-1]) if len(t) else (None, None)
+        if end is not None and len(t) and t[-1] < end:
+            t, v = np.append(t, end), np.vstack([v, v[-1:]])
+        width = v.shape[1]
+        all_units = results.units(tr.signal)
+        units = [all_units[c] for c in tr.columns] if all_units is not None else None
+        shown_units += units or []
+        mixed = units is not None and len(set(units)) > 1
+        trace_styles = styles[drawn:drawn + width] if overlaid else line_styles(list(tr.labels))
+        drawn += width
+        for j in range(width):
+            if overlaid:
+                label = tr.title if width == 1 else f"{tr.signal}[{tr.labels[j]}]"
+                label += f" ({units[j] or '?'})" if mixed else ""
+            else:
+                label = tr.labels[j] + (f" ({units[j] or '?'})" if mixed else "") if width > 1 else None
+            ax.step(t, v[:, j], where="post", label=label, **trace_styles[j])
+            labelled += label is not None
+        if stop is not None and last_t is not None:
+            ax.scatter(np.full(width, last_t), last_v, s=18, color="tab:red", zorder=5, clip_on=False)
+    if stop is not None:
+        ax.axvline(stop, color="tab:red", ls="--", lw=1.0)
+    name = ", ".join(tr.title for tr in traces)
+    ax.set_ylabel(axis_label(textwrap.fill(name, 40), shown_units if shown_units else None))
+    return labelled
+
+
+def draw_markers(axes, markers: Sequence[Marker]) -> None:
+    """Each marker on every axis: a dotted line at an instant, a light band over a span;
+    its words at the top of the first axis."""
+    for m in markers:
+        for ax in axes:
+            if m.instant:
+                ax.axvline(m.start, color=MARKER_COLOUR, ls=":", lw=1.0, gid=MARKER_GID)
+            else:
+                ax.axvspan(m.start, m.end, color=MARKER_COLOUR, alpha=0.08, lw=0, gid=MARKER_GID)
+        axes[0].annotate(m.label, xy=(m.start, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -2),
+                         textcoords="offset points", rotation=90, ha="left", va="top", fontsize="x-small",
+                         color=MARKER_COLOUR, gid=MARKER_GID, annotation_clip=True,
+                         bbox={"boxstyle": "square,pad=0.1", "facecolor": "white", "alpha": 0.7, "linewidth": 0})
 
 
 def axis_label(name: str, units: Sequence[str] | None) -> str:

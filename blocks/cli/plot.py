@@ -1,34 +1,49 @@
-"""``plot``: the logged signals of a results folder, one axis per signal, as PNG."""
+"""``plot``: the logged signals of a results folder as PNG: an axis per selection, elements
+by label or index, signals overlaid, the diagram's events marked."""
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from .program import EXIT_OK, UsageError
+
+SELECTION_HELP = ("an axis: a signal (plant.q), elements of it by label or 0-based index "
+                  "(plant.q[fore.1], plant.q[0:3], plant.q[thumb.1,fore.1]), or several such "
+                  "separated by commas to overlay them (plant.q[fore.1],ref.y); repeat for more "
+                  "axes (default: every logged signal, an axis each)")
 
 
 def add(sub, program) -> argparse.ArgumentParser:
     """The ``plot`` command."""
     plot = sub.add_parser("plot", help="plot logged signals of a run",
-                          description="Plot signals of a results folder, one axis per signal.")
+                          description="Plot signals of a results folder: an axis per -s, with the diagram's "
+                                      "events (Step times, and what the application marks) as dotted lines "
+                                      "and bands.")
     plot.add_argument("run_dir", type=Path, metavar="RUN_DIR", help=f"results folder of '{program.name} run'")
-    plot.add_argument("-s", "--signal", action="append", dest="signals", metavar="BLOCK.PORT",
-                      help="signal to plot (repeatable; default: all logged signals)")
+    plot.add_argument("-s", "--signal", action="append", dest="signals", metavar="SELECTION", help=SELECTION_HELP)
+    plot.add_argument("--no-markers", action="store_true", help="do not mark the diagram's events")
     plot.add_argument("-o", "--output", type=Path, help="PNG file (default: RUN_DIR/plots/signals.png)")
     plot.set_defaults(handler=cmd_plot)
     return plot
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    """Plot the chosen signals (default: all) and print the files written."""
+    """Plot the chosen selections (default: every signal) and print the files written."""
     from blocks import Results
     from blocks.plot import plot_signals
+    from blocks.plot_markers import markers
 
     results = Results.load(args.run_dir)
     out = args.output or args.run_dir / "plots" / "signals.png"
+    events: list = []
+    if not args.no_markers:
+        events, notes = markers(results.info)
+        for note in notes:
+            print(f"{args.program.name}: note: {note}", file=sys.stderr)
     try:
-        written = plot_signals(results, out, args.signals)
+        written = plot_signals(results, out, args.signals, markers=events)
     except (KeyError, ValueError) as exc:
         raise UsageError(str(exc).strip("'\"")) from None
     for path in written:

@@ -14,12 +14,16 @@
  * A row of a single term is that one product, as numpy's is; longer rows equal numpy's
  * ndarray.dot to round-off, not bit for bit (BLAS sums in its own order). That is enough:
  * within a run the executor uses a block's kernel for all of its hits or for none.
+ *
+ * The table at the end also lists the kernels of the library's signal blocks (lib_math.c,
+ * lib_dynamic.c, lib_sources.c; their conventions in lib_common.h).
  */
 #include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "lib_common.h"
 #include "library.h"
 
 /* y (r) = M (r x L, row-major, L >= 1) . v (L), each row summed in order (see above).
@@ -341,5 +345,45 @@ const blk_library_entry blk_library[] = {
     ENTRY(lti_output),
     ENTRY(lti_update),
     ENTRY(lti_advance),
+    ENTRY(abs_output),
+    ENTRY(sign_output),
+    ENTRY(bias_output),
+    ENTRY(minmax_output),
+    ENTRY(math_output),
+    ENTRY(relational_output),
+    ENTRY(compare_output),
+    ENTRY(logic_output),
+    ENTRY(dead_zone_output),
+    ENTRY(quantizer_output),
+    ENTRY(product_output),
+    ENTRY(threshold_switch_output),
+    ENTRY(multiport_switch_output),
+    ENTRY(lookup1d_output),
+    ENTRY(lookup2d_output),
+    ENTRY(concatenate_output),
+    ENTRY(selector_output),
+    ENTRY(integrator_output),
+    ENTRY(integrator_update),
+    ENTRY(integrator_advance),
+    ENTRY(derivative_output),
+    ENTRY(derivative_update),
+    ENTRY(moving_average_output),
+    ENTRY(moving_average_update),
+    ENTRY(pid_output),
+    ENTRY(pid_update),
+    ENTRY(pid_advance),
+    ENTRY(rate_limiter_output),
+    ENTRY(rate_limiter_update),
+    ENTRY(backlash_output),
+    ENTRY(backlash_update),
+    ENTRY(stop_output),
+    ENTRY(stop_update),
+    ENTRY(sine_output),
+    ENTRY(pulse_output),
+    ENTRY(chirp_output),
+    ENTRY(from_file_output),
+    ENTRY(random_number_output),
+    ENTRY(random_number_update),
+    ENTRY(random_number_advance),
     {NULL, NULL},
 };

@@ -36,8 +36,9 @@ def functions() -> dict[str, int]:
 
 
 def make_kernel(context: np.ndarray, output: str | None = None, update: str | None = None,
-                advance: str | None = None, *owners: Any) -> Kernel | None:
-    """A Kernel of the named library functions reading ``context``; None without them."""
+                advance: str | None = None, *owners: Any, failures=None) -> Kernel | None:
+    """A Kernel of the named library functions reading ``context``; None without them.
+    ``failures``: the block's ``Kernel.error`` (default: this module's ``error``)."""
     table = functions()
     names = [name for name in (output, update, advance) if name is not None]
     if not names or any(name not in table for name in names):
@@ -49,7 +50,7 @@ def make_kernel(context: np.ndarray, output: str | None = None, update: str | No
         update=table[update] if update else 0,
         advance=table[advance] if advance else 0,
         owners=(context, *owners),
-        error=error,
+        error=failures or error,
         nogil=True,
     )
 

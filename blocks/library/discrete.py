@@ -1,4 +1,5 @@
-"""Basic discrete-time blocks: one-sample delay and zero-order hold."""
+"""Basic discrete-time blocks: one-sample delays (UnitDelay, Memory), the zero-order hold,
+the discrete derivative and the moving average."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, Signal
-from blocks.library import _kernels
+from blocks.library import _kernels, _params
+from blocks.library.kernel_block import KernelBlock
 
 
 class UnitDelay(Block):
@@ -86,3 +88,71 @@ class ZeroOrderHold(Block):
             return None
         return _kernels.cached(self, (width,), lambda: _kernels.make_kernel(
             np.array([width], dtype=float), "zero_order_hold_output"))
+
+
+class Memory(UnitDelay):
+    """Outputs its input of the previous hit, at whatever rate it inherits.
+
+    Simulink's Memory block: the same one-hit delay as UnitDelay, under the name Simulink gives it
+    for blocks without a sample time of their own."""
+
+
+class DiscreteDerivative(KernelBlock):
+    """The discrete derivative y = K (u(n) - u(n-1)) / T, as Simulink's Discrete Derivative
+    (the transfer function K (z - 1)/(T z)). Needs a period.
+
+    Parameters
+    ----------
+    gain : scalar or vector
+        K
+    initial : scalar or vector
+        the input before the first hit, u(-1)
+    """
+
+    kernel_name = "derivative"
+    period_reason = "it divides by it"
+
+    def __init__(self, gain: Any = 1.0, initial: Any = 0.0):
+        self.gain = _params.elementwise("gain", gain)
+        self.initial = _params.elementwise("initial", initial)
+        width = _params.common_width(gain=self.gain, initial=self.initial)
+        self.inputs, self.outputs = {"u": width}, {"y": width}
+        self.feedthrough = True
+
+
+    def initial_state(self) -> Signal:
+        return np.array(_params.spread(self.initial, self.outputs["y"] or self.initial.size), dtype=float)
+
+    def context_numbers(self):
+        return (_params.spread(self.gain, self.outputs["y"]),)
+
+
+class MovingAverage(KernelBlock):
+    """The mean of the last ``window`` inputs (this hit's included), elementwise.
+
+    Before the window has filled, the missing inputs count as ``initial`` (zeros: the FIR filter
+    ones(window)/window from rest).
+
+    Parameters
+    ----------
+    window : int
+        how many hits are averaged
+    initial : scalar or vector
+        the inputs assumed before the first hit
+    """
+
+    kernel_name = "moving_average"
+
+    def __init__(self, window: int = 2, initial: Any = 0.0):
+        self.window = _params.integer("window", window, minimum=1, maximum=1_000_000)
+        self.initial = _params.elementwise("initial", initial)
+        width = _params.common_width(initial=self.initial)
+        self.inputs, self.outputs = {"u": width}, {"y": width}
+        self.feedthrough = True
+
+    def initial_state(self) -> Signal:
+        width = self.outputs["y"] or self.initial.size
+        return np.concatenate(((0.0,), np.tile(_params.spread(self.initial, width), self.window - 1)))
+
+    def context_numbers(self):
+        return (self.window,)

@@ -114,7 +114,7 @@ def test_a_problem_is_reported_at_the_line_of_the_python_call_that_caused_it():
         (HERE, lines[2], "block 'h' (Gain) has no parameter 'kk'"),
         (HERE, lines[3], "connection 'k.y -> k.uu': block 'k' (Gain) has no input 'uu'"),
     ]
-    assert info.value.issues[1].hint == "did you mean 'Step'?"
+    assert info.value.issues[1].hint == "did you mean 'Step', 'Stop'?"
 
 
 def test_an_override_of_a_built_diagram_says_how_it_was_given():

@@ -141,3 +141,47 @@ def test_a_complete_run_has_no_marks():
 def test_plot_signals_writes_the_png(tmp_path):
     (written,) = plot_signals(described(), tmp_path / "plots" / "s.png")
     assert written == tmp_path / "plots" / "s.png" and written.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_an_axis_of_selected_elements_and_one_of_overlaid_signals():
+    fig = figure(described(), ["b.q[fore.1]", "b.q[thumb.1,thumb.2],b.r"])
+    try:
+        one, both = fig.axes
+        assert one.get_ylabel() == "b.q[fore.1]\n(rad)" and one.get_legend() is None
+        np.testing.assert_allclose(one.get_lines()[0].get_ydata()[:5], 3 * np.arange(1, 6) * 1e-3)
+        assert legend_texts(both) == ["b.q[thumb.1]", "b.q[thumb.2]", "b.r"]
+        assert both.get_ylabel().startswith("b.q[thumb.1,thumb.2], b.r")
+        assert len({line.get_color() for line in both.get_lines()}) == 3
+    finally:
+        plt.close(fig)
+
+
+def marker_artists(ax):
+    return [a for a in (*ax.get_lines(), *ax.patches, *ax.texts) if a.get_gid() == "marker"]
+
+
+def test_markers_are_drawn_on_every_axis_and_named_once():
+    from blocks.plot_markers import Marker
+
+    events = [Marker(0.001, 0.001, "", "s: step at 0.001 s"), Marker(0.002, 0.004, "moving", "moved")]
+    fig = figure(described(), ["b.q", "b.r"], markers=events)
+    try:
+        top, bottom = fig.axes
+        lines = [a for a in marker_artists(bottom) if a in bottom.get_lines()]
+        assert [line.get_xdata()[0] for line in lines] == [0.001] and len(bottom.patches) == 1
+        assert [t.get_text() for t in marker_artists(top) if t in top.texts] == ["s: step at 0.001 s", "moving"]
+        assert not [t for t in bottom.texts if t.get_gid() == "marker"]
+        assert stop_lines(bottom) == [0.001]  # a marker line, not a stop: the run is complete
+    finally:
+        plt.close(fig)
+
+
+def test_plot_signals_marks_the_runs_steps_unless_asked_not_to(tmp_path, monkeypatch):
+    import blocks.plot as plot
+
+    drawn = []
+    monkeypatch.setattr(plot, "draw_markers", lambda axes, markers: drawn.append(list(markers)))
+    run = described(block_types={"s": "Step"}, parameters={"s": {"time": 0.002}})
+    plot_signals(run, tmp_path / "a.png")
+    plot_signals(run, tmp_path / "b.png", markers=False)
+    assert [[m.start for m in ms] for ms in drawn] == [[0.002], []]

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from importlib.metadata import entry_points
 from pathlib import Path
 
 import numpy as np
 
 import blocks
+from blocks.plot_markers import ENTRY_POINT_GROUP, markers
 from hierhand.model import load_hand
 from hierhand.tasks.phases import phase_at, task_phases
 
@@ -42,3 +44,21 @@ def test_manipulation_and_grasp_phases():
     assert phase_at(phases, 0.9) == "thumb and forefinger done moving the object"
     assert phase_at(phases, 0.2) == "support released"
     assert task_phases({}) == []
+
+
+def test_the_hand_registers_its_phases_as_plot_markers():
+    """``hierhand plot`` marks a task's phases: the support, then each finger's trajectory
+    from its first to its last waypoint."""
+    installed = {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    assert installed == {"task_phases": "hierhand.tasks.phases:task_phases"}
+    diagram = blocks.load_diagram(ROOT / "diagrams" / "regrasp.yaml")
+    parameters = diagram.parameters()
+    found, notes = markers({"block_types": {n: s.type_name for n, s in diagram.blocks.items()},
+                            "parameters": parameters})
+    assert notes == []
+    spans = [(0.0, parameters["support"]["until"])]
+    for finger in ("middle", "fore"):
+        waypoints = parameters["manip"]["trajectories"][finger]["waypoints"]
+        spans.append((waypoints[0][0], waypoints[-1][0]))
+    assert [(m.start, m.end) for m in found] == spans
+    assert found[0].during == "object on its support (released at 0.1 s)"
