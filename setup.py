@@ -72,9 +72,9 @@ setup(
         Extension(
             "blocks._native",
             sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/fmu.c",
-                     f"{BLOCKS_CSRC}/fmu_me.c"],
+                     f"{BLOCKS_CSRC}/fmu_me.c", f"{BLOCKS_CSRC}/fmu_host.c"],
             depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/fmu.h",
-                     f"{BLOCKS_CSRC}/fmu_me.h"],
+                     f"{BLOCKS_CSRC}/fmu_me.h", f"{BLOCKS_CSRC}/fmu_calls.h", f"{BLOCKS_CSRC}/fmu_host.h"],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),

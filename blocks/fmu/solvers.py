@@ -34,8 +34,10 @@ from typing import Any
 import numpy as np
 
 from ..kernel import address
-from ..timebase import format_duration, parse_duration
+from ..timebase import format_duration
 from . import interrupt
+from .instance import function_address
+from .model import duration_parameter
 from .sundials import CV_NORMAL, CV_ROOT_RETURN
 
 SOLVERS = ("cvode", "euler")
@@ -86,13 +88,7 @@ def solver_choice(solver: Any, substep: Any) -> tuple[str, Fraction | None]:
     if solver != "euler":
         raise ValueError("parameter 'substep' is the fixed step of 'solver: euler'; CVode chooses its own "
                          "steps (drop 'substep', or add 'solver: euler')")
-    try:
-        step = parse_duration(substep)
-    except ValueError as exc:
-        raise ValueError(f"parameter 'substep' must be a duration such as '1 ms': {exc}") from None
-    if step <= 0:
-        raise ValueError(f"parameter 'substep' must be positive, got {substep!r}")
-    return solver, step
+    return solver, duration_parameter("substep", substep, "1 ms")
 
 
 def integration(solver: str, substep: Fraction | None, default_step: Fraction | None, tolerance: float,
@@ -174,7 +170,7 @@ class ContinuousCalls:
         self._flag_refs = tuple(ctypes.byref(f) for f in self._flags)
 
     def _address(self, name: str) -> int:
-        return ctypes.cast(self.functions[name], ctypes.c_void_p).value
+        return function_address(self.functions[name])
 
     def check(self, name: str, status: int, t: float) -> None:
         if status > 1:

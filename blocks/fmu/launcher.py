@@ -1,0 +1,206 @@
+"""The FMU launcher: the process that forks the FMU hosts of a run's process.
+
+A fresh Python process with fmpy and the FMU modules imported takes about half a second
+to start; a fork of one that has them, a millisecond or two. So the first hosted FMU
+instance of a process starts the launcher (``Launcher.here``), and every host is forked
+from it (``spawn``). The launcher:
+
+- runs in a session of its own (so do the hosts it forks), so a Ctrl-C at the terminal
+  reaches only the run's process, which decides what happens to its FMUs;
+- lives as long as the run's process keeps its end of their socket open: it exits at the
+  end-of-file, also when the run's process was killed (SIGKILL included), and every host
+  it forked has asked for SIGKILL when the launcher exits (PR_SET_PDEATHSIG), so no host
+  outlives the run's process, not even one stuck in an FMU call that never returns;
+- reaps its hosts when asked and says how each ended (``ended``: the exit status), which
+  the run's process, not their parent, could not learn otherwise.
+
+A process forked from the run's process (a sweep's local runner, a forked Dask worker)
+starts a launcher of its own when it needs one (``os.register_at_fork``); the hosts it
+inherited belong to the process that made them.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import signal
+import socket
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+from ..block import BlockError
+
+STARTUP_SECONDS = 120.0
+"""How long the launcher may take to start (importing numpy and fmpy on a loaded machine)."""
+
+REAP_SECONDS = 10.0
+"""How long the launcher waits for a host to end once its end of the channel is closed."""
+
+_PR_SET_PDEATHSIG = 1
+
+
+class Launcher:
+    """The run's side of the launcher of this process."""
+
+    _lock = threading.Lock()
+    _here: tuple[int, Launcher] | None = None
+
+    @classmethod
+    def here(cls) -> Launcher:
+        """This process's launcher, started on first use."""
+        with cls._lock:
+            if cls._here is None or cls._here[0] != os.getpid() or not cls._here[1].alive:
+                cls._here = (os.getpid(), cls())
+            return cls._here[1]
+
+    @classmethod
+    def forget(cls) -> None:
+        """In a process forked from one with a launcher: that launcher is not this process's."""
+        if cls._here is not None:
+            cls._here[1].sock.close()
+        cls._here = None
+        cls._lock = threading.Lock()
+
+    def __init__(self):
+        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        root = str(Path(__file__).resolve().parents[2])
+        env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
+                   PYTHONPATH=os.pathsep.join([root, *filter(None, [os.environ.get("PYTHONPATH")])]))
+        command = [sys.executable, "-P", "-c", f"from blocks.fmu.launcher import main; main({theirs.fileno()})"]
+        try:
+            self.process = subprocess.Popen(command, pass_fds=(theirs.fileno(),), start_new_session=True,
+                                            stdin=subprocess.DEVNULL, env=env, close_fds=True)
+        finally:
+            theirs.close()
+        self.sock = ours
+        self.alive = True
+        self._owed = 0
+        """Answers to requests whose waiting was interrupted (a signal), to skip."""
+        ready = self._receive(STARTUP_SECONDS)
+        if ready != b"ready":
+            self.alive = False
+            self.process.kill()
+            code = self.process.wait()
+            raise BlockError(f"the process that runs FMUs in processes of their own did not start (exit code "
+                             f"{code}); run the FMU in this process with 'isolation: none'")
+
+    def spawn(self, fds: list[int]) -> int:
+        """Fork a host that serves the channel of ``fds`` (its socket end, the shared memory);
+        its process id."""
+        with self._lock:
+            answer = self._ask(lambda: socket.send_fds(self.sock, [b"spawn"], fds), STARTUP_SECONDS)
+        if not answer.isdigit():
+            raise BlockError(f"could not start a process for the FMU: {answer.decode(errors='replace')}")
+        return int(answer)
+
+    def ended(self, pid: int) -> int | None:
+        """Reap the host ``pid`` (its end of the channel closed, or killed): its exit status
+        (``os.waitstatus_to_exitcode``: the exit code, or minus the signal), None if unknown."""
+        with self._lock:
+            answer = self._ask(lambda: self.sock.send(b"reap %d" % pid), REAP_SECONDS + 5.0)
+        return int(answer) if answer.lstrip(b"-").isdigit() else None
+
+    def _ask(self, request, seconds: float) -> bytes:
+        """Send a request and return its answer, skipping those of requests that a signal
+        interrupted before their answer came."""
+        while self._owed and self._receive(seconds):
+            self._owed -= 1
+        request()
+        self._owed += 1
+        answer = self._receive(seconds)
+        if answer:
+            self._owed -= 1
+        return answer
+
+    def _receive(self, seconds: float) -> bytes:
+        """The launcher's next answer ('' if it is gone or silent for ``seconds``)."""
+        if not select.select([self.sock], [], [], seconds)[0]:
+            return b""
+        try:
+            answer = self.sock.recv(256)
+        except OSError:
+            answer = b""
+        if not answer:
+            self.alive = False
+        return answer
+
+
+os.register_at_fork(after_in_child=Launcher.forget)
+
+
+# -- the launcher's own side ---------------------------------------------------------------
+
+def main(fd: int) -> None:
+    """The launcher's life: import what the hosts need, then fork one per request until the
+    run's process closes its end (or dies)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    sock = socket.socket(fileno=fd)
+    from . import host
+
+    sock.send(b"ready")
+    while True:
+        try:
+            message, fds, _, _ = socket.recv_fds(sock, 256, 4)
+        except OSError:
+            break
+        if not message:
+            break
+        op, _, arg = message.partition(b" ")
+        if op == b"spawn":
+            sock.send(_fork(sock, host, fds))
+        elif op == b"reap":
+            sock.send(_reap(int(arg)))
+    os._exit(0)
+
+
+def _fork(sock: socket.socket, host, fds: list[int]) -> bytes:
+    """Fork the host of the channel ``fds``: its process id, or why not."""
+    launcher = os.getpid()
+    try:
+        pid = os.fork()
+    except OSError as exc:
+        for f in fds:
+            os.close(f)
+        return f"fork failed: {exc.strerror}".encode()
+    if pid == 0:
+        code = 0
+        try:
+            sock.close()
+            _die_with_parent()
+            if os.getppid() != launcher:  # the launcher ended before the request took hold
+                os._exit(1)
+            host.serve(*fds)
+        except BaseException:
+            code = 1
+        os._exit(code)
+    for f in fds:
+        os.close(f)
+    return str(pid).encode()
+
+
+def _die_with_parent() -> None:
+    """Ask the kernel for SIGKILL when the launcher exits (Linux: PR_SET_PDEATHSIG)."""
+    import ctypes
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+
+
+def _reap(pid: int) -> bytes:
+    """Wait (at most REAP_SECONDS) for the host ``pid`` to end: its exit status."""
+    try:
+        handle = os.pidfd_open(pid)
+    except OSError:
+        handle = None
+    try:
+        if handle is not None and not select.select([handle], [], [], REAP_SECONDS)[0]:
+            return b"unknown"
+        _, status = os.waitpid(pid, 0)
+    except ChildProcessError:
+        return b"unknown"
+    finally:
+        if handle is not None:
+            os.close(handle)
+    return str(os.waitstatus_to_exitcode(status)).encode()
