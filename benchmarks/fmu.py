@@ -51,7 +51,7 @@ def main() -> None:
     args = ap.parse_args()
     native, _ = per_simulated_second(blocks.load_diagram(ROOT / "diagrams" / "regrasp.yaml"), args.repeat)
     print(f"re-grasp, 1 s simulated, median of {args.repeat} runs after a warm-up run")
-    print(f"  {'native HandPlant':<34}: {1000 * native:7.2f} ms per simulated s")
+    print(f"  {'native HandPlant':<36}: {1000 * native:7.2f} ms per simulated s")
     with tempfile.TemporaryDirectory() as tmp:
         for fmi in (2, 3):
             fmu = export_plant_fmu(Path(tmp) / f"plant{fmi}.fmu", fmi=fmi)
@@ -62,12 +62,12 @@ def main() -> None:
                 walls[isolation], first = per_simulated_second(diagram, args.repeat)
                 ratio = walls[isolation] / native
                 where = "its own process" if isolation == "process" else "the run's process"
-                line = (f"  {f'FMU plant (FMI {fmi}), {where}':<34}: {1000 * walls[isolation]:7.2f} ms per simulated s"
+                line = (f"  {f'FMU plant (FMI {fmi}), {where}':<36}: {1000 * walls[isolation]:7.2f} ms per simulated s"
                         f"   ratio to native {ratio:5.2f}")
                 if isolation == "none":
                     line += f"   target <= {TARGET_RATIO}: {'met' if ratio <= TARGET_RATIO else 'MISSED'}"
                 print(line + f"   (first run {1000 * first:.0f} ms)")
-            print(f"  {f'isolated / in-process (FMI {fmi})':<34}: {walls['process'] / walls['none']:7.2f}")
+            print(f"  {f'isolated / in-process (FMI {fmi})':<36}: {walls['process'] / walls['none']:7.2f}")
 
 
 if __name__ == "__main__":

@@ -16,6 +16,12 @@
  * As the Python side does around each step: before it, the interrupt hook is looked at
  * and FMI 2's log proxy re-armed; after doStep, interrupt.check() raises a Ctrl-C that an
  * FMU callback noted (blocks/fmu/interrupt.py).
+ *
+ * An instance hosted in a process of its own (FMU_CHANNEL, blocks/fmu/hosted.py) steps
+ * the same way through its channel instead (hosted_step): the inputs into the channel's
+ * values, one round trip (fmu_host.c), the outputs out of them; the host makes the FMI
+ * calls (fmu_calls.h, shared with this file). Anything but a plain success goes to slow
+ * as FMU_SLOW_HOSTED, with how waiting ended.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>

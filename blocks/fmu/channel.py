@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..block import BlockError
+from . import native as compiled
 from .solvers import CallFailed, SolverError
 
 _LENGTH = struct.Struct("<Q")
@@ -43,9 +44,7 @@ class ChannelClosed(EOFError):
 @functools.cache
 def native() -> dict[str, Any]:
     """The channel's C functions, layout and codes (``blocks._native.fmu_kernel()["host"]``)."""
-    from .kernel import native as kernel_native
-
-    found = kernel_native()
+    found = compiled.native()
     if found is None:
         raise BlockError("running an FMU in a process of its own needs the compiled extension blocks._native, "
                          "which is not built (reinstall with 'pip install -e .')")

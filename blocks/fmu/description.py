@@ -15,7 +15,6 @@ from __future__ import annotations
 import errno
 import io
 import math
-import os
 import zipfile
 from dataclasses import dataclass
 from fractions import Fraction

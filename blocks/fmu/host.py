@@ -29,7 +29,8 @@ import os
 import socket
 from typing import Any, Callable
 
-from .channel import Region, encode, native, ports_of, receive, send
+from . import native as compiled
+from .channel import Region, encode, native, ports_of, put_ports, receive, send
 from .cosimulation import CoSimulation
 from .exchange import ModelExchange
 from .instance import Binary, Instance, call_failed
@@ -129,9 +130,14 @@ class Host:
 
     # -- requests -------------------------------------------------------------------------
 
+    REQUESTS = ("instantiate", "start", "read", "stop", "free")
+    """The messages the run sends, each answered by the method of its name."""
+
     def handle(self, request: tuple) -> tuple:
         what, *args = request
         try:
+            if what not in self.REQUESTS:
+                raise ValueError(f"the FMU host got an unknown request {what!r}")
             return ("ok", getattr(self, what)(*args))
         except Exception as exc:
             self.ready(False)
@@ -171,7 +177,7 @@ class Host:
     def step(self, kind: int, status: int) -> tuple:
         """A step that the C loop did not finish (``kind``: the call that was not a plain
         success, 0 for a step it did not take) and what it came to."""
-        inst, kinds = self.inst, native_kinds()
+        inst, kinds = self.inst, compiled.native()["kinds"]
         t, h = self.region.asked
         read_error = None
         try:
@@ -202,16 +208,13 @@ class Host:
         except Exception as exc:
             self.ready(False)
             return encode(exc)
-        first = 0
-        for name, width in self.outputs:
-            self.region.outputs[first:first + width] = got[name]
-            first += width
+        put_ports(self.region.outputs, self.outputs, got)
         return None
 
     def ready(self, ready: bool) -> None:
         """Whether the C loop may answer the next steps by itself."""
         if self.table is not None:
-            self.table[native_slots()["ready"]] = int(ready)
+            self.table[compiled.native()["slots"]["ready"]] = int(ready)
 
     def _trace(self, inst: Instance) -> None:
         """The C loops of a model-exchange instance name their calls too (fmu_me.c's ME_TRACE)."""
@@ -230,7 +233,7 @@ class Host:
         """The FMU_* table (fmu.h) of the C loop's steady step, on the channel's values."""
         import numpy as np
 
-        slots = native_slots()
+        slots = compiled.native()["slots"]
         table = np.zeros(slots["ports"], dtype=np.int64)
         names = {}
         for verb, transfers, buf in (("set", inst.writes, self.region.inputs_address),
@@ -256,20 +259,6 @@ class Host:
             for i, flag in enumerate(inst.step_flags):
                 table[slots["flags"] + i] = ctypes.addressof(flag)
         return table
-
-
-@functools.cache
-def native_slots() -> dict[str, int]:
-    from .kernel import native as kernel_native
-
-    return kernel_native()["slots"]
-
-
-@functools.cache
-def native_kinds() -> dict[str, int]:
-    from .kernel import native as kernel_native
-
-    return kernel_native()["kinds"]
 
 
 def serve(sock_fd: int, region_fd: int) -> None:

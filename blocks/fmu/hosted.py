@@ -55,7 +55,6 @@ class HostedInstance:
     hosted = True
 
     def __init__(self, model: Binary):
-        codes = native()["codes"]
         self.model = model
         self.timeout = model.timeout
         self.started = self.used = self.broken = self.freed = False
@@ -65,7 +64,6 @@ class HostedInstance:
         """How the host ended once reaped: its exit code, or minus the signal that ended it."""
         self.reaped = False
         self.owner = os.getpid()
-        self._answered, self._done, self._step = codes["answered"], codes["done"], codes["step"]
         self._outputs_at: float | None = None
         """The time of the outputs in the channel (read with the last step), if any."""
         self._read_error: Exception | None = None
@@ -84,7 +82,11 @@ class HostedInstance:
             theirs.close()
         self.sock = ours
         self.sock.settimeout(self.timeout)
-        self._message(("instantiate", model, model.in_ports, model.out_ports), "instantiating it")
+        try:
+            self._message(("instantiate", model, model.in_ports, model.out_ports), "instantiating it")
+        except BaseException:
+            self.free()  # the host of an FMU that did not instantiate ends (and is reaped) here
+            raise
 
     # -- the surface of Instance ------------------------------------------------------------
 
@@ -145,7 +147,7 @@ class HostedInstance:
             raise self._gone(self._step_text(t, h))
         if waited == codes["late"]:
             raise self._late(self._step_text(t, h))
-        if self.region.answer == self._done:
+        if self.region.answer == codes["done"]:
             self._outputs(t + h, None)
             return False, False, t + h
         reply = self._reply(self._step_text(t, h))
@@ -204,6 +206,8 @@ class HostedInstance:
         process, and not left inside a call that was stopped (its host is killed then)."""
         if self.inherited:
             raise BlockError(f"{self.model.shown}: this FMU instance belongs to the process that made it")
+        if self.reaped:
+            raise BlockError(f"{self.model.shown}: the FMU's process has ended")
         if self.killed or self.region.pending:
             self._abandon()
             raise BlockError(f"{self.model.shown}: the FMU was stopped inside a call and cannot be used again")
@@ -260,7 +264,10 @@ class HostedInstance:
         status = self._end()
         shown = self.model.shown
         if status is not None and status < 0:
-            name = signal.Signals(-status).name if -status in signal.Signals._value2member_map_ else f"signal {-status}"
+            try:
+                name = signal.Signals(-status).name
+            except ValueError:
+                name = f"signal {-status}"
             meaning = SIGNALS.get(name)
             text = (f"{shown} crashed in {where}: {name}" + (f" ({meaning})" if meaning else "")
                     + " ended the process that ran it")
@@ -283,7 +290,7 @@ class HostedInstance:
     def _abandon(self) -> None:
         """The host is left inside a call (or its state is unknown): kill it, break the instance."""
         self.broken = True
-        if not self.killed and not self.inherited:
+        if not self.killed and not self.inherited and not self.reaped:  # a reaped host's pid may be another's
             self.killed = True
             try:
                 os.kill(self.pid, signal.SIGKILL)

@@ -17,6 +17,12 @@ initialising it with the inputs of that moment), a step the Python update would 
 a call that returned worse than a warning, a doStep that asks to terminate or returned
 early. So messages, EndRun and Ctrl-C are the Python methods' own, and the values that
 reach the FMU and come back are the same, to the last bit.
+
+An instance in a process of its own (``hosted.HostedInstance``) has the same kernel: its
+table holds the instance's channel instead of the FMU's functions (``attach_hosted``), the
+C step writes the inputs into the channel and reads the outputs from it, and a step that
+was not a plain success (or whose host ended or timed out, or a signal that came while
+it waited) is handed to ``hosted`` with how the waiting ended.
 """
 
 from __future__ import annotations
@@ -31,20 +37,10 @@ from ..block import EndRun
 from ..compiled import failure
 from ..kernel import END_RUN, Kernel, address
 from . import interrupt
+from .native import native
 from .hosted import HostedInstance
 from .instance import Instance, call_failed
 from .log_messages import fmi2_logger_arming
-
-
-@functools.cache
-def native() -> dict[str, Any] | None:
-    """The C functions and context layout (``fmu_kernel()`` of blocks._native); None
-    when the extension is not built."""
-    try:
-        from .. import _native
-    except ImportError:
-        return None
-    return _native.fmu_kernel()
 
 
 def fmu_kernel(block: Any) -> Kernel | None:

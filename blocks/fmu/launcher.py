@@ -1,4 +1,4 @@
-"""The FMU launcher: the process that forks the FMU hosts of a run's process.
+"""The FMU launcher, as the run's process sees it: the process that forks its FMU hosts.
 
 A fresh Python process with fmpy and the FMU modules imported takes about half a second
 to start; a fork of one that has them, a millisecond or two. So the first hosted FMU
@@ -14,6 +14,8 @@ from it (``spawn``). The launcher:
 - reaps its hosts when asked and says how each ended (``ended``: the exit status), which
   the run's process, not their parent, could not learn otherwise.
 
+The launcher's own side is ``forkserver``.
+
 A process forked from the run's process (a sweep's local runner, a forked Dask worker)
 starts a launcher of its own when it needs one (``os.register_at_fork``); the hosts it
 inherited belong to the process that made them.
@@ -23,7 +25,6 @@ from __future__ import annotations
 
 import os
 import select
-import signal
 import socket
 import subprocess
 import sys
@@ -37,8 +38,6 @@ STARTUP_SECONDS = 120.0
 
 REAP_SECONDS = 10.0
 """How long the launcher waits for a host to end once its end of the channel is closed."""
-
-_PR_SET_PDEATHSIG = 1
 
 
 class Launcher:
@@ -68,7 +67,7 @@ class Launcher:
         root = str(Path(__file__).resolve().parents[2])
         env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
                    PYTHONPATH=os.pathsep.join([root, *filter(None, [os.environ.get("PYTHONPATH")])]))
-        command = [sys.executable, "-P", "-c", f"from blocks.fmu.launcher import main; main({theirs.fileno()})"]
+        command = [sys.executable, "-P", "-c", f"from blocks.fmu.forkserver import main; main({theirs.fileno()})"]
         try:
             self.process = subprocess.Popen(command, pass_fds=(theirs.fileno(),), start_new_session=True,
                                             stdin=subprocess.DEVNULL, env=env, close_fds=True)
@@ -128,79 +127,3 @@ class Launcher:
 
 
 os.register_at_fork(after_in_child=Launcher.forget)
-
-
-# -- the launcher's own side ---------------------------------------------------------------
-
-def main(fd: int) -> None:
-    """The launcher's life: import what the hosts need, then fork one per request until the
-    run's process closes its end (or dies)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    sock = socket.socket(fileno=fd)
-    from . import host
-
-    sock.send(b"ready")
-    while True:
-        try:
-            message, fds, _, _ = socket.recv_fds(sock, 256, 4)
-        except OSError:
-            break
-        if not message:
-            break
-        op, _, arg = message.partition(b" ")
-        if op == b"spawn":
-            sock.send(_fork(sock, host, fds))
-        elif op == b"reap":
-            sock.send(_reap(int(arg)))
-    os._exit(0)
-
-
-def _fork(sock: socket.socket, host, fds: list[int]) -> bytes:
-    """Fork the host of the channel ``fds``: its process id, or why not."""
-    launcher = os.getpid()
-    try:
-        pid = os.fork()
-    except OSError as exc:
-        for f in fds:
-            os.close(f)
-        return f"fork failed: {exc.strerror}".encode()
-    if pid == 0:
-        code = 0
-        try:
-            sock.close()
-            _die_with_parent()
-            if os.getppid() != launcher:  # the launcher ended before the request took hold
-                os._exit(1)
-            host.serve(*fds)
-        except BaseException:
-            code = 1
-        os._exit(code)
-    for f in fds:
-        os.close(f)
-    return str(pid).encode()
-
-
-def _die_with_parent() -> None:
-    """Ask the kernel for SIGKILL when the launcher exits (Linux: PR_SET_PDEATHSIG)."""
-    import ctypes
-
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-
-
-def _reap(pid: int) -> bytes:
-    """Wait (at most REAP_SECONDS) for the host ``pid`` to end: its exit status."""
-    try:
-        handle = os.pidfd_open(pid)
-    except OSError:
-        handle = None
-    try:
-        if handle is not None and not select.select([handle], [], [], REAP_SECONDS)[0]:
-            return b"unknown"
-        _, status = os.waitpid(pid, 0)
-    except ChildProcessError:
-        return b"unknown"
-    finally:
-        if handle is not None:
-            os.close(handle)
-    return str(os.waitstatus_to_exitcode(status)).encode()

@@ -4,8 +4,11 @@ Instantiating an FMU (loading its binary, allocating its memory) costs far more 
 resetting one, and an FMU may allow only one instance per process, so a block keeps the
 instances its runs gave back and hands them to the next runs. ``PooledModel`` is the
 block's ``Model`` with that pool: a run takes an idle instance (reset when it starts) or a
-new one, extracting the archive the first time a run needs one; giving it back terminates
-the FMU's simulation and pools the instance, or frees it if it failed. Closing the block,
+new one (in this process, or for ``isolation: process`` in a process of its own,
+``hosted``), extracting the archive the first time a run needs one; giving it back
+terminates the FMU's simulation and pools the instance, or frees it if it failed. A
+process forked from this one drops the isolated instances it inherited (their hosts
+belong to the parent) and makes its own. Closing the block,
 or its going away, frees the idle instances and, once no run holds one, the extracted
 files.
 """

@@ -36,6 +36,7 @@ import numpy as np
 from ..kernel import address
 from ..timebase import format_duration
 from . import interrupt
+from .native import native
 from .instance import function_address
 from .model import duration_parameter
 from .sundials import CV_NORMAL, CV_ROOT_RETURN
@@ -114,8 +115,6 @@ def integration(solver: str, substep: Fraction | None, default_step: Fraction | 
 @functools.cache
 def layout() -> dict[str, Any]:
     """The C functions and the table's layout (fmu_me.h), from blocks._native."""
-    from .kernel import native
-
     found = native()
     if found is None:
         raise SolverError("model exchange needs the compiled extension blocks._native, which is not built "
