@@ -8,13 +8,15 @@
  * that Ctrl-C and SIGTERM stop a run whose FMU never returns.
  *
  * The host's end (blocks/fmu/host.py): serve waits for the next request the same way
- * (slices of HOST_IDLE_NS, ending when the run's process is gone) and answers a steady
+ * (HOST_IDLE_SPIN_NS, then slices of HOST_IDLE_NS, ending when the run's process is gone;
+ * the spins of both sides adapt, see spin) and answers a steady
  * step of a co-simulation FMU with Float64 ports by itself, through the FMU's functions
  * (fmu_calls.h) on the channel's values, tracing each call's name into the channel. Any
  * other request, and a step that was not a plain success, goes back to Python.
  *
  * Linux only (futexes); elsewhere isolation is refused in Python and these are not called.
  */
+#define _GNU_SOURCE
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
 
@@ -26,6 +28,7 @@
 
 #ifdef __linux__
 #include <errno.h>
+#include <sched.h>
 #include <limits.h>
 #include <linux/futex.h>
 #include <poll.h>
@@ -38,7 +41,8 @@
 #include "fmu_calls.h"
 #include "fmu_host.h"
 
-#define HOST_SPIN_NS 50000LL        /* how long a side spins before it sleeps */
+#define HOST_SPIN_NS 50000LL        /* how long the run's side spins for an answer before it sleeps */
+#define HOST_IDLE_SPIN_NS 50000LL   /* how long the host spins for the next request before it sleeps */
 #define HOST_TRUST 16               /* a side's trust in spinning after a spin that paid */
 #define HOST_PROBE 64               /* without trust, every HOST_PROBE-th wait spins all the same */
 #define HOST_SLICE_NS 10000000LL    /* the run's sleeps between looking at the host and at signals */
@@ -92,10 +96,10 @@ static bool closed(int fd) { (void)fd; return true; }
 
 #endif
 
-/* Spin until *word differs from seen, for at most HOST_SPIN_NS: whether it did. */
-static bool spin_for(uint32_t *word, uint32_t seen)
+/* Spin until *word differs from seen, for at most ns nanoseconds: whether it did. */
+static bool spin_for(uint32_t *word, uint32_t seen, int64_t ns)
 {
-    int64_t until = now_ns() + HOST_SPIN_NS;
+    int64_t until = now_ns() + ns;
     for (;;) {
         for (int i = 0; i < 64; i++) {
             if (__atomic_load_n(word, __ATOMIC_ACQUIRE) != seen)
@@ -107,21 +111,34 @@ static bool spin_for(uint32_t *word, uint32_t seen)
     }
 }
 
-/* Spin while spinning pays: *trust (the side's own field of the channel) is set to
-   HOST_TRUST by a spin that saw the change and halved by one that did not, and without
-   trust only every HOST_PROBE-th wait spins (to find out whether it pays again). When both
-   processes share one processor, the other side cannot move while this one spins. */
-static bool spin(uint32_t *word, uint32_t seen, int32_t *trust, uint32_t count)
+/* The processor this thread runs on (-1 if unknown). */
+static int this_cpu(void)
 {
-    if (*trust <= 0 && count % HOST_PROBE != 0)
+#ifdef __linux__
+    return sched_getcpu();
+#else
+    return -1;
+#endif
+}
+
+/* Spin while spinning pays. Not at all while the other side last ran on this processor
+   (other, its field of the channel): it cannot move while this one spins. Else *trust
+   (this side's field) is set to HOST_TRUST by a spin that saw the change and halved by one
+   that did not, and without trust only every HOST_PROBE-th wait spins (to find out whether
+   it pays again). */
+static bool spin(uint32_t *word, uint32_t seen, int32_t *trust, int32_t other, uint32_t count, int64_t ns)
+{
+    int cpu = this_cpu();
+    if ((cpu >= 0 && cpu == other) || (*trust <= 0 && count % HOST_PROBE != 0))
         return __atomic_load_n(word, __ATOMIC_ACQUIRE) != seen;
-    bool changed = spin_for(word, seen);
+    bool changed = spin_for(word, seen, ns);
     *trust = changed ? HOST_TRUST : *trust / 2;
     return changed;
 }
 
 void blk_host_post(host_channel *ch)
 {
+    ch->parent_cpu = this_cpu();
     __atomic_store_n(&ch->request, ch->request + 1, __ATOMIC_SEQ_CST);
     if (__atomic_load_n(&ch->host_waiting, __ATOMIC_SEQ_CST))
         futex_wake(&ch->request);
@@ -135,7 +152,7 @@ int blk_host_wait(host_channel *ch, int fd, double timeout)
     int64_t start = now_ns(), limit = start + (int64_t)(timeout * 1e9);
     PyThreadState *released = PyEval_SaveThread();
     int outcome = HOST_ANSWERED;
-    if (!spin(&ch->reply, target - 1, &ch->parent_spins, target) ||
+    if (!spin(&ch->reply, target - 1, &ch->parent_spins, ch->host_cpu, target, HOST_SPIN_NS) ||
         __atomic_load_n(&ch->reply, __ATOMIC_ACQUIRE) != target) {
         for (;;) {
             __atomic_store_n(&ch->parent_waiting, 1, __ATOMIC_SEQ_CST);
@@ -171,7 +188,7 @@ int blk_host_wait(host_channel *ch, int fd, double timeout)
 static bool next_request(host_channel *ch, int fd)
 {
     uint32_t answered = ch->reply;
-    if (spin(&ch->request, answered, &ch->host_spins, answered))
+    if (spin(&ch->request, answered, &ch->host_spins, ch->parent_cpu, answered, HOST_IDLE_SPIN_NS))
         return true;
     for (;;) {
         __atomic_store_n(&ch->host_waiting, 1, __ATOMIC_SEQ_CST);
@@ -194,6 +211,7 @@ static bool next_request(host_channel *ch, int fd)
 static void answer(host_channel *ch, int how)
 {
     ch->answer = how;
+    ch->host_cpu = this_cpu();
     __atomic_store_n(&ch->reply, ch->request, __ATOMIC_SEQ_CST);
     if (__atomic_load_n(&ch->parent_waiting, __ATOMIC_SEQ_CST))
         futex_wake(&ch->reply);

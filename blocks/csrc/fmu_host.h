@@ -31,6 +31,8 @@ typedef struct {
     int32_t answer;          /* how it was answered: HOST_DONE or HOST_MESSAGE */
     int32_t parent_spins;    /* how much each side trusts spinning (each writes its own): */
     int32_t host_spins;      /* spins that came to nothing lower it, see fmu_host.c */
+    int32_t parent_cpu;      /* the processor each side last ran on (each writes its own): */
+    int32_t host_cpu;        /* spinning on the other side's processor cannot pay */
     double t, h;             /* HOST_STEP: from t over h */
     int64_t inputs;          /* where the input values start (bytes from the channel's start), */
     int64_t outputs;         /* and the output values */

@@ -76,6 +76,11 @@ class Region:
         self.outputs_address = self.address + end
         self.call_address = self.address + layout["call"]
         self._marks: dict[str, bytes] = {}
+        self._words = np.frombuffer(self.map, dtype=np.int32, count=layout["t"] // 4)
+        """The header's 32-bit words (the counters, command and answer), for reading and writing them fast."""
+        self._step = np.frombuffer(self.map, dtype=np.float64, count=2, offset=layout["t"])
+        """The step asked for, (t, h): adjacent in the header."""
+        self._step_code = native()["codes"]["step"]
 
     @classmethod
     def create(cls, n_in: int, n_out: int) -> Region:
@@ -91,30 +96,32 @@ class Region:
     @property
     def pending(self) -> bool:
         """Whether a request has not been answered (a call the run stopped waiting for)."""
-        return self._get("I", "request") != self._get("I", "reply")
+        words, at = self._words, self.at
+        return words[at["request"] // 4] != words[at["reply"] // 4]
 
     @property
     def command(self) -> int:
-        return self._get("i", "command")
+        return int(self._words[self.at["command"] // 4])
 
     @command.setter
     def command(self, value: int) -> None:
-        self._put("i", "command", value)
+        self._words[self.at["command"] // 4] = value
 
     @property
     def answer(self) -> int:
-        return self._get("i", "answer")
+        return int(self._words[self.at["answer"] // 4])
 
     def step(self, t: float, h: float) -> None:
         """Ask for the step from ``t`` over ``h`` (the inputs already in place)."""
-        self._put("i", "command", native()["codes"]["step"])
-        self._put("d", "t", t)
-        self._put("d", "h", h)
+        self._words[self.at["command"] // 4] = self._step_code
+        self._step[0] = t
+        self._step[1] = h
 
     @property
     def asked(self) -> tuple[float, float]:
         """The step asked for: (t, h)."""
-        return self._get("d", "t"), self._get("d", "h")
+        t, h = self._step
+        return float(t), float(h)
 
     # -- the call traced and the log --------------------------------------------------
 
@@ -156,7 +163,7 @@ class Region:
 
     def close(self) -> None:
         """Unmap the region and close its file (views of it must be gone)."""
-        self.inputs = self.outputs = self.bytes = None
+        self.inputs = self.outputs = self.bytes = self._words = self._step = None
         try:
             self.map.close()
         except BufferError:  # a view of it is still alive somewhere: the map goes with it

@@ -105,6 +105,8 @@ class Host:
         self.inst: Instance | None = None
         self.inputs: list[tuple[str, int]] = []
         self.outputs: list[tuple[str, int]] = []
+        self.input_views: dict[str, Any] = {}
+        """The input ports' values in the channel (views), as the instance reads them."""
         self.table: Any = None
         """The FMU_* table of the steady step in C (fmu.h), for a co-simulation FMU with
         Float64 ports only; None for one that steps here."""
@@ -121,10 +123,10 @@ class Host:
             command, kind, status = serve(address, fd, table)
             if command == self.codes["orphan"]:
                 return
-            if command == self.codes["step"]:
-                reply = self.step(kind, status)
-            else:
-                reply = self.handle(receive(self.sock))
+            reply = self.step(kind, status) if command == self.codes["step"] else self.handle(receive(self.sock))
+            if reply is None:  # a step that was a plain success: the outputs are in the channel
+                answer(address, self.codes["done"])
+                continue
             answer(address, self.codes["message"])
             send(self.sock, reply)
 
@@ -147,6 +149,7 @@ class Host:
         cls = hosted_class(instance_class(binary))
         cls.region = self.region
         self.inputs, self.outputs = inputs, outputs
+        self.input_views = ports_of(self.region.inputs, inputs)
         self.inst = inst = cls(binary)
         self._trace(inst)
         if isinstance(inst, CoSimulation) and all(x.kind.name == "Float64" for x in (*inst.writes, *inst.reads)):
@@ -154,8 +157,7 @@ class Host:
 
     def start(self, t: float, assignments: list, tolerance: float | None) -> tuple | None:
         self.ready(False)
-        inputs = ports_of(self.region.inputs, self.inputs)
-        self.inst.start(t, assignments, tolerance, inputs)
+        self.inst.start(t, assignments, tolerance, self.input_views)
         error = self._read(t)
         self.ready(error is None)
         return error
@@ -174,15 +176,16 @@ class Host:
         if self.inst is not None:
             self.inst.free()
 
-    def step(self, kind: int, status: int) -> tuple:
+    def step(self, kind: int, status: int) -> tuple | None:
         """A step that the C loop did not finish (``kind``: the call that was not a plain
-        success, 0 for a step it did not take) and what it came to."""
+        success, 0 for a step it did not take) and what it came to: None for a plain success
+        (the outputs at the step's end are in the channel), else the answer to send."""
         inst, kinds = self.inst, compiled.native()["kinds"]
         t, h = self.region.asked
         read_error = None
         try:
             if kind == 0:
-                outcome = inst.step(ports_of(self.region.inputs, self.inputs), t, h)
+                outcome = inst.step(self.input_views, t, h)
             elif kind == kinds["set"]:
                 raise call_failed(inst.writes[0].function, status)
             elif kind == kinds["step"]:
@@ -195,8 +198,9 @@ class Host:
         terminate, early, last = outcome
         if read_error is None and not early:
             read_error = self._read(last if terminate else t + h)
-        if terminate or early or read_error is not None:
-            self.ready(False)
+        if not (terminate or early or read_error is not None):
+            return None
+        self.ready(False)
         return ("outcome", outcome, read_error)
 
     # -- helpers ----------------------------------------------------------------------------

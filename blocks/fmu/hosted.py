@@ -70,6 +70,8 @@ class HostedInstance:
         n_in = sum(width for _, width in model.in_ports)
         n_out = sum(width for _, width in model.out_ports)
         self.region = Region.create(n_in, n_out)
+        functions = native()
+        self._post, self._wait, self._codes = functions["post"], functions["wait"], functions["codes"]
         ours, theirs = socket.socketpair()
         self.launcher = Launcher.here()
         try:
@@ -126,10 +128,9 @@ class HostedInstance:
         self._usable()
         put_ports(self.region.inputs, self.model.in_ports, inputs)
         self.region.step(t, h)
-        wait = native()["wait"]
-        native()["post"](self.region.address)
+        self._post(self.region.address)
         try:
-            waited = wait(self.region.address, self.sock.fileno(), self.timeout)
+            waited = self._wait(self.region.address, self.sock.fileno(), self.timeout)
         except BaseException:
             self._abandon()
             raise
@@ -142,7 +143,7 @@ class HostedInstance:
     def finish_step(self, waited: int, t: float, h: float) -> tuple[bool, bool, float]:
         """What the step from ``t`` came to, once waiting for it ended with ``waited``
         (HOST_ANSWERED, HOST_GONE, HOST_LATE; the kernel waits in C and hands over here)."""
-        codes = native()["codes"]
+        codes = self._codes
         if waited == codes["gone"]:
             raise self._gone(self._step_text(t, h))
         if waited == codes["late"]:
@@ -216,9 +217,9 @@ class HostedInstance:
         """Send ``request`` and return the value of its answer (an error raised as it was);
         ``during`` says what the request is, for a failure's message."""
         region = self.region
-        region.command = native()["codes"]["message"]
+        region.command = self._codes["message"]
         try:
-            native()["post"](region.address)
+            self._post(region.address)
             send(self.sock, request)
         except BaseException as exc:
             if isinstance(exc, OSError) and not isinstance(exc, TimeoutError):
