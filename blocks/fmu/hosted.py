@@ -22,6 +22,7 @@ logger as a warning, and the results stand.
 from __future__ import annotations
 
 import os
+import select
 import signal
 import socket
 from collections.abc import Mapping
@@ -73,8 +74,8 @@ class HostedInstance:
         functions = native()
         self._post, self._wait, self._codes = functions["post"], functions["wait"], functions["codes"]
         ours, theirs = socket.socketpair()
-        self.launcher = Launcher.here()
         try:
+            self.launcher = Launcher.here()
             self.pid = self.launcher.spawn([theirs.fileno(), self.region.fd])
         except BaseException:
             ours.close()
@@ -97,6 +98,18 @@ class HostedInstance:
         """Whether this is a copy in a process forked from the one that made it (whose host
         is not this process's)."""
         return self.owner != os.getpid()
+
+    @property
+    def usable(self) -> bool:
+        """Whether a pooled instance can serve another run: this process's, and its host
+        alive (one that ended while idle, killed by another program or with its launcher,
+        is broken)."""
+        if self.inherited or self.broken:
+            return False
+        if not self.launcher.running or select.select([self.sock], [], [], 0)[0]:  # readable: its end closed
+            self.broken = True
+            return False
+        return True
 
     def arm(self) -> None:
         """Nothing to arm: the FMU's callbacks run in its own process."""

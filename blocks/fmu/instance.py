@@ -116,8 +116,8 @@ class Instance:
 
     value_counts = False
     """Whether the get and set functions also take the number of values (FMI 3)."""
-    inherited = False
-    """Whether the instance belongs to another process (never, for one in this process's memory)."""
+    usable = True
+    """Whether a pooled instance can serve another run (always, for one in this process's memory)."""
 
     def __init__(self, model: Binary):
         fmpy = import_fmpy()

@@ -50,9 +50,17 @@ class Launcher:
     def here(cls) -> Launcher:
         """This process's launcher, started on first use."""
         with cls._lock:
-            if cls._here is None or cls._here[0] != os.getpid() or not cls._here[1].alive:
+            if cls._here is None or cls._here[0] != os.getpid() or not cls._here[1].running:
                 cls._here = (os.getpid(), cls())
             return cls._here[1]
+
+    @property
+    def running(self) -> bool:
+        """Whether the launcher still runs (it may have been killed by another program)."""
+        if self.alive and self.process.poll() is not None:
+            self.alive = False
+            self.sock.close()
+        return self.alive
 
     @classmethod
     def forget(cls) -> None:
@@ -77,19 +85,34 @@ class Launcher:
         self.alive = True
         self._owed = 0
         """Answers to requests whose waiting was interrupted (a signal), to skip."""
-        ready = self._receive(STARTUP_SECONDS)
+        try:
+            ready = self._receive(STARTUP_SECONDS)
+        except BaseException:  # a signal while it starts: it does not outlive this
+            self._stop()
+            raise
         if ready != b"ready":
-            self.alive = False
-            self.process.kill()
-            code = self.process.wait()
+            code = self._stop()
             raise BlockError(f"the process that runs FMUs in processes of their own did not start (exit code "
                              f"{code}); run the FMU in this process with 'isolation: none'")
+
+    def _stop(self) -> int:
+        """Kill a launcher that did not start, and reap it: its exit code."""
+        self.alive = False
+        self.sock.close()
+        self.process.kill()
+        return self.process.wait()
 
     def spawn(self, fds: list[int]) -> int:
         """Fork a host that serves the channel of ``fds`` (its socket end, the shared memory);
         its process id."""
         with self._lock:
-            answer = self._ask(lambda: socket.send_fds(self.sock, [b"spawn"], fds), STARTUP_SECONDS)
+            try:
+                answer = self._ask(lambda: socket.send_fds(self.sock, [b"spawn"], fds), STARTUP_SECONDS)
+            except OSError:
+                self.alive, answer = False, b""
+        if not answer:
+            raise BlockError("could not start a process for the FMU: the process that starts them has ended "
+                             "(the next run starts it again)")
         if not answer.isdigit():
             raise BlockError(f"could not start a process for the FMU: {answer.decode(errors='replace')}")
         return int(answer)
@@ -98,7 +121,10 @@ class Launcher:
         """Reap the host ``pid`` (its end of the channel closed, or killed): its exit status
         (``os.waitstatus_to_exitcode``: the exit code, or minus the signal), None if unknown."""
         with self._lock:
-            answer = self._ask(lambda: self.sock.send(b"reap %d" % pid), REAP_SECONDS + 5.0)
+            try:
+                answer = self._ask(lambda: self.sock.send(b"reap %d" % pid), REAP_SECONDS + 5.0)
+            except OSError:
+                self.alive, answer = False, b""
         return int(answer) if answer.lstrip(b"-").isdigit() else None
 
     def _ask(self, request, seconds: float) -> bytes:

@@ -8,7 +8,8 @@ new one (in this process, or for ``isolation: process`` in a process of its own,
 ``hosted``), extracting the archive the first time a run needs one; giving it back
 terminates the FMU's simulation and pools the instance, or frees it if it failed. A
 process forked from this one drops the isolated instances it inherited (their hosts
-belong to the parent) and makes its own. Closing the block,
+belong to the parent) and makes its own, and an isolated instance whose process ended
+while it was idle is dropped too. Closing the block,
 or its going away, frees the idle instances and, once no run holds one, the extracted
 files.
 """
@@ -63,15 +64,15 @@ class PooledModel(Model):
         with self.lock:
             if self.closed:
                 raise BlockError(f"{self.shown}: the FMU block was closed")
-            inherited = [inst for inst in self.idle if inst.inherited]
-            self.idle[:] = [inst for inst in self.idle if not inst.inherited]
+            unusable = [inst for inst in self.idle if not inst.usable]
+            self.idle[:] = [inst for inst in self.idle if inst not in unusable]
             inst = self.idle.pop() if self.idle else None
             if inst is None and self.once_per_process and self.live and self.isolation == "none":
                 raise BlockError(f"{self.shown} can be instantiated only once per process, and its "
                                  "instance is in use by another run")
             self.live += 1
-        for copy in inherited:  # a forked process's copies of another process's hosted instances
-            copy.free()
+        for gone in unusable:  # copies of another process's hosted instances, or ones whose host ended
+            gone.free()
         if inst is None:
             try:
                 inst = new_instance(self._extracted())

@@ -306,3 +306,18 @@ def test_a_well_behaved_misbehaving_fmu_is_the_first_order_fmu(tmp_path, misbeha
     path = misbehaving_fmu(tmp_path / "tame.fmu", "cs2", misbehaving["cs2"])
     same(simulate(diagram(fmus.fmi2, params="isolation: none")), simulate(diagram(path)))
 
+
+
+def test_runs_go_on_when_the_fmu_processes_were_killed_between_them(fmus):
+    """Another program kills the launcher (and with it the idle FMU process of the block's
+    pool): the next run starts both again."""
+    from blocks.fmu.launcher import Launcher
+
+    d = diagram(fmus.fmi2, params="isolation: process")
+    first = simulate(d)
+    gc.collect()                                                  # the run's instance back in the pool
+    launcher = Launcher.here().process
+    launcher.kill()
+    launcher.wait(timeout=60)
+    same(first, simulate(d))
+    assert Launcher.here().process.pid != launcher.pid
