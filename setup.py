@@ -3,7 +3,9 @@
 Metadata lives in pyproject.toml; this file only declares what is compiled, because
 setuptools' extension support is the build path every pip and every Python install
 already has (no CMake, no code generator). The framework's extension ``blocks._native``
-runs the compiled parts of event programs and holds the FMU block's kernel (``blocks/csrc``). Besides the extension ``hierhand._native``
+is the CPython host (``host.c``) of the op-table interpreter (``core.c``, plain C99 that
+needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``). Besides
+the extension ``hierhand._native``
 the build links two plain shared libraries from the same C sources,
 ``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so``, that ``hierhand fmu export`` copies
 into FMUs, so exporting needs no compiler. They link libc and libm only; their FMI
@@ -71,10 +73,9 @@ setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/runner.c", f"{BLOCKS_CSRC}/library.c", f"{BLOCKS_CSRC}/fmu.c",
-                     f"{BLOCKS_CSRC}/fmu_me.c", f"{BLOCKS_CSRC}/fmu_host.c"],
-            depends=[f"{BLOCKS_CSRC}/blocks_kernel.h", f"{BLOCKS_CSRC}/library.h", f"{BLOCKS_CSRC}/fmu.h",
-                     f"{BLOCKS_CSRC}/fmu_me.h", f"{BLOCKS_CSRC}/fmu_calls.h", f"{BLOCKS_CSRC}/fmu_host.h"],
+            sources=[f"{BLOCKS_CSRC}/{name}.c" for name in ("host", "core", "library", "fmu", "fmu_me", "fmu_host")],
+            depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "fmu", "fmu_me",
+                                                             "fmu_calls", "fmu_host")],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),

@@ -141,7 +141,21 @@ class Block:
     connection between ports of different types is a conversion, which ``validate``
     lists with the rules of ``input_rule`` / ``output_rule``."""
 
-    # -- configuration hooks, called by the diagram loader -------------------------
+    def __new__(cls, *args: Any, **kwargs: Any):
+        # the arguments the constructor is called with, for constructor_arguments()
+        self = super().__new__(cls)
+        self._constructed_with = (args, kwargs)
+        return self
+
+    def constructor_arguments(self) -> dict[str, Any]:
+        """The parameters this block was made with, by name (positional ones named after
+        ``__init__``'s signature): what a diagram built from Python writes as the block's
+        ``params`` when it is saved as YAML (``blocks.save_diagram``)."""
+        args, kwargs = getattr(self, "_constructed_with", ((), {}))
+        names = [n for n in type(self).parameters()]
+        return {**dict(zip(names, args)), **kwargs}
+
+    # -- configuration hooks, called by the diagram builder --------------------------
 
     def bind(self, period: Fraction | None) -> None:
         """Receive the sample period (``None`` when the diagram gives none). Override to

@@ -1,13 +1,18 @@
 """A validated diagram as plain data: blocks, connections, logged signals, end time.
 
-The loader (``blocks.loader``) makes a ``Diagram`` from a YAML file; the planner
-(``blocks.schedule``) and the executor (``blocks.simulate``) read it. A Diagram is not
-changed after loading and holds nothing derived from it (the plans the planner builds
-are kept by the planner), so one Diagram can be planned and run any number of times.
+The builder (``blocks.builder``, which the YAML loader drives) makes a ``Diagram``; the
+planner (``blocks.schedule``) and the executor (``blocks.simulate``) read it. A Diagram is
+flat: the blocks of its subsystems are blocks of its own, named by their path
+(``ctrl.integ``), so the planner and executor see one diagram. What the files wrote, the
+subsystems with their ports and wires, is kept beside it (``root``, ``subsystems``) for
+the commands that show it. A Diagram is not changed after loading and holds nothing
+derived from it (the plans the planner builds are kept by the planner), so one Diagram
+can be planned and run any number of times.
 """
 
 from __future__ import annotations
 
+import posixpath
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -20,9 +25,35 @@ from .issues import Issue
 from .references import Reference
 
 
+@dataclass(frozen=True)
+class FileScope:
+    """Where the relative paths of one diagram file lead: its folder, and that folder as a
+    reference relative to the top diagram's folder (``"."`` for the top diagram itself;
+    ``sub`` for a subsystem read from ``sub/pi.yaml``). ``Diagram.files`` names every file
+    by such a reference, so a diagram and its subsystems can be copied as one tree."""
+
+    folder: Path = field(default_factory=Path.cwd)
+    ref_dir: str = "."
+
+    def ref(self, path: str) -> str:
+        """The reference, from the top diagram's folder, of ``path`` as this file names it
+        (kept as written in the top diagram; an absolute path stays absolute)."""
+        if self.ref_dir == "." or Path(path).expanduser().is_absolute():
+            return path
+        return posixpath.normpath(posixpath.join(self.ref_dir, Path(path).as_posix()))
+
+    def path(self, path: str) -> Path:
+        """Where ``path``, as this file names it, lies (relative ones against its folder)."""
+        given = Path(path).expanduser()
+        return given if given.is_absolute() else self.folder / path
+
+
 @dataclass
 class BlockSpec:
-    """A block of the diagram: its name, configured block object, period and offset."""
+    """A block of the diagram: its name, configured block object, period and offset.
+
+    A block of a subsystem is named by its path (``ctrl.integ``) and written in the
+    subsystem's file (``file``, None: the diagram's own)."""
 
     name: str
     type_name: str
@@ -32,12 +63,15 @@ class BlockSpec:
     params: dict
     line: int
     params_file: str | None = None
-    """The block's params_file (resolved against the diagram's folder), if it has one."""
-
-    @property
-    def references(self) -> dict[str, str]:
-        """This block's block references: parameter -> name of the block it refers to."""
-        return {p: self.params[p] for p in type(self.block).block_params if p in self.params}
+    """The block's params_file (resolved against its diagram's folder), if it has one."""
+    references: dict[str, str] = field(default_factory=dict)
+    """This block's block references: parameter -> the (path) name of the block it refers
+    to; for a reference a diagram loaded on its own leaves unbound, the reference's name."""
+    file: str | None = None
+    type_ref: str | None = None
+    """The type as the diagram names it (``Gain``, ``python:mod:Cls``); None: ``type_name``."""
+    scope: FileScope = field(default_factory=FileScope)
+    """Where the relative paths of its file lead."""
 
 
 @dataclass(frozen=True)
@@ -51,6 +85,9 @@ class Connection:
     delay: int = 0
     initial: tuple[float, ...] | None = None
     line: int = 0
+    file: str | None = None
+    """The file the connection is written in (None: the diagram's own; a subsystem's file
+    for a wire of a subsystem or one into or out of it)."""
 
     @property
     def src(self) -> str:
@@ -72,10 +109,84 @@ class LogEntry:
     port: str
     decimate: int = 1
     line: int = 0
+    file: str | None = None
 
     @property
     def signal(self) -> str:
         return f"{self.block}.{self.port}"
+
+
+@dataclass(frozen=True)
+class DiagramPort:
+    """An input or output of a diagram as a whole (or of a subsystem): the inner ports it
+    stands for (an input may feed several inputs; an output is one output), with their
+    width and, where their blocks know them, units and element names."""
+
+    name: str
+    signals: tuple[str, ...]
+    """Inner ports by their path name (``ctrl.integ.u``)."""
+    width: int
+    units: str | list[str] | None = None
+    labels: tuple[str, ...] | None = None
+    line: int | None = None
+    file: str | None = None
+
+
+@dataclass(frozen=True)
+class DeclaredReference:
+    """A block reference a diagram leaves to the diagram that includes it (``references:``),
+    and, when it is loaded on its own, the type of the block that stands in for it."""
+
+    name: str
+    type_name: str | None = None
+    line: int | None = None
+
+
+@dataclass
+class Composite:
+    """One diagram file's level of a diagram: the top diagram or one of its subsystems.
+
+    It keeps what the file wrote, with every name as its path in the whole diagram: the
+    blocks written in it, its subsystems, its own wires (``wires``: endpoints may be a
+    subsystem's ports, ``ctrl.e``), its ports and its block references. ``validate`` and
+    ``graph`` show the diagram by it; the planner and executor use the flat blocks only."""
+
+    path: str
+    """``""`` for the top diagram, else the subsystem's path (``ctrl``, ``ctrl.inner``)."""
+    diagram_name: str
+    file: str | None
+    """The YAML file it was read from; None for a level built in Python."""
+    line: int | None = None
+    """Where the including diagram names the subsystem (None for the top)."""
+    including_file: str | None = None
+    source: str | None = None
+    """The diagram file as the including entry names it (``diagram: pi.yaml``)."""
+    blocks: tuple[str, ...] = ()
+    subsystems: tuple[str, ...] = ()
+    wires: tuple[Connection, ...] = ()
+    log: tuple[LogEntry, ...] = ()
+    """The signals it asks to log (those of its subsystems by path: ``ctrl.integ.y``)."""
+    inputs: dict[str, DiagramPort] = field(default_factory=dict)
+    outputs: dict[str, DiagramPort] = field(default_factory=dict)
+    references: dict[str, DeclaredReference] = field(default_factory=dict)
+    """The block references it leaves to its includer (``references:``)."""
+    bindings: dict[str, str] = field(default_factory=dict)
+    """For a subsystem: each of its references -> the block it is bound to, by path."""
+    bind: dict[str, str] = field(default_factory=dict)
+    """For a subsystem: its entry's ``bind`` as written (names in the including level)."""
+    params: dict[str, Any] = field(default_factory=dict)
+    """For a subsystem: the overrides it was given, by dotted path inside it (``prop.k``),
+    from its entry's ``params`` and from ``--set``."""
+
+    @property
+    def origin(self) -> str:
+        """Where it comes from, for people: its file as the including entry names it, its
+        file, or ``built in Python``."""
+        return self.source or self.file or "built in Python"
+
+    def name_of(self, path: str) -> str:
+        """``path`` (a block or subsystem inside this level) as this level's file names it."""
+        return path[len(self.path) + 1:] if self.path else path
 
 
 @dataclass(frozen=True)
@@ -94,7 +205,12 @@ class Conversion:
 
 @dataclass
 class Diagram:
-    """A validated diagram: blocks, connections, logged signals and the end time."""
+    """A validated diagram: blocks, connections, logged signals and the end time.
+
+    Flat: a subsystem's blocks are among ``blocks`` under their path names
+    (``ctrl.integ``), its wires among ``connections`` from output to input, so planning
+    and running see no subsystems. ``root`` and ``subsystems`` keep how the files were
+    composed; ``inputs`` and ``outputs`` are the diagram's own ports."""
 
     name: str
     description: str
@@ -109,12 +225,49 @@ class Diagram:
     files: dict[str, Path] = field(default_factory=dict)
     """Every file the diagram read, by the reference it makes: its blocks' params files and
     the files their path parameters name (an FMU's ``path``), as written relative to the
-    diagram's folder (``../fmu/X.fmu``) or absolute, and the ``python:`` modules it imported
-    from its folder (``mymod.py``); each maps to the path it was read from. What a copy of
-    the diagram needs elsewhere (``blocks.sweep.bundle``)."""
+    diagram's folder (``../fmu/X.fmu``) or absolute, the ``python:`` modules it imported
+    from its folder (``mymod.py``) and the diagram files of its subsystems (``pi.yaml``);
+    a subsystem's own files by their reference from the top diagram's folder
+    (``sub/gains.yaml``). Each maps to the path it was read from. What a copy of the
+    diagram needs elsewhere (``blocks.sweep.bundle``)."""
+    root: Composite | None = None
+    """The top level as its file wrote it (None: a Diagram made without the builder)."""
+    subsystems: dict[str, Composite] = field(default_factory=dict)
+    """Every subsystem, nested ones too, by path, in the order they are written."""
+
+    @property
+    def inputs(self) -> dict[str, DiagramPort]:
+        """The diagram's own inputs (``inputs:``): a diagram meant to be a subsystem."""
+        return self.root.inputs if self.root else {}
+
+    @property
+    def outputs(self) -> dict[str, DiagramPort]:
+        """The diagram's own outputs (``outputs:``)."""
+        return self.root.outputs if self.root else {}
 
     def issue(self, line: int | None, message: str, hint: str = "") -> Issue:
         return Issue(self.file, line, message, hint)
+
+    def issue_at(self, item: BlockSpec | Connection | LogEntry, message: str, hint: str = "") -> Issue:
+        """An issue at ``item``'s line, in the file it is written in."""
+        return Issue(item.file or self.file, item.line, message, hint)
+
+    def open_issue(self) -> Issue | None:
+        """Why the diagram cannot run on its own, or None: it has inputs, or block
+        references that an including diagram binds. Such a diagram loads and validates
+        (a stand-in takes a reference's place), but runs only as a subsystem."""
+        root = self.root
+        if root is None or not (root.inputs or root.references):
+            return None
+        parts = []
+        if root.inputs:
+            parts.append(f"inputs ({', '.join(root.inputs)})")
+        if root.references:
+            parts.append(f"block references ({', '.join(root.references)})")
+        use = f"ctrl: {{diagram: {Path(root.file).name}}}" if root.file else "DiagramBuilder.add_subsystem"
+        return self.issue(None, f"diagram '{self.name}' has {' and '.join(parts)} that an including "
+                          "diagram gives it: it runs only as a subsystem",
+                          f"use it as a block of another diagram ({use}) and connect its inputs there")
 
     def driver_of(self, block: str, port: str) -> Connection | None:
         """The connection feeding input ``block.port``, if any."""
@@ -124,9 +277,19 @@ class Diagram:
         return None
 
     def width(self, signal: str) -> int:
-        """Width of an output signal ``block.port``."""
-        block, port = signal.split(".")
+        """Width of an output signal ``block.port`` (the block may be a path, ``ctrl.u``)."""
+        block, port = signal.rsplit(".", 1)
         return self.blocks[block].block.outputs[port]
+
+    def split_key(self, key: str) -> tuple[str, str] | None:
+        """``ctrl.prop.k.0`` -> (``ctrl.prop``, ``k.0``): the block a ``block.param`` key
+        names and the path into its parameters; None when no block of it is named."""
+        parts = key.split(".")
+        for n in range(len(parts) - 1, 0, -1):
+            block = ".".join(parts[:n])
+            if block in self.blocks:
+                return block, ".".join(parts[n:])
+        return None
 
     def references(self) -> list[Reference]:
         """Every block reference of the diagram (``reflex.hand -> plant``), in block order."""
@@ -149,6 +312,13 @@ class Diagram:
     def parameters(self) -> dict[str, dict]:
         """Parameters of every block after params files and overrides (JSON-friendly)."""
         return {name: jsonable(spec.params) for name, spec in self.blocks.items()}
+
+    def composition(self) -> dict[str, dict]:
+        """Each subsystem's file and the overrides it was given (for run.json)."""
+        return {path: {"diagram": sub.origin, "name": sub.diagram_name,
+                       **({"params": jsonable(sub.params)} if sub.params else {}),
+                       **({"bind": dict(sub.bindings)} if sub.bindings else {})}
+                for path, sub in self.subsystems.items()}
 
 
 def jsonable(value: Any) -> Any:

@@ -2,10 +2,10 @@
 
 A block whose ``output`` / ``update`` / ``advance`` exist as C functions of the calling
 convention in ``blocks/csrc/blocks_kernel.h`` returns a ``Kernel`` from
-``Block.kernel()``. The executor then calls them directly, and runs a stretch of events
-whose blocks all have kernels in one C call (no Python between the 1 ms hits of a
-controller and a plant, say). A block without a kernel runs through its Python methods
-as before; both kinds mix freely in one diagram.
+``Block.kernel()``. The executor's C core (``blocks/csrc/core.c``) then calls them
+directly while it interprets the run's op table (no Python between the 1 ms hits of a
+controller and a plant, say). A block without a kernel runs through its Python methods,
+called by the core's host as ops of the same table; both kinds mix freely in one diagram.
 
 A block whose kernel writes anything besides its state (an FMU instance's time and
 outputs, the plant's scratch) gives its Kernel a ``bind``: the executor calls

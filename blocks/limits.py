@@ -35,3 +35,12 @@ MAX_FOLDER_NAME = 100
 """Longest folder name made from a diagram's ``name:`` (the default ``runs/<name>``), in
 bytes of UTF-8: file systems refuse names beyond 255 bytes, and a results path must leave
 room for the folder it is in."""
+
+MAX_SUBSYSTEM_DEPTH = 32
+"""Deepest nesting of subsystems (a subsystem inside a subsystem ...): a real diagram nests
+a few levels; a chain of files that each include the next is refused past this."""
+
+MAX_SUBSYSTEM_BLOCKS = 200_000
+"""Most blocks a diagram's subsystems may add in all. A file that includes another twice,
+which includes another twice, ... doubles the blocks per level: 30 small files would make
+10^9 blocks. A flat diagram of this size loads and plans in about 40 s."""

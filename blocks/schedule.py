@@ -197,8 +197,8 @@ class _Planner:
             if diagram.blocks[c.dst_block].period is None:
                 self.inherit_to[c.src_block][c.dst_block] = None
 
-    def fail(self, line: int | None, message: str, hint: str = "") -> None:
-        raise DiagramError([Issue(self.d.file, line, message, hint)])
+    def fail(self, line: int | None, message: str, hint: str = "", file: str | None = None) -> None:
+        raise DiagramError([Issue(file or self.d.file, line, message, hint)])
 
     def plan(self, t_end: Fraction | None) -> Schedule:
         d = self.d
@@ -206,7 +206,7 @@ class _Planner:
         for name, spec in d.blocks.items():
             if spec.period is None and spec.block.time_varying and not self.sources[name]:
                 self.fail(spec.line, f"block '{name}' ({spec.type_name}) changes with time and has no "
-                          "inputs to inherit a period from", f"give block '{name}' a period")
+                          "inputs to inherit a period from", f"give block '{name}' a period", spec.file)
         times = [s.period for s in explicit.values()] + [s.offset for s in explicit.values() if s.offset]
         if times:
             base = fraction_gcd(times)
@@ -444,10 +444,10 @@ class _Planner:
             start = min((i for i, e in enumerate(cycle) if e[0][0] == "o"),
                         key=lambda i: (self.order[cycle[i][0][1]], cycle[i][0][2]))
             cycle = cycle[start:] + cycle[:start]
-            line = next((wires[e].line for e in cycle if e in wires), None)
-            self.fail(line, f"algebraic loop: {_chain([cycle[0][0]] + [v for _, v in cycle])}",
+            wire = next((wires[e] for e in cycle if e in wires), None)
+            self.fail(wire.line if wire else None, f"algebraic loop: {_chain([cycle[0][0]] + [v for _, v in cycle])}",
                       "break it with a block without feedthrough (e.g. UnitDelay) or add "
-                      "'delay: 1' to one connection")
+                      "'delay: 1' to one connection", wire.file if wire else None)
         out_nodes = [v for v in nx.lexicographical_topological_sort(
             graph, key=lambda v: (self.order[v[1]], v[0] == "o", v[2])) if v[0] == "o"]
         steps: list[tuple[str, list[str]]] = []

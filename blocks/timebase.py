@@ -75,6 +75,27 @@ def format_duration(seconds: Fraction) -> str:
     raise AssertionError("unreachable")
 
 
+def exact_duration_text(seconds: Fraction) -> str:
+    """``seconds`` as text that ``parse_duration`` reads back exactly (``"0.1 ms"``,
+    ``"2.5 s"``), in the largest unit giving a number of at least 1; ValueError for a
+    duration no decimal text gives (1/3 s)."""
+    if seconds == 0:
+        return "0 s"
+    for unit in ("s", "ms", "us", "ns"):
+        value = seconds / _UNITS[unit]
+        if abs(value) >= 1 or unit == "ns":
+            break
+    digits = 0
+    while (value * 10**digits).denominator != 1:
+        digits += 1
+        if digits > 30:
+            raise ValueError(f"the duration {seconds} s is not a decimal number of seconds")
+    scaled = abs(value * 10**digits).numerator
+    whole, frac = divmod(scaled, 10**digits)
+    text = str(whole) + (f".{frac:0{digits}d}".rstrip("0") if digits else "")
+    return f"{'-' if value < 0 else ''}{text} {unit}"
+
+
 def fraction_gcd(values: list[Fraction]) -> Fraction:
     """Greatest common divisor of positive rationals: gcd(numerators)/lcm(denominators)."""
     num = reduce(math.gcd, (v.numerator for v in values))

@@ -98,11 +98,15 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         print(f"hierhand: {exc}", file=sys.stderr)
         return EXIT_FAILED
     r = summary["regrasp"]
+
+    def seconds(value: float | None) -> str:
+        return "never" if value is None else f"{value} s"
+
     print(f"grasp: peak ratio {summary['grasp']['peak_ratio']:.3f}, steady max "
           f"{summary['grasp']['steady_ratio_max']:.3f}; manipulation: position error "
           f"{1000 * summary['manipulation']['position_error_m']:.2f} mm; re-grasp: forefinger separates at "
-          f"{r['suppressed']['fore_separation_time_s']} s with suppresser, "
-          f"{r['unsuppressed']['fore_separation_time_s']} without")
+          f"{seconds(r['suppressed']['fore_separation_time_s'])} with suppresser, "
+          f"{seconds(r['unsuppressed']['fore_separation_time_s'])} without")
     print(f"wrote {args.output}/summary.json, report.md and fig09.png ... fig14.png")
     return EXIT_OK
 

@@ -1,5 +1,6 @@
 """``graph``: the wiring of a diagram as DOT text, or drawn to SVG, PNG or PDF: blocks as
-records with their ports, wires port to port, colours by rate with a legend."""
+records with their ports, wires port to port, colours by rate with a legend; a subsystem
+as one box, or (``--expand``) as a frame around its blocks."""
 
 from __future__ import annotations
 
@@ -17,6 +18,8 @@ def add(sub, program) -> argparse.ArgumentParser:
     diagram_args(graph)
     graph.add_argument("-o", "--output", type=Path,
                        help="file to write: .dot, .svg or .png (default: DOT text on stdout)")
+    graph.add_argument("--expand", action="store_true",
+                       help="draw the blocks of every subsystem, each subsystem a frame around them")
     graph.set_defaults(handler=cmd_graph)
     return graph
 
@@ -30,14 +33,14 @@ def cmd_graph(args: argparse.Namespace) -> int:
     schedule = build_schedule(diagram, None)
     out = args.output
     if out is None:
-        sys.stdout.write(to_dot(diagram, schedule))
+        sys.stdout.write(to_dot(diagram, schedule, args.expand))
         return EXIT_OK
     suffix = out.suffix.lower()
     if suffix in (".dot", ".gv"):
         out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(to_dot(diagram, schedule), encoding="utf-8")
+        out.write_text(to_dot(diagram, schedule, args.expand), encoding="utf-8")
     elif suffix in (".svg", ".png", ".pdf"):
-        render(diagram, schedule, out)
+        render(diagram, schedule, out, args.expand)
     else:
         raise UsageError(f"-o {out}: unknown format {suffix or '(none)'!r}; use .dot, .svg or .png")
     print(f"wrote {out}")

@@ -1,4 +1,5 @@
-"""``validate``: check a diagram and print its blocks, rates, references and execution order."""
+"""``validate``: check a diagram and print its blocks (as a tree of its subsystems), rates,
+ports, references and execution order."""
 
 from __future__ import annotations
 
@@ -14,6 +15,8 @@ def add(sub, program) -> argparse.ArgumentParser:
                               description="Check DIAGRAM and print blocks, periods, base tick, "
                                           "hyperperiod and execution order.")
     diagram_args(validate)
+    validate.add_argument("--plan", action="store_true",
+                          help="also print the run's op table: blocks, programs of ops, copies and logs, with names")
     validate.set_defaults(handler=cmd_validate)
     return validate
 
@@ -32,23 +35,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
           f"({format_duration(s.hyperperiod * s.base_tick)})"
           + (f"; t_end: {format_duration(t_end)} = {s.n_ticks} ticks" if t_end else ""))
     print("blocks:")
-    wn = max(len(n) for n in diagram.blocks)
-    wt = max(len(b.type_name) for b in diagram.blocks.values())
-    for name, spec in diagram.blocks.items():
-        blk = spec.block
-        ins = ", ".join(f"{p}[{w}]" for p, w in blk.inputs.items()) or "-"
-        outs = ", ".join(f"{p}[{w}]" for p, w in blk.outputs.items()) or "-"
-        notes = []
-        if name in s.advanced:
-            notes.append("advanced between events")
-        if blk.has_feedthrough():
-            notes.append("feedthrough")
-        if any(blk.initial_reads(p) != blk.reads(p) for p in blk.outputs):
-            initial = sorted(set().union(*(blk.initial_reads(p) for p in blk.outputs)))
-            notes.append(f"feedthrough at t = 0 from {', '.join(initial)}" if initial
-                         else "no feedthrough at t = 0")
-        print(f"  {name:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
-              + (f"  ({', '.join(notes)})" if notes else ""))
+    print_block_tree(diagram, s)
+    print_ports(diagram)
     print_references_and_notes(diagram)
     print("execution order:")
     print(f"  t = 0: {s.initial.describe()}")
@@ -63,7 +51,77 @@ def cmd_validate(args: argparse.Namespace) -> int:
         print(f"  at {at} (mod {format_duration(s.hyperperiod * s.base_tick)}): {s.programs[j].describe()}")
     if not s.event_ticks.size and s.advanced:
         print(f"  no other events: {', '.join(sorted(s.advanced))} advanced from t = 0 to t_end")
+    if args.plan:
+        from blocks.optable import op_table
+        from blocks.optable_text import describe_table
+
+        t_end = t_end if t_end is not None else end_time(args, diagram)
+        print(describe_table(op_table(diagram, build_schedule(diagram, t_end))))
     return EXIT_OK
+
+
+def print_block_tree(diagram, s) -> None:
+    """Each block with its type, rate and ports; a subsystem's blocks indented under a
+    line of its own (its file, ports and what it was given) where its entry stands."""
+    def indent(path: str) -> str:
+        return "  " * (1 + sum(1 for sub in diagram.subsystems if path.startswith(sub + ".")))
+
+    wn = max(len(indent(n)) + len(n) for n in diagram.blocks)
+    wt = max(len(b.type_name) for b in diagram.blocks.values())
+    shown: set[str] = set()
+    for name, spec in diagram.blocks.items():
+        for path, sub in diagram.subsystems.items():
+            if name.startswith(path + ".") and path not in shown:
+                shown.add(path)
+                print(f"{indent(path)}{path}: subsystem {sub.origin} (diagram {sub.diagram_name!r})"
+                      + "".join(f"; {part}" for part in subsystem_parts(sub)))
+        blk = spec.block
+        ins = ", ".join(f"{p}[{w}]" for p, w in blk.inputs.items()) or "-"
+        outs = ", ".join(f"{p}[{w}]" for p, w in blk.outputs.items()) or "-"
+        notes = []
+        if name in s.advanced:
+            notes.append("advanced between events")
+        if blk.has_feedthrough():
+            notes.append("feedthrough")
+        if any(blk.initial_reads(p) != blk.reads(p) for p in blk.outputs):
+            initial = sorted(set().union(*(blk.initial_reads(p) for p in blk.outputs)))
+            notes.append(f"feedthrough at t = 0 from {', '.join(initial)}" if initial
+                         else "no feedthrough at t = 0")
+        label = indent(name) + name
+        print(f"{label:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
+              + (f"  ({', '.join(notes)})" if notes else ""))
+
+
+def subsystem_parts(sub) -> list[str]:
+    """A subsystem's ports, bindings and the overrides it was given, as ``validate`` shows them."""
+    def inner(port) -> str:
+        return ", ".join(sub.name_of(signal) for signal in port.signals)
+
+    parts = [f"in: {'; '.join(f'{port_text(p)} -> {inner(p)}' for p in sub.inputs.values())}" if sub.inputs else "",
+             f"out: {'; '.join(f'{port_text(p)} <- {inner(p)}' for p in sub.outputs.values())}"
+             if sub.outputs else "",
+             f"bind: {', '.join(f'{r} -> {b}' for r, b in sub.bindings.items())}" if sub.bindings else "",
+             f"params: {', '.join(f'{k}={v!r}' for k, v in sub.params.items())}" if sub.params else ""]
+    return [p for p in parts if p]
+
+
+def port_text(port) -> str:
+    """A port as ``validate`` names it: ``e[1]``, with its unit where known (``q[9] (rad)``)."""
+    return f"{port.name}[{port.width}]" + (f" ({port.units})" if isinstance(port.units, str) else "")
+
+
+def print_ports(diagram) -> None:
+    """The diagram's own inputs and outputs and the references it leaves to an includer."""
+    for kind, ports, arrow in (("inputs", diagram.inputs, "->"), ("outputs", diagram.outputs, "<-")):
+        if ports:
+            print(f"{kind} (of the diagram as a subsystem):")
+            for port in ports.values():
+                print(f"  {port_text(port)} {arrow} {', '.join(port.signals)}")
+    refs = diagram.root.references if diagram.root else {}
+    if refs:
+        print("references the including diagram binds:")
+        for ref in refs.values():
+            print(f"  {ref.name}" + (f" (stand-in here: {ref.type_name})" if ref.type_name else ""))
 
 
 def print_references_and_notes(diagram) -> None:

@@ -3,8 +3,8 @@
  * A block that can compute its outputs, its update and its advance in C offers them to
  * the executor as a blocks.Kernel: the addresses of functions of the types below and a
  * context pointer (its constants: parameters, a model). The executor then runs every hit
- * of that block in C, and runs whole stretches of events whose blocks all have kernels
- * in one C call, with no Python in between (blocks/csrc/runner.c).
+ * of that block in C: the op-table core (blocks/csrc/core.h) calls these functions
+ * directly, with no Python between one kernel's step and the next.
  *
  * Conventions, the same for every kernel:
  * - ctx is Kernel.context, passed back unchanged; the kernel only reads through it
@@ -33,7 +33,8 @@
  *   and uses the Kernel it returns, whose context belongs to that run and may be written.
  *   That kernel gets the state as above: the flat array (the plant's), else NULL (an FMU's
  *   live instance, whose changes it keeps in its context).
- * - The GIL: the executor holds it around a kernel's calls unless the Kernel says nogil.
+ * - The GIL: the executor (blocks/csrc/host.c) holds it around a kernel's calls unless
+ *   the Kernel says nogil.
  *   A nogil kernel calls nothing of Python's C API (so never returns BLK_RAISED) and
  *   writes only its state, its outputs and a context no other run uses at the same time
  *   (no static buffers, no scratch shared through a constant context: give such scratch

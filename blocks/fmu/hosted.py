@@ -182,6 +182,9 @@ class HostedInstance:
         if self.region.pending:
             self._abandon()
             return
+        if not self.launcher.running:  # killed from outside, and the host with it: not the FMU's doing
+            self.broken = True
+            return
         try:
             self.broken = bool(self._message(("stop",), "terminating it after its run"))
         except HostFailure as exc:

@@ -13,17 +13,24 @@ The drawing needs no Graphviz: the layout is done here (longest-path layers, a f
 barycenter passes against crossings) and drawn with matplotlib. The DOT text is for
 those who have Graphviz.
 
-Modules: ``rates`` (periods and their colours), ``ports`` (what a block shows), ``layout``
-(layers and their order), ``drawing`` (matplotlib), ``dot`` (Graphviz text).
+A diagram with subsystems is drawn as its top file wrote it, each subsystem one box with
+its ports and the rates of the blocks inside (yellow when they differ, as Simulink colours
+a hybrid subsystem); ``expand`` draws every block, each subsystem a frame around its own
+(a cluster in the DOT text).
+
+Modules: ``view`` (what is shown: boxes, wires, frames), ``rates`` (periods and their
+colours), ``ports`` (what a box shows), ``layout`` (layers and their order), ``drawing``
+(matplotlib), ``dot`` (Graphviz text).
 """
 
 from __future__ import annotations
 
 from .dot import to_dot
-from .drawing import draw, geometry, render
+from .drawing import draw, draw_picture, geometry, render
 from .layout import crossings, layered
 from .ports import is_feedthrough
 from .rates import effective_rate, rate_colors
+from .view import Picture, picture
 
-__all__ = ["crossings", "draw", "effective_rate", "geometry", "is_feedthrough", "layered", "rate_colors", "render",
-           "to_dot"]
+__all__ = ["Picture", "crossings", "draw", "draw_picture", "effective_rate", "geometry", "is_feedthrough", "layered",
+           "picture", "rate_colors", "render", "to_dot"]

@@ -1,4 +1,5 @@
-"""The wiring drawn with matplotlib: boxes with their ports, wires routed port to port, loops in channels."""
+"""The wiring drawn with matplotlib: boxes with their ports, wires routed port to port, loops
+in channels, and (expanded) each subsystem a frame around its blocks."""
 
 from __future__ import annotations
 
@@ -9,9 +10,10 @@ import numpy as np
 
 from ..diagram import Diagram
 from ..schedule import Schedule
-from .layout import Layered, layered
+from .layout import Layered, group_of, layered
 from .ports import input_ports, output_ports
-from .rates import RateColors, rate_colors, rate_line, tint
+from .rates import tint
+from .view import Frame, Picture, picture
 
 
 # All lengths in inches; y grows downwards while laying out (the axes are flipped).
@@ -26,6 +28,8 @@ V_GAP = 0.45        # between boxes of a layer
 WAYPOINT = 0.16     # height a passing wire takes in a layer
 LANE = 0.14         # between the vertical runs of the wires that go back
 CHANNEL = 0.2       # between the horizontal runs of the wires that go back
+FRAME_HEAD = 0.32   # a frame's label above the boxes in it
+FRAME_PAD = 0.14    # between a frame and what it holds (and a frame inside it)
 
 
 def text_width(text: str, size: float, bold: bool = False) -> float:
@@ -66,20 +70,22 @@ class Geometry:
     channels: dict[int, float]
     """connection index -> y of a returning wire's horizontal run."""
     bounds: tuple[float, float, float, float]
+    frames: dict[str, tuple[float, float, float, float]] = None
+    """subsystem path -> (x, y, w, h) of its frame (expanded pictures)."""
 
 
-def geometry(diagram: Diagram, schedule: Schedule, lay: Layered, rates: RateColors) -> Geometry:
+def geometry(picture: Picture, lay: Layered) -> Geometry:
     sizes = {}
-    for name in diagram.blocks:
-        ins, outs = input_ports(diagram, name), output_ports(diagram, name)
+    for name, node in picture.nodes.items():
+        ins, outs = input_ports(picture, name), output_ports(picture, name)
         in_w = max((text_width(p, FONT) for p in ins), default=0.0)
         out_w = max((text_width(p, FONT) for p in outs), default=0.0)
-        head = max(text_width(name, TITLE_FONT, bold=True), text_width(diagram.blocks[name].type_name, SMALL_FONT),
-                   text_width(rate_line(schedule, rates, name), SMALL_FONT))
+        head = max(text_width(name, TITLE_FONT, bold=True), text_width(node.type_line, SMALL_FONT),
+                   text_width(node.rate_line, SMALL_FONT))
         w = max(head + 2 * PAD, in_w + out_w + 2 * PAD + 0.35, 1.0)
         h = HEADER + max(len(ins), len(outs), 1) * ROW + 0.08
         sizes[name] = (w, h, ins, outs)
-    conns = diagram.connections
+    conns = picture.wires
     index = {id(c): i for i, c in enumerate(conns)}
     fb = [index[id(c)] for c in lay.feedback]
     n_layers = len(lay.columns)
@@ -133,22 +139,34 @@ def geometry(diagram: Diagram, schedule: Schedule, lay: Layered, rates: RateColo
             return None
         return float(np.mean([t - o for o, t in pairs]))
 
+    def gap(item, below) -> float:
+        boxes_both = isinstance(item, str) + isinstance(below, str)
+        return (V_GAP, 0.22, 0.04)[2 - boxes_both]
+
+    bands = frame_bands(picture, lay, height, gap) if picture.frames else None
     for k, col in enumerate(lay.columns):
-        desired = []
-        for item in col:
-            want = feed_y(item) if k else None
-            desired.append(want)
-        tops, y = [], 0.0
-        for j, item in enumerate(col):
-            want = desired[j]
-            top = y if want is None else max(want, y)
-            tops.append(top)
-            if j + 1 < len(col):
-                boxes_both = isinstance(item, str) + isinstance(col[j + 1], str)
-                y = top + height(item) + (V_GAP, 0.22, 0.04)[2 - boxes_both]
-        placed = [(tops[j] - desired[j]) for j in range(len(col)) if desired[j] is not None]
-        shift = float(np.median(placed)) if placed else 0.0
-        shift = min(shift, tops[0] - min(0.0, tops[0])) if tops else 0.0
+        if bands is not None:
+            tops, y, shift = [], None, 0.0
+            for j, item in enumerate(col):
+                group = group_of(picture, item)
+                same = j and group_of(picture, col[j - 1]) == group
+                y = y + height(col[j - 1]) + gap(col[j - 1], item) if same else bands[group]
+                tops.append(y)
+        else:
+            desired = []
+            for item in col:
+                want = feed_y(item) if k else None
+                desired.append(want)
+            tops, y = [], 0.0
+            for j, item in enumerate(col):
+                want = desired[j]
+                top = y if want is None else max(want, y)
+                tops.append(top)
+                if j + 1 < len(col):
+                    y = top + height(item) + gap(item, col[j + 1])
+            placed = [(tops[j] - desired[j]) for j in range(len(col)) if desired[j] is not None]
+            shift = float(np.median(placed)) if placed else 0.0
+            shift = min(shift, tops[0] - min(0.0, tops[0])) if tops else 0.0
         for j, item in enumerate(col):
             top = tops[j] - shift
             x0, x1 = column_x[k]
@@ -196,17 +214,64 @@ def geometry(diagram: Diagram, schedule: Schedule, lay: Layered, rates: RateColo
         used_src[ks] = used_src.get(ks, 0) + 1
         lanes[(i, "dst")] = column_x[kd][0] - 0.3 - used_dst.get(kd, 0) * LANE
         used_dst[kd] = used_dst.get(kd, 0) + 1
-    ys = [top, bottom] + list(channels.values())
-    xs = [0.0, column_x[-1][1] if column_x else 1.0] + list(lanes.values())
-    return Geometry(boxes, waypoints, column_x, lanes, channels, (min(xs), max(xs), min(ys), max(ys)))
+    frames = frame_boxes(picture, boxes, waypoints, lay)
+    ys = [top, bottom] + list(channels.values()) + [f[1] for f in frames.values()] + \
+        [f[1] + f[3] for f in frames.values()]
+    xs = [0.0, column_x[-1][1] if column_x else 1.0] + list(lanes.values()) + [f[0] for f in frames.values()] + \
+        [f[0] + f[2] for f in frames.values()]
+    return Geometry(boxes, waypoints, column_x, lanes, channels, (min(xs), max(xs), min(ys), max(ys)), frames)
 
 
-def wire_path(diagram: Diagram, lay: Layered, geo: Geometry, i: int):
+def frame_bands(picture: Picture, lay: Layered, height, gap) -> dict[str, float]:
+    """The top of each frame's band (``""``: the boxes outside every frame): the bands are
+    stacked in the layout's order of frames, each as tall as its tallest column, with room
+    for a frame's label above and its border below."""
+    order = [""] + [f.path for f in picture.frames]
+    tall = dict.fromkeys(order, 0.0)
+    for col in lay.columns:
+        run: dict[str, float] = {}
+        for j, item in enumerate(col):
+            group = group_of(picture, item)
+            extra = gap(col[j - 1], item) if j and group_of(picture, col[j - 1]) == group else 0.0
+            run[group] = run.get(group, 0.0) + extra + height(item)
+        for group, h in run.items():
+            tall[group] = max(tall[group], h)
+    tops: dict[str, float] = {}
+    y = 0.0
+    for i, group in enumerate(order):
+        y += FRAME_HEAD if group else 0.0
+        tops[group] = y
+        y += tall[group]
+        after = order[i + 1] if i + 1 < len(order) else None
+        closing = sum(1 for f in order[1:] if group and (group == f or group.startswith(f + "."))
+                      and not (after and (after == f or after.startswith(f + "."))))
+        y += V_GAP + closing * FRAME_PAD
+    return tops
+
+
+def frame_boxes(picture: Picture, boxes: dict, waypoints: dict, lay: Layered) -> dict[str, tuple]:
+    """Each frame's rectangle: around its boxes (and the wires that pass in its band), a
+    frame holding another one ``FRAME_PAD`` further out."""
+    out: dict[str, tuple] = {}
+    for frame in sorted(picture.frames, key=lambda f: -f.depth):
+        parts = [(b.x, b.y, b.x + b.w, b.y + b.h) for n, b in boxes.items() if n in frame.members]
+        parts += [(x0, y - WAYPOINT / 2, x1, y + WAYPOINT / 2) for (i, k), (x0, x1, y) in waypoints.items()
+                  if picture.wires[i].src_block in frame.members]
+        parts += [(x, y, x + w, y + h) for path, (x, y, w, h) in out.items() if path.startswith(frame.path + ".")]
+        if not parts:
+            continue
+        x0, y0 = min(p[0] for p in parts) - FRAME_PAD, min(p[1] for p in parts) - FRAME_HEAD + 0.04
+        x1, y1 = max(p[2] for p in parts) + FRAME_PAD, max(p[3] for p in parts) + FRAME_PAD
+        out[frame.path] = (x0, y0, x1 - x0, y1 - y0)
+    return out
+
+
+def wire_path(picture: Picture, lay: Layered, geo: Geometry, i: int):
     """The vertices and codes of a matplotlib Path for connection ``i``, and the point
     where its delay mark goes."""
     from matplotlib.path import Path as MPath
 
-    c = diagram.connections[i]
+    c = picture.wires[i]
     x0, y0 = geo.boxes[c.src_block].out_anchor(c.src_port)
     x1, y1 = geo.boxes[c.dst_block].in_anchor(c.dst_port)
     if i in geo.channels:
@@ -241,29 +306,35 @@ def wire_path(diagram: Diagram, lay: Layered, geo: Geometry, i: int):
     return pts, codes, mark
 
 
-def draw(diagram: Diagram, schedule: Schedule):
-    """The wiring drawn on a new matplotlib Figure (sized in inches to fit its text).
+def draw(diagram: Diagram, schedule: Schedule, expand: bool = False):
+    """The wiring drawn on a new matplotlib Figure (sized in inches to fit its text); a
+    subsystem is one box, or with ``expand`` a frame around its blocks.
 
     Every connection is a patch whose gid is ``wire:`` and the connection's text
-    (``plant.q -> reflex.q``), every block a patch with gid ``block:NAME``.
+    (``plant.q -> reflex.q``), every block (and subsystem box) a patch with gid
+    ``block:NAME``, every frame one with gid ``frame:PATH``.
     """
+    return draw_picture(picture(diagram, schedule, expand))
+
+
+def draw_picture(pic: Picture):
+    """``draw`` for a picture already made (``blocks.graph.view.picture``)."""
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
     from matplotlib.patches import FancyBboxPatch, Patch, PathPatch, Polygon
     from matplotlib.path import Path as MPath
 
-    rates = rate_colors(diagram, schedule)
-    lay = layered(diagram)
-    geo = geometry(diagram, schedule, lay, rates)
+    lay = layered(pic)
+    geo = geometry(pic, lay)
     x_min, x_max, y_min, y_max = geo.bounds
     title_h = 0.45
     # legend: one row if it fits, else as many columns as fit
-    entries = [(label, colour) for label, colour in rates.legend]
-    has_delay = any(c.delay for c in diagram.connections)
+    entries = list(pic.legend)
+    has_delay = any(c.delay for c in pic.wires)
     labels = [label for label, _ in entries] + (["delayed one sample (z\u207b\u00b9)"] if has_delay else [])
     entry_w = max((text_width(t, FONT) for t in labels), default=1.0) + 0.65
     content_w = x_max - x_min + 0.6
-    width = max(content_w, text_width(diagram.name, 12, bold=True) + 0.6, 4.0)
+    width = max(content_w, text_width(pic.name, 12, bold=True) + 0.6, 4.0)
     ncol = max(1, min(len(labels), int((width - 0.3) // entry_w)))
     if ncol * entry_w + 0.3 > width:
         width = ncol * entry_w + 0.3
@@ -277,7 +348,7 @@ def draw(diagram: Diagram, schedule: Schedule):
     top = y_min - title_h - legend_h - 0.15
     ax.set_xlim(left, left + width)
     ax.set_ylim(top + height, top)
-    ax.text(left + 0.3, top + 0.3, diagram.name, fontsize=12, fontweight="bold", va="center", ha="left")
+    ax.text(left + 0.3, top + 0.3, pic.name, fontsize=12, fontweight="bold", va="center", ha="left")
     handles = [Patch(facecolor=tint(colour, 0.3), edgecolor=colour, linewidth=1.6, label=label)
                for label, colour in entries]
     if has_delay:
@@ -286,21 +357,25 @@ def draw(diagram: Diagram, schedule: Schedule):
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(left + 0.2, top + title_h + 0.05),
                   bbox_transform=ax.transData, ncol=ncol, frameon=False, fontsize=FONT, title="rates",
                   title_fontsize=FONT, alignment="left", handlelength=1.6, columnspacing=1.2, borderaxespad=0)
+    for frame in pic.frames:
+        if frame.path in geo.frames:
+            draw_frame(ax, frame, geo.frames[frame.path])
     for name, box in geo.boxes.items():
-        colour = rates.colors[name]
+        node = pic.nodes[name]
+        colour = node.colour
         ax.add_patch(FancyBboxPatch((box.x, box.y), box.w, box.h, boxstyle="round,pad=0,rounding_size=0.05",
                                     facecolor=tint(colour), edgecolor=colour, linewidth=1.8, zorder=2,
                                     gid=f"block:{name}"))
         cx = box.x + box.w / 2
         ax.text(cx, box.y + 0.16, name, fontsize=TITLE_FONT, fontweight="bold", ha="center", va="center", zorder=4)
-        ax.text(cx, box.y + 0.34, diagram.blocks[name].type_name, fontsize=SMALL_FONT, style="italic",
+        ax.text(cx, box.y + 0.34, node.type_line, fontsize=SMALL_FONT, style="italic",
                 color="0.3", ha="center", va="center", zorder=4)
-        ax.text(cx, box.y + 0.50, rate_line(schedule, rates, name), fontsize=SMALL_FONT, color=colour,
+        ax.text(cx, box.y + 0.50, node.rate_line, fontsize=SMALL_FONT, color=colour,
                 ha="center", va="center", zorder=4)
         ax.plot([box.x, box.x + box.w], [box.y + HEADER - 0.03] * 2, color=colour, linewidth=0.8, alpha=0.6,
                 zorder=3)
-        wired_in = {c.dst_port for c in diagram.connections if c.dst_block == name}
-        wired_out = {c.src_port for c in diagram.connections if c.src_block == name}
+        wired_in = {c.dst_port for c in pic.wires if c.dst_block == name}
+        wired_out = {c.src_port for c in pic.wires if c.src_block == name}
         for p in box.inputs:
             x, y = box.in_anchor(p)
             ax.text(x + PAD, y, p, fontsize=FONT, ha="left", va="center", zorder=4,
@@ -310,10 +385,10 @@ def draw(diagram: Diagram, schedule: Schedule):
             ax.text(x - PAD, y, p, fontsize=FONT, ha="right", va="center", zorder=4,
                     color="black" if p in wired_out else "0.55")
             if p in wired_out:
-                ax.plot([x], [y], marker="o", markersize=3.5, color=rates.colors[name], zorder=5)
-    for i, c in enumerate(diagram.connections):
-        pts, codes, mark = wire_path(diagram, lay, geo, i)
-        colour = rates.colors[c.src_block]
+                ax.plot([x], [y], marker="o", markersize=3.5, color=colour, zorder=5)
+    for i, c in enumerate(pic.wires):
+        pts, codes, mark = wire_path(pic, lay, geo, i)
+        colour = pic.nodes[c.src_block].colour
         ax.add_patch(PathPatch(MPath(pts, codes), facecolor="none", edgecolor=colour, linewidth=1.3,
                                linestyle=(0, (4, 2.5)) if c.delay else "-", zorder=1, gid=f"wire:{c}",
                                capstyle="round"))
@@ -327,10 +402,22 @@ def draw(diagram: Diagram, schedule: Schedule):
     return fig
 
 
-def render(diagram: Diagram, schedule: Schedule, path: str | Path) -> Path:
+def draw_frame(ax, frame: Frame, rect: tuple[float, float, float, float]) -> None:
+    """A subsystem's frame: a rounded grey rectangle with its path and file at the top left."""
+    from matplotlib.patches import FancyBboxPatch
+
+    x, y, w, h = rect
+    ax.add_patch(FancyBboxPatch((x, y), w, h, boxstyle="round,pad=0,rounding_size=0.08", facecolor="none",
+                                edgecolor="0.45", linewidth=1.1, linestyle=(0, (6, 3)), zorder=0.5,
+                                gid=f"frame:{frame.path}"))
+    ax.text(x + 0.1, y + 0.16, frame.label, fontsize=SMALL_FONT, fontweight="bold", color="0.35", ha="left",
+            va="center", zorder=4)
+
+
+def render(diagram: Diagram, schedule: Schedule, path: str | Path, expand: bool = False) -> Path:
     """Draw the diagram to an SVG, PNG or PDF file (format from the suffix)."""
     path = Path(path)
-    fig = draw(diagram, schedule)
+    fig = draw(diagram, schedule, expand)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=150)
     return path

@@ -29,7 +29,9 @@ THRESHOLD_REDUCERS = ("first_time_above", "first_time_below")
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _CALL = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*(?:\((.*)\))?$", re.S)
-_SIGNAL = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*(-?\d+)\s*\])?$")
+_SIGNAL = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)\.([A-Za-z_][A-Za-z0-9_]*)\s*"
+                     r"(?:\[\s*(-?\d+)\s*\])?$")
+"""``block.port`` or ``block.port[i]``; the block may be a path into subsystems (``ctrl.integ``)."""
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,7 @@ class Metric:
             except ValueError as exc:
                 raise SweepError(f"--metric {self.text}: {exc}") from None
             return
-        block, port = self.signal.split(".")
+        block, port = self.signal.rsplit(".", 1)
         if block not in diagram.blocks:
             raise SweepError(f"--metric {self.text}: no block named '{block}'; blocks are: "
                              f"{', '.join(diagram.blocks)}")

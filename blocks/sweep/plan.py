@@ -89,21 +89,20 @@ def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_e
 
 def _swept_files(base, points: list[Point]) -> dict[str, Path]:
     """The files that swept path parameters name (``--grid plant.path=a.fmu,b.fmu``), by the
-    reference each point gives, resolved as the loader does; those that are no file are
-    left to fail in their points."""
+    reference each point gives (from the top diagram's folder, for a block of a subsystem),
+    resolved as the loader does; those that are no file are left to fail in their points."""
     found: dict[str, Path] = {}
     for key in points[0]:
-        block, _, param = key.partition(".")
-        spec = base.blocks.get(block)
-        if spec is None or param not in type(spec.block).path_params:
+        named = base.split_key(key)
+        spec = base.blocks.get(named[0]) if named else None
+        if spec is None or named[1] not in type(spec.block).path_params:
             continue
         for point in points:
             ref = point[key]
             if isinstance(ref, str) and ref.strip():
-                path = Path(ref).expanduser()
-                path = path if path.is_absolute() else base.base_dir / ref
+                path = spec.scope.path(ref)
                 if path.is_file():
-                    found[ref] = path
+                    found[spec.scope.ref(ref)] = path
     return found
 
 

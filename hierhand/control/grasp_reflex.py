@@ -4,35 +4,43 @@ At every hit (1 ms in the paper) the reflex
 
 1. finds the fingers in contact from the fingertip force sensors (``fn``), so it follows
    the grasp through a re-grasp; fingers listed in ``grasp`` that are not touching are
-   pushed towards the others with ``approach_force`` until they do (again, after a
-   bounce), unless voluntary motion had taken them over when they last touched;
-2. takes the internal ("squeeze") forces among those fingertips (Yoshikawa-Nagai): the
+   pushed towards the touching ones with ``approach_force`` until they do (again, after a
+   bounce), unless the reflex was letting go of them when they last touched;
+2. takes the internal ("squeeze") forces among the touching fingers (Yoshikawa-Nagai): the
    internal force nearest to every finger pushing along its contact normal,
-   ``(I - G^+ G) n``; for two contacts this is the squeeze along their line;
+   ``(I - G^+ G) n``, with G the grasp matrix of the contact points (tip centre plus tip
+   radius along the normal); for two contacts this is the squeeze along the line between
+   them. An approaching finger is no part of it: it does not touch the object;
 3. finds the contact that is most short of the normal force it needs,
-   ``need_i = max(min_force * w_i, |f_t,i| / ratio_target)`` (the sensor form of the
+   ``need_i = max(min_force * |g_i|, |f_t,i| / ratio_target)`` (the sensor form of the
    friction scaling at the safety ratio);
 4. realises it with integral control of one grasp force scale ``s``:
-   ``s += ki * dt * max_i (need_i - fn_i) / (n_i . g_i)``, the fingertip forces ``s g_i``
-   mapped to joint torques by ``J_i^T``. One integrator for the whole grasp, not one per
-   finger: in a pinch both normal forces respond alike to a difference between the
-   fingers' pushes (the object just moves), so per-finger integrators would drift apart.
-   Only the fingers the reflex still holds count: a finger whose actuator command keeps
-   less than ``release_share`` of its grasping torque (input ``share``, from the
-   suppresser) has been handed to voluntary motion, the least share first and never more
-   than leaves two fingers held (two are the grasp; a pinch whose posture PD resists the
-   squeeze keeps only about 0.9 of its torque, and must still be squeezed). A finger handed
-   over keeps at most the squeeze it had then: as the others take its load over they need
-   more squeeze, which must not press the leaving finger back onto the object. Counting it would wind the integrator
-   up while the finger is pulled off the object (its |f_t| / f_n climbs as it lets go of
-   its load), raising the squeeze of every finger and its own grasp torque.
+   ``s += ki * dt * max_i hold_i (need_i - fn_i) / (n_i . g_i)``, the fingertip forces
+   ``s g_i`` mapped to joint torques by ``J_i^T`` at the contact points. One integrator for
+   the whole grasp, not one per finger: in a pinch both normal forces respond alike to a
+   difference between the fingers' pushes (the object just moves), so per-finger
+   integrators would drift apart.
+
+The hand-over to voluntary motion follows the suppresser (input ``share``: per finger,
+what the suppresser lets through of its grasping torque). Two touching fingers are the
+grasp: the two the suppresser spares most are held whole (``hold`` 1), and the reflex makes
+up with squeeze what the suppresser takes from them. A third touching finger is held by 1
+while its share is at least ``hold_share`` (the sigmoid at rest lets a little less than the
+whole grasp torque through), falling linearly to 0 as its share falls to ``release_share``: it
+drives the integrator by that much, and from the next hit shares the squeeze by that
+much (the internal force of all three, blended toward that of the other two). Without this
+the reflex winds up while voluntary motion pulls a finger off the object (its ``|f_t| /
+f_n`` climbs as it lets go of its load), raising the squeeze of every finger and the
+leaving finger's own grasp torque. With the suppresser off (share 1) nothing is handed
+over; ``follow_suppression: false`` is the paper's reflex, which knows nothing of the
+suppresser.
 
 The minimum force: a grasp that must take a load suddenly (the hand-over of the object
 at 0.1 s in the task diagrams) needs its squeeze in place beforehand, ``m g / (k
 safety_ratio)`` per finger for k fingers carrying weight m g by friction (2.45 N for the
 0.3 kg object in a two-finger pinch); the task diagrams use 3 N. The default 1 N closes
-the fingers just as cleanly, but the ratio then exceeds the safety ratio for some 20 ms
-after the hand-over while the integrator catches up.
+the fingers just as cleanly, but at the hand-over the ratio then reaches the sliding limit
+before the integrator catches up, and the object slips out.
 
 Why a margin: an integral loop approaches its target exponentially, so aiming exactly at
 the safety ratio would leave ``|f_t| / f_n`` just above it for ever; aiming at
@@ -110,24 +118,33 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
     contact_threshold : float
         normal force, N, above which a finger counts as in contact
     release_share : float
-        a finger whose actuator command keeps less than this share of its grasping torque
-        (input 'share', from the suppresser) is left to voluntary motion: its force no
-        longer drives the integrator (never more than leaves two fingers held)
+        share (input 'share', from the suppresser) at which a third touching finger is
+        wholly handed to voluntary motion (two fingers are always held whole: they are the
+        grasp)
+    hold_share : float
+        share down to which a third touching finger is held whole; in proportion between
+        it and release_share
+    follow_suppression : bool
+        hand fingers over as the suppresser switches their grasp off (the hold above);
+        false: the paper's reflex, which holds every touching finger whole
     """
 
     type_name = "GraspReflex"
 
     def __init__(self, hand, grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,
-                 approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.8):
+                 approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.5,
+                 hold_share: float = 0.9, follow_suppression: bool = True):
         self.hand = hand_of(hand)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
                             ("max_force", max_force), ("contact_threshold", contact_threshold)):
             if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
                 raise ValueError(f"parameter '{name}' must be a positive number, got {value!r}")
-        if not (isinstance(release_share, (int, float)) and 0 <= release_share <= 1):
-            raise ValueError(f"parameter 'release_share' must be in [0, 1], got {release_share!r}")
+        if not (isinstance(release_share, (int, float)) and isinstance(hold_share, (int, float))
+                and 0 <= release_share < hold_share <= 1):
+            raise ValueError(f"parameters 'release_share' and 'hold_share' must satisfy 0 <= release_share < "
+                             f"hold_share <= 1, got {release_share!r} and {hold_share!r}")
         if not 0 <= margin < 1:
             raise ValueError(f"parameter 'margin' must be in [0, 1), got {margin!r}")
         if not 0 <= approach_force <= max_force:
@@ -138,9 +155,12 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         self.ratio_target = float(safety_ratio) / (1.0 + float(margin))
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
         self.release_share = float(release_share)
+        self.hold_share = float(hold_share)
+        self.follow_suppression = bool(follow_suppression)
         # the native calls' flat parameter array; the period (P_DT) is set by bind
         self._params = pack_params(self.threshold, self.approach_force, self.ki, np.nan, self.min_force,
-                                   self.ratio_target, self.max_force, self.initial, self.release_share)
+                                   self.ratio_target, self.max_force, self.initial, self.release_share,
+                                   self.hand.tip_radius, self.follow_suppression, self.hold_share)
         self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6, "share": 3}
         self.input_defaults = {"share": WHOLE_SHARE}
         self.outputs = {"tau_g": 9, "force": 3, "active": 3}
@@ -171,9 +191,9 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         )
 
     def initial_state(self) -> np.ndarray:
-        """[grasp force scale s (N), per finger the scale it was handed to voluntary motion at when
-        it last touched, 0 while the reflex holds it (3)]."""
-        return np.concatenate(([self.approach_force], np.zeros(3)))
+        """[grasp force scale s (N), per finger 1 where voluntary motion had taken it over when it
+        last touched, else 0 (3), per finger how much the reflex holds it (3, 1 at the start)]."""
+        return np.concatenate(([self.approach_force], np.zeros(3), np.ones(3)))
 
     def directions(self, state: np.ndarray, tip: np.ndarray, normal: np.ndarray,
                    fn: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -38,6 +38,9 @@ P_GRAVITY_COMP: int = _L["MANIP_P_GRAVITY_COMP"]  # 1.0: add the fingers' gravit
 P_LOAD_COMP: int = _L["MANIP_P_LOAD_COMP"]  # 1.0: add J^T of the shared object weight
 P_STEP: int = _L["MANIP_P_STEP"]  # seconds either side of t for the velocity target
 P_REACH_RTOL: int = _L["MANIP_P_REACH_RTOL"]  # inverse_kinematics._REACH_RTOL
+P_DT: int = _L["MANIP_P_DT"]  # the controller's period, s (set by bind)
+P_MATCHED: int = _L["MANIP_P_MATCHED"]  # 1.0: kp, kd realised for the period (matched_gains)
+P_CONTACT_COMP: int = _L["MANIP_P_CONTACT_COMP"]  # 1.0: aim fingers in contact fn / k_n into the object
 N_PARAMS: int = _L["MANIP_N_PARAMS"]
 
 # -- trajectories: waypoints (3, n_max, 4) rows (t, x, y, phi); meta (3, 2) float64 ------
@@ -48,18 +51,28 @@ M_INTERP: int = _L["MANIP_M_INTERP"]  # trajectory.INTERPOLATIONS' code
 N_OUT: int = _L["MANIP_N_OUT"]
 
 OK: int = _L["MANIP_OK"]
-"""Status of ``manipulation_output``; ``UNREACHABLE + f`` means finger f's target is out of reach."""
+"""Status of ``manipulation_output``; ``UNREACHABLE + f`` means finger f's target is out of reach,
+``NO_PERIOD`` that matched gains were asked for without a period (``P_DT``)."""
 UNREACHABLE: int = _L["MANIP_UNREACHABLE"]
+NO_PERIOD: int = _L["MANIP_NO_PERIOD"]
 
 manipulation_output = _native.manipulation_output
-"""``manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, out) -> status``: fill
+"""``manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, normal, obj, out) -> status``: fill
 ``out`` (3, 9) with the rows tau_m, tau_ff, q_ref (``out`` incomplete unless ``OK``).
 Takes C-contiguous float64 arrays only (``TypeError`` otherwise)."""
 
 
+matched_gains = _native.matched_gains
+"""``matched_gains(inertia, kp, kd, period) -> (kp_T, kd_T)``: the gains a torque held for each
+period needs to give a joint of that inertia the closed-loop poles of the continuous PD
+(pole matching under a zero-order hold; hierhand/csrc/control.h)."""
+
+
 def pack_params(q0, kp, kd, gravity, weight, threshold: float, gravity_compensation: bool,
-                load_compensation: bool, step: float) -> np.ndarray:
-    """The ``params`` vector of ``manipulation_output``."""
+                load_compensation: bool, step: float, matched: bool = True, period: float = np.nan,
+                contact_compensation: bool = True) -> np.ndarray:
+    """The ``params`` vector of ``manipulation_output`` (``period`` is set again by the
+    block's ``bind``)."""
     p = np.zeros(N_PARAMS)
     p[P_Q0:P_Q0 + 9] = q0
     p[P_KP:P_KP + 9] = kp
@@ -71,6 +84,9 @@ def pack_params(q0, kp, kd, gravity, weight, threshold: float, gravity_compensat
     p[P_LOAD_COMP] = 1.0 if load_compensation else 0.0
     p[P_STEP] = step
     p[P_REACH_RTOL] = _REACH_RTOL
+    p[P_MATCHED] = 1.0 if matched else 0.0
+    p[P_CONTACT_COMP] = 1.0 if contact_compensation else 0.0
+    p[P_DT] = period
     return p
 
 

@@ -10,16 +10,29 @@ the law in C over flat arrays packed once at load time). When a target turns out
 unreachable during the run, the Python API on the same C (``finger_ik_near``) names the
 finger and the distance.
 
+Beyond the paper's PD, each a parameter (and a row of the report's ablation):
+
+- ``discretization: matched``: kp and kd are the continuous joint PD, realised at the
+  block's period for each joint's own inertia (the diagonal of its finger's mass matrix,
+  armature included) by pole matching under the zero-order hold, so the 10 ms loop is
+  stable for any kp, kd > 0. Applied as they are and held for 10 ms (``held``), a joint PD
+  goes unstable once kd T / J exceeds 2: kd = 0.02 N m s/rad for the distal joints.
+- ``contact_compensation``: a finger in contact aims as deep into the object as its
+  measured normal force presses it (fn / k_n along the contact normal, the plant's
+  contact law), so that posture holding does not push back against the squeeze.
+- ``gravity_compensation`` and ``load_compensation`` (output ``tau_ff``, added after the
+  suppresser): the fingers' own gravity torques, and J^T of the object's load shared among
+  the fingers in contact by the grasp matrix at their contact points (``G^+ w``), so that
+  the shares balance the load's moment about the object's centre as well as its weight
+  (input ``obj``: the object's pose; ``normal``: the contact normals). The load is the
+  object's weight less the force on input ``support`` (what carries the object before the
+  hand-over; without it the fingers would lift the object a second time while they close).
+  Without the feedforward the soft PD lets a held object sag by millimetres.
+
 Outputs: ``tau_m``, the PD torque of the voluntary motion (what the suppresser weighs
-against the grasping torque), and ``tau_ff``, a feedforward that keeps the 10 ms loop's
-gains small: the fingers' own gravity torques and the object's load shared equally by
-the fingers in contact (``J^T`` of ``-(m g + f_support) / k``); without it the soft PD lets
-a held object sag by millimetres. The optional input ``support`` is the force something
-else applies to the object (the support that carries it until the hand takes it over):
-the fingers carry only the rest, or they would lift the object a second time and load
-every contact tangentially while the grasp closes. The suppresser adds ``tau_ff`` to the actuator command after
-suppression. Keeping the feedforward out of ``tau_m`` matters: it is not voluntary
-motion, and a finger that merely carries the object must not have its grasp suppressed.
+against the grasping torque), and ``tau_ff``. Keeping the feedforward out of ``tau_m``
+matters: it is not voluntary motion, and a finger that merely carries the object must not
+have its grasp suppressed.
 """
 
 from __future__ import annotations
@@ -36,11 +49,13 @@ from ..kernels import KERNELS, context, model_address
 from ..model.hand_source import ModelsTheHand, hand_of
 from ..model.port_info import DescribesHandPorts
 from .inverse_kinematics import UnreachableError, finger_ik_near
-from .manipulation_kernel import OK, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
+from .manipulation_kernel import NO_PERIOD, OK, P_DT, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
 
 DERIVATIVE_STEP = 1e-3
 """Seconds either side of t for the joint-velocity target (central difference of the IK)."""
+DISCRETIZATIONS = ("matched", "held")
+"""How kp and kd become the torque of a sampled PD (see the class docstring)."""
 
 
 class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
@@ -55,24 +70,34 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
     trajectories : mapping
         per finger name: {waypoints: [[t, x, y, phi], ...], interpolation: minjerk|linear}
     kp : scalar or 9 values
-        joint stiffness, N m/rad
+        joint stiffness, N m/rad, of the continuous PD (see discretization)
     kd : scalar or 9 values
-        joint damping, N m s/rad
+        joint damping, N m s/rad, of the continuous PD (see discretization)
     gravity_compensation : bool
         add the fingers' own gravity torques
     load_compensation : bool
         add J^T of the object's load (weight plus input support) shared by the fingers in
-        contact
+        contact through the grasp matrix at their contact points (the shares balance the
+        load's moment too)
     contact_threshold : float
         normal force, N, above which a finger carries part of the object
+    discretization : str
+        'matched' (default): kp and kd are the continuous joint PD, realised at the block's
+        period by pole matching on each joint's own inertia, stable for any kp, kd > 0;
+        'held': kp and kd applied as they are and held for the period (unstable once
+        kd T / J > 2, about kd = 0.02 N m s/rad for the distal joints at 10 ms)
+    contact_compensation : bool
+        aim a finger in contact as deep into the object as its measured normal force presses
+        it (fn / k_n along the contact normal), so that the PD does not resist the squeeze
     """
 
     type_name = "ManipulationPD"
     time_varying = True
 
-    def __init__(self, hand, trajectories: Mapping[str, Any] | None = None, kp: Any = 2.0, kd: Any = 0.01,
+    def __init__(self, hand, trajectories: Mapping[str, Any] | None = None, kp: Any = 3.0, kd: Any = 0.04,
                  gravity_compensation: bool = True, load_compensation: bool = True,
-                 contact_threshold: float = 0.05):
+                 contact_threshold: float = 0.05, discretization: str = "matched",
+                 contact_compensation: bool = True):
         self.hand = hand_of(hand)
         self.kp = float_array(kp, "kp", ndim=1, width=9, broadcast=True)
         self.kd = float_array(kd, "kd", ndim=1, width=9, broadcast=True)
@@ -81,16 +106,23 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         self.gravity_compensation = bool(gravity_compensation)
         self.load_compensation = bool(load_compensation)
         self.threshold = float(contact_threshold)
+        if discretization not in DISCRETIZATIONS:
+            raise ValueError(f"parameter 'discretization' must be one of {', '.join(DISCRETIZATIONS)}, "
+                             f"got {discretization!r}")
+        self.discretization = discretization
+        self.contact_compensation = bool(contact_compensation)
         self.weight = self.hand.params.object.mass * self.hand.gravity
         self.trajectories = self.parse_trajectories(trajectories or {})
-        self.inputs = {"q": 9, "qd": 9, "fn": 3, "support": 3}
+        self.inputs = {"q": 9, "qd": 9, "fn": 3, "support": 3, "normal": 6, "obj": 3}
         self.input_defaults = {"support": np.zeros(3)}
         self.outputs = {"tau_m": 9, "tau_ff": 9, "q_ref": 9}
         self.feedthrough = True
         # the native output's flat arrays (built from the attributes above, once)
         self._model = self.hand.native
         self._params = pack_params(self.hand.q0, self.kp, self.kd, self.hand.gravity, self.weight, self.threshold,
-                                   self.gravity_compensation, self.load_compensation, DERIVATIVE_STEP)
+                                   self.gravity_compensation, self.load_compensation, DERIVATIVE_STEP,
+                                   matched=discretization == "matched",
+                                   contact_compensation=self.contact_compensation)
         self._waypoints, self._meta = pack_trajectories(self.trajectories)
 
     def parse_trajectories(self, config: Mapping[str, Any]) -> list[Trajectory | None]:
@@ -119,6 +151,14 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
             out.append(traj)
         return out
 
+    def bind(self, period) -> None:
+        """Take the period the matched gains are realised for (a 'matched' PD needs one)."""
+        if period is None and self.discretization == "matched":
+            raise ValueError("ManipulationPD needs an explicit period (the paper's is 10 ms) to realise its gains "
+                             "for it; or give discretization: held")
+        super().bind(period)
+        self._params[P_DT] = float(period) if period is not None else np.nan
+
     def joint_targets_for(self, finger: int, point: np.ndarray) -> np.ndarray:
         """Joint angles (3,) of one finger for a tip target, on the branch nearest q0."""
         return finger_ik_near(self.hand, finger, point, self.hand.q0[3 * finger:3 * finger + 3])
@@ -128,21 +168,22 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         the object afterwards are not seen). Inputs the native call refuses for their type
         (lists, other dtypes, strided views) are converted to float64 first; inputs of the
         wrong width raise ``ValueError`` naming the port, a target out of reach
-        ``UnreachableError`` naming the finger."""
+        ``UnreachableError`` naming the finger; matched gains need ``bind``'s period first."""
         out = np.empty((3, 9))
-        q, qd, fn, support = inputs["q"], inputs["qd"], inputs["fn"], inputs.get("support", self.input_defaults["support"])
+        values = (inputs["q"], inputs["qd"], inputs["fn"], inputs.get("support", self.input_defaults["support"]),
+                  inputs["normal"], inputs["obj"])
         try:
-            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, q, qd, fn, support, out)
+            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, *values, out)
         except TypeError:
-            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t, flat_float64(q),
-                                         flat_float64(qd), flat_float64(fn), flat_float64(support), out)
+            status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t,
+                                         *(flat_float64(v) for v in values), out)
         if status != OK:
-            raise self.unreachable(status - UNREACHABLE, t)
+            raise self._kernel_error(status, 0, t, "output")
         return {"tau_m": out[0], "tau_ff": out[1], "q_ref": out[2]}
 
     def kernel(self) -> Kernel | None:
         """``output`` in C: the same native call on the arrays packed in ``__init__``
-        (stateless; the period does not enter)."""
+        and ``bind`` (stateless)."""
         model, params, waypoints, meta = self._model, self._params, self._waypoints, self._meta
         ctx = context(model_address(model), address(params), address(waypoints), address(meta),
                       waypoints.shape[1])
@@ -155,7 +196,11 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         )
 
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BaseException:
-        """The kernel's failure (a target out of reach) as ``output`` raises it."""
+        """A failure of the native output (a target out of reach, no period to match the gains
+        to) as ``output`` raises it."""
+        if code == NO_PERIOD:
+            return ValueError("ManipulationPD: its gains are matched to its period, and it has none yet "
+                              "(hint: give the block a period, or discretization: held)")
         return self.unreachable(code - UNREACHABLE, t)
 
     def unreachable(self, finger: int, t: float) -> UnreachableError:

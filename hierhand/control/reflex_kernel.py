@@ -36,7 +36,10 @@ P_RATIO: int = _L["REFLEX_P_RATIO"]  # ratio_target = safety_ratio / (1 + margin
 P_MAX_FORCE: int = _L["REFLEX_P_MAX_FORCE"]
 P_INITIAL: int = _L["REFLEX_P_INITIAL"]  # three slots: 1.0 for the fingers listed in 'grasp'
 P_COINCIDENT_RTOL: int = _L["REFLEX_P_COINCIDENT_RTOL"]  # internal_forces._COINCIDENT_RTOL
-P_RELEASE_SHARE: int = _L["REFLEX_P_RELEASE_SHARE"]  # below this share of its grasp torque a finger is let go
+P_RELEASE_SHARE: int = _L["REFLEX_P_RELEASE_SHARE"]  # losing contact below this share: not pushed back
+P_TIP_RADIUS: int = _L["REFLEX_P_TIP_RADIUS"]  # three fingertip radii (contact point = tip + radius * normal)
+P_FOLLOW: int = _L["REFLEX_P_FOLLOW"]  # 1.0: the hold of a finger follows its share (hand-over)
+P_HOLD_SHARE: int = _L["REFLEX_P_HOLD_SHARE"]  # a third finger is held whole down to this share
 N_PARAMS: int = _L["REFLEX_N_PARAMS"]
 
 # -- output vector of reflex_output: tau_g(9) force(3) active(3) ------------------------
@@ -45,7 +48,7 @@ O_FORCE: int = _L["REFLEX_O_FORCE"]
 O_ACTIVE: int = _L["REFLEX_O_ACTIVE"]
 N_OUT: int = _L["REFLEX_N_OUT"]
 
-N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, scale at hand-over (3), 0 while held]
+N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, handed over when it last touched (3), hold (3)]
 
 _directions = _native.reflex_directions
 _forces = _native.reflex_forces
@@ -61,8 +64,11 @@ WHOLE_SHARE = np.ones(3)
 
 
 def pack_params(threshold: float, approach_force: float, ki: float, dt: float, min_force: float,
-                ratio_target: float, max_force: float, initial, release_share: float = 0.8) -> np.ndarray:
-    """The reflex parameters as the native calls' flat array (``initial``: 3 booleans)."""
+                ratio_target: float, max_force: float, initial, release_share: float = 0.5,
+                tip_radius=(0.0, 0.0, 0.0), follow_suppression: bool = True,
+                hold_share: float = 0.9) -> np.ndarray:
+    """The reflex parameters as the native calls' flat array (``initial``: 3 booleans,
+    ``tip_radius``: the hand's three fingertip radii)."""
     p = np.empty(N_PARAMS)
     p[P_THRESHOLD] = threshold
     p[P_APPROACH] = approach_force
@@ -74,6 +80,9 @@ def pack_params(threshold: float, approach_force: float, ki: float, dt: float, m
     p[P_INITIAL : P_INITIAL + 3] = np.asarray(initial, dtype=bool)
     p[P_COINCIDENT_RTOL] = _COINCIDENT_RTOL
     p[P_RELEASE_SHARE] = release_share
+    p[P_TIP_RADIUS : P_TIP_RADIUS + 3] = tip_radius
+    p[P_FOLLOW] = 1.0 if follow_suppression else 0.0
+    p[P_HOLD_SHARE] = hold_share
     return p
 
 
@@ -81,12 +90,15 @@ def reflex_directions(params, state, tip, normal, fn) -> tuple[np.ndarray, np.nd
     """(g (3, 2), grasp (3,) bool, touching (3,) bool): ``GraspReflex.directions``.
 
     ``touching``: ``fn > contact_threshold``; ``grasp``: touching, or listed in 'grasp',
-    not handed to voluntary motion when it last touched (state[1 + i] == 0) and not touching. With
-    fewer than two fingers in the grasp ``g`` is 0.
-    Otherwise every finger pushes along its normal, an approaching one toward the others'
-    centroid, and ``g`` is ``(I - G^+ G) push`` over the grasp, or the centroid squeeze
-    ``c - p_i`` when that projection leaves some finger not pushing (``g_i . push_i <= 0``);
-    largest row length 1.
+    not handed over when it last touched (state[1 + i] == 0) and not touching. With fewer
+    than two fingers in the grasp ``g`` is 0. With two or more touching, ``g`` is
+    ``(I - G^+ G) push`` over them at their contact points (tip centre plus radius along the
+    normal), each pushing along its normal, blended toward the internal force of the other
+    two by the hold (state[4 + i]) of a third one held in part; an approaching finger gets a
+    unit push toward the touching ones. With fewer touching, the projection is over the
+    whole grasp, an approaching finger pushing toward the others' centroid. Where the
+    projection leaves some finger not pushing (``g_i . push_i <= 0``), the centroid squeeze
+    ``c - p_i``; largest row length 1 (of the members).
     """
     g = np.empty((3, 2))
     flags = np.empty(6)
@@ -124,16 +136,15 @@ def reflex_output(model, params, state, q, tip, normal, fn) -> np.ndarray:
 
 
 def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.ndarray:
-    """(4,) fresh next state ``[scale, scale at hand-over (3)]``.
+    """(7,) fresh next state ``[scale, handed over (3), hold (3)]``.
 
-    With at least two fingers in the grasp, touching and held by the reflex, the scale
-    moves by ``ki * dt * max_i (need_i - fn_i) / max(g_i . n_i, 1e-3)`` over those fingers,
-    ``need_i = max(min_force |g_i|, |ft_i| / ratio_target)``, clipped to
-    ``[0, max_force]``. A finger is held by the reflex unless its actuator command keeps less than
-    ``release_share`` of its grasping torque (``share``, 3 values: the suppresser's output);
-    the least share is handed over first, and two fingers always stay held. A touching
-    finger handed over keeps the scale it was first handed over at (0 when held), one out of
-    contact keeps its entry.
+    Each touching finger's hold: 1 for the two with the largest ``share`` (3 values: the
+    suppresser's output), for a third 1 down to ``hold_share`` falling linearly to 0 at
+    ``release_share`` (all 1 without ``follow_suppression``); a finger out of contact keeps
+    its hold. With at least two fingers touching, the scale moves by ``ki * dt * max_i
+    hold_i (need_i - fn_i) / max(g_i . n_i, 1e-3)`` over them, ``need_i = max(min_force
+    |g_i|, |ft_i| / ratio_target)``, clipped to ``[0, max_force]``. A touching finger is
+    marked handed over (1.0) while its hold is below 1; one out of contact keeps its mark.
     """
     new = np.empty(N_STATE)
     try:

@@ -5,6 +5,7 @@ Its law is ``suppresser_kernel`` (compiled, ``hierhand/csrc/suppresser.c``).
 
 from __future__ import annotations
 
+import math
 from typing import Any, Mapping
 
 import numpy as np
@@ -21,11 +22,13 @@ from .suppresser_kernel import (
     O_SHARE,
     O_TAU,
     O_TAU_G_EFF,
+    P_ALPHA,
     PASS,
     check_steepness,
     mode_code,
     pack_params,
     suppress_output,
+    suppress_update,
 )
 
 
@@ -36,11 +39,24 @@ class Suppresser(DescribesHandPorts, Block):
     unsuppressed: the manipulation controller's feedforward (finger gravity, the object's
     weight), which is not voluntary motion and must not weigh against the grasp.
 
-    ``mode: magnitude`` (default) uses g = |tau_m|: the larger the manipulation torque of
-    a joint, in either direction, the more its grasping torque is suppressed, as the
-    paper's prose describes. ``mode: signed`` is the paper's literal formula (g = tau_m),
-    which only suppresses against positive manipulation torques. ``enabled: false``
-    passes tau_g through unchanged, for the paper's comparison run without suppression.
+    ``mode: signed`` is the paper's literal formula, g = tau_m, with tau_m signed positive
+    against the joint's grasping torque: only voluntary motion that pulls against the grasp
+    suppresses it (the paper gives no joint convention; in this hand's counter-clockwise
+    angles the forefinger's pull off the object is a negative torque, the thumb's a positive
+    one). ``mode: magnitude`` uses g = |tau_m|, which also suppresses a grasp that voluntary
+    motion pushes along. ``enabled: false`` passes tau_g through unchanged, for the paper's
+    comparison run without suppression.
+
+    ``time_constant`` > 0 low-passes g before the sigmoid (first order, at the block's
+    period; the block then needs one). The sigmoid closes a loop from the manipulation
+    torque through the grasping torque and the finger back to the manipulation torque, of
+    gain |tau_g| S_a / 4 where the sigmoid is steepest: several times what the 10 ms PD
+    tolerates, so without the filter a holding finger whose torque strays to S_b can start
+    an oscillation at the PD's rate that throws the object. 0 is the paper's static law.
+
+    Output ``share``: per finger, what the suppresser lets through of its grasping torque
+    (``tau_g_eff . tau_g / |tau_g|^2``, 1 when disabled); the reflex stops squeezing for a
+    finger as it falls (``GraspReflex`` parameter ``release_share``).
 
     The nine joints are done in one native call (``suppress_output``).
 
@@ -51,42 +67,79 @@ class Suppresser(DescribesHandPorts, Block):
     S_b : scalar or 9 values
         manipulation torque, N m, at which the grasping torque is halved
     mode : str
-        'magnitude' (suppress by |tau_m|) or 'signed' (the paper's literal formula)
+        'signed' (the paper's formula, tau_m signed against the grasp) or 'magnitude'
+        (suppress by |tau_m|)
     enabled : bool
         false passes the grasping torque through unsuppressed
+    time_constant : float
+        seconds; > 0 low-passes the manipulation torque the sigmoid reads (needs a period),
+        0 reads it as it is
     """
 
     type_name = "Suppresser"
 
-    def __init__(self, S_a: Any = 100.0, S_b: Any = 0.1, mode: str = "magnitude", enabled: bool = True):
+    def __init__(self, S_a: Any = 100.0, S_b: Any = 0.03, mode: str = "signed", enabled: bool = True,
+                 time_constant: float = 0.0):
         code = mode_code(mode)
         self.S_a = float_array(S_a, "S_a", ndim=1, width=9, broadcast=True)
         self.S_b = float_array(S_b, "S_b", ndim=1, width=9, broadcast=True)
         check_steepness(self.S_a)
+        if isinstance(time_constant, bool) or not isinstance(time_constant, (int, float)) or not (
+                math.isfinite(time_constant) and time_constant >= 0):
+            raise ValueError(f"parameter 'time_constant' must be a time >= 0 in seconds, got {time_constant!r}")
         self.mode = mode
         self.enabled = bool(enabled)
+        self.time_constant = float(time_constant)
         self.inputs = {"tau_g": 9, "tau_m": 9, "tau_ff": 9}
         self.input_defaults = {"tau_ff": np.zeros(9)}
         self.outputs = {"tau": 9, "tau_g_eff": 9, "share": 3}
-        self.feedthrough = True
+        self.feedthrough = (True if not self.filtered else
+                            {"tau": {"tau_g", "tau_m", "tau_ff"}, "tau_g_eff": {"tau_g"}, "share": {"tau_g"}})
         self._params = pack_params(self.S_a, self.S_b, code if self.enabled else PASS)
 
+    @property
+    def filtered(self) -> bool:
+        """Whether the sigmoid reads the low-passed manipulation torque (the block's state)."""
+        return self.time_constant > 0
+
+    def bind(self, period) -> None:
+        """Take the period the low-pass filter steps at (a filtered suppresser needs one)."""
+        if self.filtered:
+            if period is None:
+                raise ValueError("a Suppresser with a time_constant needs an explicit period (its filter's step), "
+                                 "e.g. the reflex's 1 ms")
+            self._params[P_ALPHA] = -math.expm1(-float(period) / self.time_constant)
+        super().bind(period)
+
+    def initial_state(self) -> np.ndarray | None:
+        """The low-passed suppression inputs (9, zero at the start), or None for the static law."""
+        return np.zeros(9) if self.filtered else None
+
     def output(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        """One native call on the parameters packed in ``__init__`` (so S_a, S_b or the mode
-        changed on the object afterwards are not seen). Inputs the native call refuses for
-        their type (lists, other dtypes, strided views) are converted to float64 first;
-        inputs of the wrong width raise ``ValueError`` naming the port."""
+        """One native call on the parameters packed in ``__init__`` and ``bind`` (so S_a, S_b
+        or the mode changed on the object afterwards are not seen). Inputs the native call
+        refuses for their type (lists, other dtypes, strided views) are converted to float64
+        first; inputs of the wrong width raise ``ValueError`` naming the port."""
         out = np.empty(N_OUT)
         tau_g, tau_m, tau_ff = inputs["tau_g"], inputs["tau_m"], inputs.get("tau_ff", self.input_defaults["tau_ff"])
         try:
-            suppress_output(self._params, tau_g, tau_m, tau_ff, out)
+            suppress_output(self._params, tau_g, state, tau_m, tau_ff, out)
         except TypeError:
-            suppress_output(self._params, flat_float64(tau_g), flat_float64(tau_m), flat_float64(tau_ff), out)
+            suppress_output(self._params, flat_float64(tau_g), state, flat_float64(tau_m), flat_float64(tau_ff), out)
         return {"tau": out[O_TAU:O_TAU + 9], "tau_g_eff": out[O_TAU_G_EFF:O_TAU_G_EFF + 9],
                 "share": out[O_SHARE:O_SHARE + 3]}
 
+    def update(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> Any:
+        """The low-pass step of the suppression inputs (a fresh array); None when static."""
+        if state is None:
+            return None
+        nxt = np.empty(9)
+        suppress_update(self._params, state, flat_float64(inputs["tau_g"]), flat_float64(inputs["tau_m"]), nxt)
+        return nxt
+
     def kernel(self) -> Kernel | None:
-        """``output`` in C: the same native law on the parameters packed in ``__init__``
-        (stateless, no period needed)."""
-        return Kernel(context=address(self._params), output=KERNELS["Suppresser.output"], owners=(self._params,),
+        """``output`` (and, when filtered, ``update``) in C: the same native law on the
+        parameters packed in ``__init__`` and ``bind``."""
+        return Kernel(context=address(self._params), output=KERNELS["Suppresser.output"],
+                      update=KERNELS["Suppresser.update"] if self.filtered else 0, owners=(self._params,),
                       nogil=True)

@@ -8,8 +8,12 @@ Two readings of ``g``:
 
 - ``"magnitude"`` (default), ``g = |tau_m|``: suppression grows with the size of the
   manipulation torque, whichever its sign, as the paper's prose says.
-- ``"signed"``, ``g = tau_m``: the paper's literal formula; only positive ``tau_m``
-  suppresses, a large negative one passes ``tau_g`` through almost unchanged.
+- ``"signed"``: the paper's literal formula, ``g = tau_m`` with ``tau_m`` signed positive
+  against the joint's grasping torque (``-tau_m`` where ``tau_g >= 0``): only voluntary
+  motion that works against the grasp suppresses it. The paper does not give its joint
+  convention; in this hand's (every angle counter-clockwise) the torque that pulls the
+  forefinger off the object is negative and the thumb's positive, so the formula read in
+  it would never suppress the withdrawing forefinger.
 
 ``S_b`` is the manipulation torque at which ``tau_g`` is halved and ``S_a`` (>= 0) the
 steepness. Note that ``S_a = 0`` halves ``tau_g`` everywhere; "no suppression" is a large
@@ -37,6 +41,7 @@ _L = _native.LAYOUT
 P_S_A: int = _L["SUPPRESS_P_S_A"]  # 9 sigmoid steepnesses
 P_S_B: int = _L["SUPPRESS_P_S_B"]  # 9 half-suppression torques
 P_MODE: int = _L["SUPPRESS_P_MODE"]  # PASS, MAGNITUDE or SIGNED
+P_ALPHA: int = _L["SUPPRESS_P_ALPHA"]  # the low-pass step 1 - exp(-T / time constant)
 N_PARAMS: int = _L["SUPPRESS_N_PARAMS"]
 PASS: int = _L["SUPPRESS_PASS"]
 MAGNITUDE: int = _L["SUPPRESS_MAGNITUDE"]
@@ -50,10 +55,16 @@ MODES = {"magnitude": MAGNITUDE, "signed": SIGNED}
 """The modes by name, with their codes in the packed parameters."""
 
 suppress_output = _native.suppress
-"""``suppress_output(params, tau_g, tau_m, tau_ff, out)``: over the 9 joints,
-``out[O_TAU_G_EFF:]`` = ``suppress(tau_g, tau_m, S_a, S_b)`` (``tau_g`` for mode ``PASS``),
+"""``suppress_output(params, tau_g, g, tau_m, tau_ff, out)``: over the 9 joints,
+``out[O_TAU_G_EFF:]`` = ``tau_g * sigmoid(S_a (S_b - g))`` (``tau_g`` for mode ``PASS``),
 ``out[O_TAU:]`` = that ``+ tau_m + tau_ff`` and ``out[O_SHARE:]`` = ``finger_shares``
-(ones for ``PASS``). Takes C-contiguous float64 arrays only (``TypeError`` otherwise)."""
+(ones for ``PASS``). ``g``: the low-passed suppression inputs (the block's state), or None
+for the static law (``g`` of ``tau_m`` now). Takes C-contiguous float64 arrays only
+(``TypeError`` otherwise)."""
+
+suppress_update = _native.suppress_update
+"""``suppress_update(params, state, tau_g, tau_m, next)``: the low-passed suppression inputs
+``state + alpha (g(tau_m) - state)`` (9) into ``next``."""
 
 
 def mode_code(mode: str) -> int:
@@ -70,14 +81,16 @@ def check_steepness(S_a: Any) -> None:
         raise ValueError(f"S_a must be >= 0, got {S_a!r}")
 
 
-def pack_params(S_a: np.ndarray, S_b: np.ndarray, mode: int) -> np.ndarray:
-    """The ``params`` vector of ``suppress_output``: 9 values each of S_a and S_b, a mode."""
+def pack_params(S_a: np.ndarray, S_b: np.ndarray, mode: int, alpha: float = 1.0) -> np.ndarray:
+    """The ``params`` vector of ``suppress_output``: 9 values each of S_a and S_b, a mode, the
+    low-pass step (set again by the block's ``bind``)."""
     if mode not in (PASS, MAGNITUDE, SIGNED):
         raise ValueError(f"mode must be PASS, MAGNITUDE or SIGNED ({PASS}, {MAGNITUDE}, {SIGNED}), got {mode!r}")
     p = np.empty(N_PARAMS)
     p[P_S_A:P_S_A + 9] = S_a
     p[P_S_B:P_S_B + 9] = S_b
     p[P_MODE] = mode
+    p[P_ALPHA] = alpha
     return p
 
 
@@ -97,7 +110,7 @@ def sigmoid(x: Any) -> Any:
     return _shaped(out, np.shape(x))
 
 
-def suppress(tau_g: Any, tau_m: Any, S_a: Any, S_b: Any, mode: str = "magnitude") -> Any:
+def suppress(tau_g: Any, tau_m: Any, S_a: Any, S_b: Any, mode: str = "signed") -> Any:
     """Suppressed grasping torque ``tau_g * sigmoid(S_a * (S_b - g(tau_m)))``, elementwise.
 
     ``S_a`` and ``S_b`` may be scalars or per-joint arrays (broadcast with the torques).
@@ -113,14 +126,13 @@ def suppress(tau_g: Any, tau_m: Any, S_a: Any, S_b: Any, mode: str = "magnitude"
     return _shaped(out, shape)
 
 
-def finger_shares(tau_g: Any, tau_g_eff: Any, tau_m: Any) -> np.ndarray:
-    """Per finger (3), how much of its grasping torque survives in the voluntary part of its
-    command: ``(tau_g_eff_i + tau_m_i) . tau_g_i / |tau_g_i|^2``, 1 where ``tau_g_i`` is zero.
+def finger_shares(tau_g: Any, tau_g_eff: Any) -> np.ndarray:
+    """Per finger (3), how much of its grasping torque the suppresser lets through:
+    ``tau_g_eff_i . tau_g_i / |tau_g_i|^2``, 1 where ``tau_g_i`` is zero.
 
-    1 means the reflex's torque reaches the joints whole; below 1 the suppresser and the
-    manipulation torque are taking the finger over (0: cancelled, negative: pulled back).
-    The torques have 9 values each.
+    1 means the reflex's torque reaches the joints whole; toward 0 the sigmoid switches it
+    off. The torques have 9 values each.
     """
     share = np.empty(3)
-    _native.finger_shares(flat_float64(tau_g), flat_float64(tau_g_eff), flat_float64(tau_m), share)
+    _native.finger_shares(flat_float64(tau_g), flat_float64(tau_g_eff), share)
     return share

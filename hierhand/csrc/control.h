@@ -25,11 +25,12 @@
 
 /* == grasping reflex (reflex.c) =========================================================
  *
- * The fingers in contact (fn > threshold), and those listed in the block's 'grasp' that
- * are not touching and were not handed to voluntary motion when they last touched, are
- * squeezed together by the internal force (I - G^+ G) push, each finger pushing along its
- * contact normal (an approaching one toward the others' centroid); one integral loop
- * scales it until every contact the reflex still holds has the normal force it needs. */
+ * The fingers in contact (fn > threshold) are squeezed together by the internal force
+ * (I - G^+ G) push at their contact points, each pushing along its contact normal; those
+ * listed in the block's 'grasp' that are not touching, and that the reflex was not letting
+ * go of when they last touched, approach the others. One integral loop scales the squeeze
+ * until every contact the reflex holds has the normal force it needs; the suppresser's
+ * share sets how much it holds each (the hand-over to voluntary motion). */
 
 /* -- parameters: params[HH_REFLEX_P_*] -------------------------------------------------- */
 enum {
@@ -42,13 +43,18 @@ enum {
     HH_REFLEX_P_MAX_FORCE = 6, /* largest force scale, N */
     HH_REFLEX_P_INITIAL = 7, /* three: non-zero for the fingers listed in 'grasp' */
     HH_REFLEX_P_COINCIDENT_RTOL = 10, /* points this close, relative to their size, coincide */
-    HH_REFLEX_P_RELEASE_SHARE = 11, /* a finger whose command keeps less of its grasp torque is let go */
-    HH_REFLEX_N_PARAMS = 12
+    HH_REFLEX_P_RELEASE_SHARE = 11, /* a finger that loses contact while the suppresser lets through less
+                                       than this share of its grasping torque is not pushed back */
+    HH_REFLEX_P_TIP_RADIUS = 12, /* three: the fingertip radii; a touching finger's contact point is its
+                                    tip centre plus this along the contact normal */
+    HH_REFLEX_P_FOLLOW = 15, /* non-zero: the reflex's hold of a finger follows its share (hand-over) */
+    HH_REFLEX_P_HOLD_SHARE = 16, /* a third finger is held whole down to this share, not at all at release_share */
+    HH_REFLEX_N_PARAMS = 17
 };
 
-/* -- state: [force scale, per finger the scale it was handed to voluntary motion at (3),
- *    0 while the reflex holds it] ---------------------------------------------------------- */
-enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_HANDED = 1, HH_REFLEX_N_STATE = 4 };
+/* -- state: [force scale, per finger 1 where the reflex was letting go of it when it last
+ *    touched (3), per finger how much the reflex holds it (3)] ---------------------------- */
+enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_HANDED = 1, HH_REFLEX_S_HOLD = 4, HH_REFLEX_N_STATE = 7 };
 
 /* -- output of hh_reflex_output: tau_g (9), |f_i| (3), in the grasp (3, 0 or 1) ---------- */
 enum { HH_REFLEX_O_TAU = 0, HH_REFLEX_O_FORCE = 9, HH_REFLEX_O_ACTIVE = 12, HH_REFLEX_N_OUT = 15 };
@@ -77,6 +83,15 @@ typedef struct hh_reflex_inputs {
  * drops it. The result does not depend on the point the moments are taken about. */
 void hh_project_internal(int k, const double *points, const double *f, double *out);
 
+/* The forces f (k x 2) at the points (k x 2, 1 <= k <= 3) that together give the object
+ * the wrench w (fx, fy and the moment about (ox, oy)) with the least sum of |f_i|^2 /
+ * weight_i (weights > 0): W G^T (G W G^T)^-1 w, the part of Yoshikawa-Nagai's
+ * decomposition that carries a load (the internal part is hh_project_internal's), shared
+ * in proportion to the weights. With one point, or points that coincide, the moment is
+ * dropped, as numpy.linalg.pinv drops it. */
+void hh_distribute_wrench(int k, const double *points, const double *weights, double ox, double oy, const double w[3],
+                          double *f);
+
 /* The centroid squeeze g_i = c - p_i of k points (k x 2), c their centroid, divided by its
  * longest row, into g (k x 2): an internal force set for any k >= 2, pushing every point
  * toward the centroid. HH_REFLEX_COINCIDENT when its longest row is at most
@@ -85,31 +100,34 @@ int hh_centroid_squeeze(int k, const double *points, double coincident_rtol, dou
 
 /* The internal force per finger at unit scale, g (3 x 2: largest row length 1, zero
  * outside the grasp or with fewer than two fingers in it), and the flags grasp and
- * touching (0 or 1). Should the projection leave some finger not pushing
- * (g_i . push_i <= 0), g is the centroid squeeze c - p_i. HH_REFLEX_OK or
- * HH_REFLEX_COINCIDENT (g then incomplete). */
+ * touching (0 or 1). With two or more touching: the internal force among them at their
+ * contact points, blended toward that of the other two by the hold (state) of a third one
+ * held in part; a finger approaching gets a unit push toward the touching ones. With fewer
+ * touching: the internal force among all of the grasp. Where the projection leaves some
+ * finger not pushing (g_i . push_i <= 0), the centroid squeeze c - p_i instead.
+ * HH_REFLEX_OK or HH_REFLEX_COINCIDENT (g then incomplete). */
 int hh_reflex_directions(const double *params, const double *state, const hh_reflex_inputs *in, double g[3][2],
                          int grasp[3], int touching[3]);
 
 /* Fingertip force commands f (3 x 2) from the directions: g_i times the state's scale for
- * a touching finger (at most the scale it was handed over at, for a finger voluntary motion
- * has taken), g_i scaled to the approach force otherwise. */
+ * a touching finger, g_i scaled to the approach force otherwise. */
 void hh_reflex_forces(const double *params, const double *state, const double g[3][2], const int touching[3],
                       double f[3][2]);
 
-/* out (HH_REFLEX_N_OUT): tau_g = J_i^T f_i per finger (J_i: Jacobian of finger i's tip
- * centre at joint angles q), |f_i|, and the grasp flags. Status as
- * hh_reflex_directions. */
+/* out (HH_REFLEX_N_OUT): tau_g = J_i^T f_i per finger (J_i: Jacobian of finger i's contact
+ * point, or of its tip centre while it does not touch, at joint angles q), |f_i|, and the
+ * grasp flags. Status as hh_reflex_directions. */
 int hh_reflex_output(const hh_model *m, const double *params, const double *state, const hh_reflex_inputs *in,
                      const double *q, double *out);
 
-/* next (HH_REFLEX_N_STATE): with two or more fingers in the grasp, touching and held
- * (not handed over: in->share[i] below release_share, least share first, while two fingers
- * stay held; in->share NULL hands none over), the scale moves by
- * ki dt max_i (need_i - fn_i) / max(g_i . n_i, 1e-3) over them, need_i =
- * max(min_force |g_i|, |ft_i| / ratio), clipped to [0, max_force]; a touching finger
- * handed over keeps the scale it was first handed over at (the state's scale then), one
- * held gets 0, a finger out of contact keeps its entry. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or HH_REFLEX_COINCIDENT. */
+/* next (HH_REFLEX_N_STATE): each touching finger's hold (the two with the largest share 1,
+ * a third 1 down to hold_share falling linearly to 0 at release_share; in->share NULL or
+ * params[HH_REFLEX_P_FOLLOW] zero: 1), the hold of a finger out of contact kept; with two or
+ * more fingers touching, the scale moves by ki dt max_i hold_i (need_i - fn_i) /
+ * max(g_i . n_i, 1e-3) over them, need_i = max(min_force |g_i|, |ft_i| / ratio), clipped to
+ * [0, max_force]; a touching finger is marked handed over (1) when its hold is below 1, held
+ * (0) otherwise, a finger out of contact keeps its mark. HH_REFLEX_OK, HH_REFLEX_NO_PERIOD or
+ * HH_REFLEX_COINCIDENT. */
 int hh_reflex_update(const double *params, const double *state, const hh_reflex_inputs *in, const double *ft,
                      double *next);
 
@@ -136,7 +154,12 @@ enum {
     HH_MANIP_P_STEP = 34, /* seconds either side of t for the velocity target */
     HH_MANIP_P_REACH_RTOL = 35, /* wrist distances this close (relative to l1 + l2)
                                    outside the reachable annulus count as on it */
-    HH_MANIP_N_PARAMS = 36
+    HH_MANIP_P_DT = 36, /* the controller's period T, s (> 0 where the gains are matched) */
+    HH_MANIP_P_MATCHED = 37, /* non-zero: realise kp, kd for the period (hh_matched_gains);
+                                zero: apply them as they are, held for the period */
+    HH_MANIP_P_CONTACT_COMP = 38, /* non-zero: aim a finger in contact as deep into the object
+                                     as its measured normal force presses it (fn / k_n) */
+    HH_MANIP_N_PARAMS = 39
 };
 
 /* -- trajectories -------------------------------------------------------------------------
@@ -163,12 +186,22 @@ typedef struct hh_trajectory {
 /* Finger f's trajectory of tr (count 0: the finger has none). */
 hh_trajectory hh_finger_trajectory(const hh_trajectories *tr, int f);
 
+/* Inputs of one hit, as the plant's output ports give them. */
+typedef struct hh_manip_inputs {
+    const double *q; /* 9 joint angles */
+    const double *qd; /* 9 joint rates */
+    const double *fn; /* 3: normal force per finger */
+    const double *support; /* 3: the force (fx, fy, torque) something else applies to the object */
+    const double *normal; /* 6: per finger the contact normal (into the object) */
+    const double *obj; /* 3: the object's pose x, y, theta */
+} hh_manip_inputs;
+
 /* -- output of hh_manipulation_output: rows tau_m, tau_ff, q_ref (9 each) --------------- */
 enum { HH_MANIP_O_TAU_M = 0, HH_MANIP_O_TAU_FF = 9, HH_MANIP_O_Q_REF = 18, HH_MANIP_N_OUT = 27 };
 
-/* -- status: HH_MANIP_OK, or HH_MANIP_UNREACHABLE + f when a target of finger f is out of
- * its reach ---------------------------------------------------------------------------- */
-enum { HH_MANIP_OK = 0, HH_MANIP_UNREACHABLE = 1 };
+/* -- status: HH_MANIP_OK, HH_MANIP_UNREACHABLE + f when a target of finger f is out of
+ * its reach, HH_MANIP_NO_PERIOD when matched gains have no period to be matched to ------ */
+enum { HH_MANIP_OK = 0, HH_MANIP_UNREACHABLE = 1, HH_MANIP_NO_PERIOD = 4 };
 
 /* An angle wrapped to (-pi, pi]. */
 double hh_wrap_angle(double a);
@@ -201,41 +234,74 @@ void hh_trajectory_sample(const hh_trajectory *tr, double t, double pose[3]);
  * last one on; NaN at a NaN time. */
 void hh_trajectory_velocity(const hh_trajectory *tr, double t, double velocity[3]);
 
-/* out (HH_MANIP_N_OUT) at time t, joint angles q (9), rates qd (9), normal forces fn (3)
- * and the force a support applies to the object (support: fx, fy, torque): tau_m = kp
- * (q_ref - q) + kd (qd_ref - qd), tau_ff the gravity and load feedforward (the load: the
- * object's weight plus the support force), q_ref. HH_MANIP_OK or HH_MANIP_UNREACHABLE + f
- * (out then incomplete). */
+/* The gains (kp_T, kd_T) that a torque held for each period T needs so that a joint of
+ * inertia J follows its target with the closed-loop poles e^{sT} of the continuous PD loop
+ * J s^2 + kd s + kp = 0 (pole matching under a zero-order hold): with z1, z2 = e^{s T},
+ * kp_T = J (1 - (z1 + z2) + z1 z2) / T^2 and kd_T = J (3 - (z1 + z2) - z1 z2) / (2 T). The
+ * sampled loop is then stable for every kp, kd > 0, where kp and kd applied as they are
+ * and held for T go unstable once kd T / J exceeds 2 (or kp T^2 / J exceeds 2 kd T / J).
+ * kp_T <= kp and kd_T <= kd; both tend to kp, kd as T -> 0. */
+void hh_matched_gains(double inertia, double kp, double kd, double period, double *kp_t, double *kd_t);
+
+/* out (HH_MANIP_N_OUT) at time t from the inputs of one hit: tau_m = kp_T (q_ref - q) +
+ * kd_T (qd_ref - qd) with the gains hh_matched_gains gives for each joint's own inertia
+ * (the diagonal of its finger's mass matrix at q, armature included) where
+ * params[HH_MANIP_P_MATCHED] is set, kp and kd as they are otherwise; tau_ff the fingers'
+ * gravity torques and J^T of the object's load (its weight plus the support force and
+ * torque), shared among the fingers carrying it (fn above the threshold) by
+ * hh_distribute_wrench at their contact points (tip centre plus radius along the normal),
+ * weighted by their normal forces, so that the shares also balance the load's moment about
+ * the object's centre; q_ref.
+ * HH_MANIP_OK, HH_MANIP_UNREACHABLE + f or HH_MANIP_NO_PERIOD (out then incomplete). */
 int hh_manipulation_output(const hh_model *m, const double *params, const hh_trajectories *tr, double t,
-                           const double *q, const double *qd, const double *fn, const double *support, double *out);
+                           const hh_manip_inputs *in, double *out);
 
 /* == suppresser (suppresser.c) ===========================================================
  *
  * tau_g_eff = tau_g * sigmoid(S_a (S_b - g(tau_m))) per joint, g = |tau_m| (magnitude) or
- * tau_m (signed), or tau_g unchanged (pass); the command is tau_g_eff + tau_m + tau_ff.
- * share_i, per finger, is how much of the finger's grasping torque tau_g_i survives in the
- * voluntary part of its command: (tau_g_eff_i + tau_m_i) . tau_g_i / |tau_g_i|^2, 1 where
- * tau_g_i is zero or in pass mode (no suppresser: nothing hands a finger over). */
+ * tau_m signed positive against the joint's grasping torque (signed: -tau_m where
+ * tau_g >= 0, tau_m where tau_g < 0), or tau_g unchanged (pass); the command is
+ * tau_g_eff + tau_m + tau_ff. share_i, per finger, is how much of the finger's grasping
+ * torque tau_g_i the suppresser lets through: tau_g_eff_i . tau_g_i / |tau_g_i|^2, 1 where
+ * tau_g_i is zero or in pass mode. */
 
 /* -- parameters: params[HH_SUPPRESS_P_*] ------------------------------------------------ */
-enum { HH_SUPPRESS_P_S_A = 0, HH_SUPPRESS_P_S_B = 9, HH_SUPPRESS_P_MODE = 18, HH_SUPPRESS_N_PARAMS = 19 };
+enum {
+    HH_SUPPRESS_P_S_A = 0, /* 9 sigmoid steepnesses, 1/(N m) */
+    HH_SUPPRESS_P_S_B = 9, /* 9 suppression inputs, N m, at which the grasping torque is halved */
+    HH_SUPPRESS_P_MODE = 18, /* HH_SUPPRESS_PASS, _MAGNITUDE or _SIGNED */
+    HH_SUPPRESS_P_ALPHA = 19, /* the low-pass step of hh_suppress_update: 1 - exp(-T / time constant) */
+    HH_SUPPRESS_N_PARAMS = 20
+};
 enum { HH_SUPPRESS_PASS = 0, HH_SUPPRESS_MAGNITUDE = 1, HH_SUPPRESS_SIGNED = 2 }; /* params[P_MODE] */
 
 /* -- output: tau (9), tau_g_eff (9), share (3) ------------------------------------------ */
 enum { HH_SUPPRESS_O_TAU = 0, HH_SUPPRESS_O_TAU_G_EFF = 9, HH_SUPPRESS_O_SHARE = 18, HH_SUPPRESS_N_OUT = 21 };
 
-/* out (HH_SUPPRESS_N_OUT) from the torques tau_g, tau_m, tau_ff (9 each). */
-void hh_suppress(const double *params, const double *tau_g, const double *tau_m, const double *tau_ff, double *out);
+/* out (HH_SUPPRESS_N_OUT) from the torques tau_g, tau_m, tau_ff (9 each) and the
+ * suppression inputs g (9): the low-passed ones of the block's state, or NULL for the static
+ * law (g from tau_m now, hh_suppression_input). */
+void hh_suppress(const double *params, const double *tau_g, const double *g, const double *tau_m,
+                 const double *tau_ff, double *out);
+
+/* next (9): the low-passed suppression inputs, state + alpha (hh_suppression_input(tau_g,
+ * tau_m) - state) per joint (alpha params[HH_SUPPRESS_P_ALPHA]); unchanged in pass mode. */
+void hh_suppress_update(const double *params, const double *state, const double *tau_g, const double *tau_m,
+                        double *next);
 
 /* The logistic function 1 / (1 + exp(-x)), without overflow for large |x|. */
 double hh_sigmoid(double x);
 
-/* One joint's suppressed grasping torque tau_g * sigmoid(S_a (S_b - g(tau_m))) in mode
- * HH_SUPPRESS_MAGNITUDE or HH_SUPPRESS_SIGNED, tau_g in HH_SUPPRESS_PASS. */
-double hh_suppressed(double tau_g, double tau_m, double s_a, double s_b, double mode);
+/* One joint's suppression input g(tau_m): |tau_m| in mode HH_SUPPRESS_MAGNITUDE, tau_m
+ * signed positive against tau_g in HH_SUPPRESS_SIGNED (-tau_m where tau_g >= 0). */
+double hh_suppression_input(double tau_g, double tau_m, double mode);
 
-/* share (3) of the torques tau_g, tau_g_eff, tau_m (9 each), as the suppresser's output
- * of that name when it does suppress. */
-void hh_finger_shares(const double *tau_g, const double *tau_g_eff, const double *tau_m, double share[3]);
+/* One joint's suppressed grasping torque for the suppression input g:
+ * tau_g * sigmoid(S_a (S_b - g)), tau_g in HH_SUPPRESS_PASS. */
+double hh_suppressed(double tau_g, double g, double s_a, double s_b, double mode);
+
+/* share (3) of the torques tau_g and tau_g_eff (9 each), as the suppresser's output of
+ * that name when it does suppress. */
+void hh_finger_shares(const double *tau_g, const double *tau_g_eff, double share[3]);
 
 #endif

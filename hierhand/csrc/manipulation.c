@@ -244,54 +244,127 @@ static int reference(const hh_model *m, const double *params, const hh_trajector
 /* The fingers' gravity torques (if enabled) plus J^T of the object's load shared by the
  * fingers carrying it (if enabled), into tau_ff (9). The load is the weight less what the
  * support carries: before the hand-over the fingers must not lift the object a second
- * time, which would load every contact tangentially while the grasp closes. */
-static void feedforward(const hh_model *m, const double *params, const double *q, const double *fn,
-                        const double *support, double *tau_ff)
+ * time, which would load every contact tangentially while the grasp closes. It is shared
+ * by the grasp matrix at the contact points, so the shares balance its moment about the
+ * object's centre too (an even split leaves the fingers of a tilted pinch to take up the
+ * moment with posture errors, which turn the object), and in proportion to the normal
+ * forces, what each contact can carry by friction: a finger that is letting go sheds its
+ * load as its normal force falls, instead of being pushed along the face by it. */
+static void feedforward(const hh_model *m, const double *params, const hh_manip_inputs *in, double *tau_ff)
 {
     for (int j = 0; j < HH_JOINTS; j++)
         tau_ff[j] = 0.0;
     int gravity = params[HH_MANIP_P_GRAVITY_COMP] != 0.0;
     double threshold = params[HH_MANIP_P_THRESHOLD];
-    int carrying = 0;
-    if (params[HH_MANIP_P_LOAD_COMP] != 0.0)
-        for (int f = 0; f < HH_FINGERS; f++)
-            if (fn[f] > threshold)
-                carrying += 1;
-    if (!gravity && carrying == 0)
-        return;
-    static const double at_rest[3] = {0.0, 0.0, 0.0};
-    double sx = 0.0, sy = 0.0; /* each carrying finger's share of the weight */
-    if (carrying) {
-        sx = -(params[HH_MANIP_P_WX] + support[0]) / carrying;
-        sy = -(params[HH_MANIP_P_WY] + support[1]) / carrying;
+    int carrying[HH_FINGERS];
+    double points[HH_FINGERS][2], shares[HH_FINGERS][2], weights[HH_FINGERS];
+    int k = 0;
+    for (int f = 0; f < HH_FINGERS; f++) {
+        double u[3][2], pts[4][2];
+        hh_finger_frames(m->fingers[f], in->q + 3 * f, u, pts);
+        carrying[f] = params[HH_MANIP_P_LOAD_COMP] != 0.0 && in->fn[f] > threshold;
+        if (carrying[f]) {
+            double radius = m->fingers[f][HH_F_TIP_RADIUS];
+            points[k][0] = pts[3][0] + radius * in->normal[2 * f];
+            points[k][1] = pts[3][1] + radius * in->normal[2 * f + 1];
+            weights[k] = in->fn[f];
+            k += 1;
+        }
     }
+    if (k > 0) {
+        double load[3] = {-(params[HH_MANIP_P_WX] + in->support[0]), -(params[HH_MANIP_P_WY] + in->support[1]),
+                          -in->support[2]};
+        hh_distribute_wrench(k, points[0], weights, in->obj[0], in->obj[1], load, shares[0]);
+    }
+    static const double at_rest[3] = {0.0, 0.0, 0.0};
+    int c = 0;
     for (int f = 0; f < HH_FINGERS; f++) {
         const double *finger = m->fingers[f];
         double u[3][2], pts[4][2];
-        hh_finger_frames(finger, q + 3 * f, u, pts);
+        hh_finger_frames(finger, in->q + 3 * f, u, pts);
         if (gravity)
             hh_finger_bias(finger, (const double(*)[2])u, at_rest, params[HH_MANIP_P_GX], params[HH_MANIP_P_GY],
                            tau_ff + 3 * f);
-        if (carrying && fn[f] > threshold) {
+        if (carrying[f]) {
             double jac[2][3];
-            hh_finger_point_jacobian((const double(*)[2])pts, pts[3][0], pts[3][1], jac);
+            hh_finger_point_jacobian((const double(*)[2])pts, points[c][0], points[c][1], jac);
             for (int j = 0; j < 3; j++)
-                tau_ff[3 * f + j] += jac[0][j] * sx + jac[1][j] * sy;
+                tau_ff[3 * f + j] += jac[0][j] * shares[c][0] + jac[1][j] * shares[c][1];
+            c += 1;
         }
     }
 }
 
-int hh_manipulation_output(const hh_model *m, const double *params, const hh_trajectories *tr, double t,
-                           const double *q, const double *qd, const double *fn, const double *support, double *out)
+void hh_matched_gains(double inertia, double kp, double kd, double period, double *kp_t, double *kd_t)
 {
+    double rate = kd / (2.0 * inertia); /* the poles s = -rate +- sqrt(rate^2 - kp / J) */
+    double discriminant = rate * rate - kp / inertia;
+    double root = sqrt(fabs(discriminant));
+    double sum = discriminant >= 0.0 ? exp((root - rate) * period) + exp(-(root + rate) * period)
+                                     : 2.0 * exp(-rate * period) * cos(root * period);
+    double product = exp(-2.0 * rate * period);
+    *kp_t = inertia * (1.0 - sum + product) / (period * period);
+    *kd_t = inertia * (3.0 - sum - product) / (2.0 * period);
+}
+
+/* The PD torque tau_m (9) toward q_ref, qd_ref: per joint the gains of hh_matched_gains
+ * for its own inertia, or kp and kd as they are. */
+static void pd_torque(const hh_model *m, const double *params, const double *q, const double *qd,
+                      const double *q_ref, const double *qd_ref, double *tau_m)
+{
+    int matched = params[HH_MANIP_P_MATCHED] != 0.0;
+    for (int f = 0; f < HH_FINGERS; f++) {
+        double mass[3][3];
+        if (matched) {
+            double u[3][2], pts[4][2];
+            hh_finger_frames(m->fingers[f], q + 3 * f, u, pts);
+            hh_finger_mass_matrix(m->fingers[f], (const double(*)[2])u, mass);
+        }
+        for (int i = 0; i < 3; i++) {
+            int j = 3 * f + i;
+            double kp = params[HH_MANIP_P_KP + j];
+            double kd = params[HH_MANIP_P_KD + j];
+            if (matched)
+                hh_matched_gains(mass[i][i], kp, kd, params[HH_MANIP_P_DT], &kp, &kd);
+            tau_m[j] = kp * (q_ref[j] - q[j]) + kd * (qd_ref[j] - qd[j]);
+        }
+    }
+}
+
+/* Moves the joint targets q_ref (9) of each finger in contact so that its tip centre sits
+ * fn / k_n deeper along the contact normal: the penetration of the contact law at the
+ * measured normal force. A planned fingertip pose lies on the object's surface; a tip that
+ * squeezes sits inside it, and a PD aimed at the surface would push back against the
+ * squeeze. A shifted target out of reach leaves the finger's target as it was. */
+static void contact_offset(const hh_model *m, const double *params, const hh_manip_inputs *in, double *q_ref)
+{
+    if (params[HH_MANIP_P_CONTACT_COMP] == 0.0)
+        return;
+    for (int f = 0; f < HH_FINGERS; f++) {
+        if (!(in->fn[f] > params[HH_MANIP_P_THRESHOLD]))
+            continue;
+        double depth = in->fn[f] / m->body[HH_B_K_N];
+        double pose[3], q[3], reach[3];
+        hh_finger_fk(m->fingers[f], q_ref + 3 * f, pose);
+        if (hh_ik_near(m->fingers[f], params[HH_MANIP_P_REACH_RTOL], pose[0] + depth * in->normal[2 * f],
+                       pose[1] + depth * in->normal[2 * f + 1], pose[2], q_ref + 3 * f, q, reach))
+            for (int j = 0; j < 3; j++)
+                q_ref[3 * f + j] = q[j];
+    }
+}
+
+int hh_manipulation_output(const hh_model *m, const double *params, const hh_trajectories *tr, double t,
+                           const hh_manip_inputs *in, double *out)
+{
+    if (params[HH_MANIP_P_MATCHED] != 0.0 && !(params[HH_MANIP_P_DT] > 0.0))
+        return HH_MANIP_NO_PERIOD;
     double qd_ref[HH_JOINTS];
     double *q_ref = out + HH_MANIP_O_Q_REF;
     int code = reference(m, params, tr, t, q_ref, qd_ref);
     if (code != HH_MANIP_OK)
         return code;
-    for (int j = 0; j < HH_JOINTS; j++)
-        out[HH_MANIP_O_TAU_M + j] = params[HH_MANIP_P_KP + j] * (q_ref[j] - q[j]) +
-                                     params[HH_MANIP_P_KD + j] * (qd_ref[j] - qd[j]);
-    feedforward(m, params, q, fn, support, out + HH_MANIP_O_TAU_FF);
+    contact_offset(m, params, in, q_ref);
+    pd_torque(m, params, in->q, in->qd, q_ref, qd_ref, out + HH_MANIP_O_TAU_M);
+    feedforward(m, params, in, out + HH_MANIP_O_TAU_FF);
     return HH_MANIP_OK;
 }

@@ -82,42 +82,141 @@ int hh_centroid_squeeze(int k, const double *points, double coincident_rtol, dou
     return HH_REFLEX_OK;
 }
 
+/* x (3) solving (G W G^T) x = w for the grasp matrix G of k points about the point c and
+ * the point weights W (NULL: all 1): G W G^T = [[K, 0, a], [0, K, b], [a, b, s]] (K = sum
+ * w_i, a = -sum w_i r_iy, b = sum w_i r_ix, both round-off about the weighted centroid,
+ * s = sum w_i |r_i|^2, r_i = p_i - c). When the moment row is numerically dependent (all
+ * points coincide) it is dropped, as numpy.linalg.pinv drops it. */
+static void grasp_solve(int k, const double *points, const double *weights, double cx, double cy, const double w[3],
+                        double x[3])
+{
+    double a = 0.0, b = 0.0, s = 0.0, fk = 0.0;
+    for (int i = 0; i < k; i++) {
+        double rx = points[2 * i] - cx;
+        double ry = points[2 * i + 1] - cy;
+        double weight = weights == NULL ? 1.0 : weights[i];
+        a -= weight * ry;
+        b += weight * rx;
+        s += weight * (rx * rx + ry * ry);
+        fk += weight;
+    }
+    double schur = s - (a * a + b * b) / fk;
+    x[2] = schur > PINV_RCOND_SQUARED * hh_max(fk, s) ? (w[2] - (a * w[0] + b * w[1]) / fk) / schur : 0.0;
+    x[0] = (w[0] - a * x[2]) / fk;
+    x[1] = (w[1] - b * x[2]) / fk;
+}
+
+/* out (k x 2) = base - G^T x for G about the centroid c (base NULL: zero). */
+static void grasp_transpose(int k, const double *points, double cx, double cy, const double x[3],
+                            const double *base, double *out)
+{
+    for (int i = 0; i < k; i++) {
+        double rx = points[2 * i] - cx;
+        double ry = points[2 * i + 1] - cy;
+        double bx = base == NULL ? 0.0 : base[2 * i];
+        double by = base == NULL ? 0.0 : base[2 * i + 1];
+        out[2 * i] = bx - (x[0] - ry * x[2]);
+        out[2 * i + 1] = by - (x[1] + rx * x[2]);
+    }
+}
+
 void hh_project_internal(int k, const double *points, const double *f, double *out)
 {
     double cx, cy;
     centroid(k, points, &cx, &cy);
-    /* w = G f, and G G^T = [[k, 0, a], [0, k, b], [a, b, s]] */
-    double w0 = 0.0, w1 = 0.0, w2 = 0.0;
-    double a = 0.0, b = 0.0, s = 0.0;
+    double w[3] = {0.0, 0.0, 0.0}; /* w = G f */
     for (int i = 0; i < k; i++) {
-        double rx = points[2 * i] - cx;
-        double ry = points[2 * i + 1] - cy;
-        w0 += f[2 * i];
-        w1 += f[2 * i + 1];
-        w2 += rx * f[2 * i + 1] - ry * f[2 * i];
-        a -= ry;
-        b += rx;
-        s += rx * rx + ry * ry;
+        w[0] += f[2 * i];
+        w[1] += f[2 * i + 1];
+        w[2] += (points[2 * i] - cx) * f[2 * i + 1] - (points[2 * i + 1] - cy) * f[2 * i];
     }
-    double fk = (double)k;
-    double schur = s - (a * a + b * b) / fk;
-    /* all points coinciding leave the moment row empty: pinv drops it */
-    double x2 = schur > PINV_RCOND_SQUARED * hh_max(fk, s) ? (w2 - (a * w0 + b * w1) / fk) / schur : 0.0;
-    double x0 = (w0 - a * x2) / fk;
-    double x1 = (w1 - b * x2) / fk;
-    /* internal = f - G^T x */
+    double x[3];
+    grasp_solve(k, points, NULL, cx, cy, w, x);
+    grasp_transpose(k, points, cx, cy, x, f, out); /* internal = f - G^T x */
+}
+
+void hh_distribute_wrench(int k, const double *points, const double *weights, double ox, double oy, const double w[3],
+                          double *f)
+{
+    double cx = 0.0, cy = 0.0, total = 0.0; /* the weighted centroid */
     for (int i = 0; i < k; i++) {
-        double rx = points[2 * i] - cx;
-        double ry = points[2 * i + 1] - cy;
-        out[2 * i] = f[2 * i] - (x0 - ry * x2);
-        out[2 * i + 1] = f[2 * i + 1] - (x1 + rx * x2);
+        cx += weights[i] * points[2 * i];
+        cy += weights[i] * points[2 * i + 1];
+        total += weights[i];
     }
+    cx /= total;
+    cy /= total;
+    /* the moment about the centroid of the wrench given about (ox, oy) */
+    double about_centroid[3] = {w[0], w[1], w[2] + (ox - cx) * w[1] - (oy - cy) * w[0]};
+    double x[3], minus[3];
+    grasp_solve(k, points, weights, cx, cy, about_centroid, x);
+    for (int i = 0; i < 3; i++)
+        minus[i] = -x[i];
+    grasp_transpose(k, points, cx, cy, minus, NULL, f); /* G^T x */
+    for (int i = 0; i < k; i++) { /* f = W G^T x */
+        f[2 * i] *= weights[i];
+        f[2 * i + 1] *= weights[i];
+    }
+}
+
+/* Where finger i acts on the object: for a touching finger the contact point, its tip
+ * centre plus the tip radius along the contact normal (internal forces are forces between
+ * the contact points: between the tip centres, a tilted squeeze would turn the object); the
+ * tip centre otherwise. */
+static void acting_point(const double *params, const hh_reflex_inputs *in, const int touching[3], int i,
+                         double point[2])
+{
+    double r = touching[i] ? params[HH_REFLEX_P_TIP_RADIUS + i] : 0.0;
+    point[0] = in->tip[3 * i] + r * in->normal[2 * i];
+    point[1] = in->tip[3 * i + 1] + r * in->normal[2 * i + 1];
+}
+
+/* The internal force at unit scale among the member fingers (largest row length 1) into g
+ * (zero for the others): (I - G^+ G) push at their acting points, each member pushing
+ * along its contact normal (toward the others' centroid while approaching), or the
+ * centroid squeeze when that projection leaves some member not pushing. */
+static int squeeze(const double *params, const hh_reflex_inputs *in, const int members[3], const int touching[3],
+                   double g[3][2])
+{
+    double points[3][2], push[3][2], internal[3][2];
+    int finger[3];
+    int k = 0;
+    for (int i = 0; i < 3; i++) {
+        g[i][0] = 0.0;
+        g[i][1] = 0.0;
+        if (!members[i])
+            continue;
+        finger[k] = i;
+        acting_point(params, in, touching, i, points[k]);
+        if (touching[i]) {
+            push[k][0] = in->normal[2 * i];
+            push[k][1] = in->normal[2 * i + 1];
+        } else {
+            approach_push(in->tip, members, i, push[k]);
+        }
+        k += 1;
+    }
+    hh_project_internal(k, points[0], push[0], internal[0]);
+    int pushing = 1;
+    for (int j = 0; j < k; j++)
+        if (internal[j][0] * push[j][0] + internal[j][1] * push[j][1] <= 0.0)
+            pushing = 0;
+    if (!pushing &&
+        hh_centroid_squeeze(k, points[0], params[HH_REFLEX_P_COINCIDENT_RTOL], internal[0]) != HH_REFLEX_OK)
+        return HH_REFLEX_COINCIDENT;
+    double longest = 0.0;
+    for (int j = 0; j < k; j++)
+        longest = hh_max(longest, sqrt(internal[j][0] * internal[j][0] + internal[j][1] * internal[j][1]));
+    for (int j = 0; j < k; j++) {
+        g[finger[j]][0] = internal[j][0] / longest;
+        g[finger[j]][1] = internal[j][1] / longest;
+    }
+    return HH_REFLEX_OK;
 }
 
 int hh_reflex_directions(const double *params, const double *state, const hh_reflex_inputs *in, double g[3][2],
                          int grasp[3], int touching[3])
 {
-    const double *tip = in->tip;
     double threshold = params[HH_REFLEX_P_THRESHOLD];
     int k = 0;
     for (int i = 0; i < 3; i++) {
@@ -132,46 +231,44 @@ int hh_reflex_directions(const double *params, const double *state, const hh_ref
     }
     if (k < 2)
         return HH_REFLEX_OK;
-    /* the grasp's points and pushes, in finger order: the contact normal, or toward the
-     * others' centroid while approaching */
-    double points[3][2], push[3][2], internal[3][2];
-    int finger[3];
-    int m = 0;
-    for (int i = 0; i < 3; i++) {
-        if (!grasp[i])
-            continue;
-        finger[m] = i;
-        points[m][0] = tip[3 * i];
-        points[m][1] = tip[3 * i + 1];
-        if (touching[i]) {
-            push[m][0] = in->normal[2 * i];
-            push[m][1] = in->normal[2 * i + 1];
-        } else {
-            approach_push(tip, grasp, i, push[m]);
-        }
-        m += 1;
-    }
-    hh_project_internal(k, points[0], push[0], internal[0]);
-    /* the centroid squeeze instead if a finger would not push */
-    int pushing = 1;
-    for (int j = 0; j < k; j++)
-        if (internal[j][0] * push[j][0] + internal[j][1] * push[j][1] <= 0.0)
-            pushing = 0;
-    if (!pushing &&
-        hh_centroid_squeeze(k, points[0], params[HH_REFLEX_P_COINCIDENT_RTOL], internal[0]) != HH_REFLEX_OK)
-        return HH_REFLEX_COINCIDENT;
-    for (int j = 0; j < k; j++) {
-        g[finger[j]][0] = internal[j][0];
-        g[finger[j]][1] = internal[j][1];
-    }
-    double longest = 0.0;
+    /* the squeeze is among the fingers touching when two or more do: a finger still
+     * approaching does not touch the object, so its push is no part of the internal force
+     * (counting it would unbalance the others' squeeze), and it approaches the touching
+     * ones' centroid; with fewer touching, all of the grasp close on each other */
+    int n_touching = touching[0] + touching[1] + touching[2];
+    if (n_touching < 2)
+        return squeeze(params, in, grasp, touching, g);
     for (int i = 0; i < 3; i++)
-        longest = hh_max(longest, sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]));
-    for (int i = 0; i < 3; i++) {
-        g[i][0] /= longest;
-        g[i][1] /= longest;
+        if (grasp[i] && !touching[i])
+            approach_push(in->tip, touching, i, g[i]);
+    /* with three touching, a finger the reflex holds only in part (hold < 1: the
+     * suppresser is taking it over) shares the squeeze in that part: the internal force
+     * of all three, blended toward that of the other two (both internal, so the blend is) */
+    int partly = -1;
+    for (int i = 0; i < 3; i++)
+        if (touching[i] && state[HH_REFLEX_S_HOLD + i] < 1.0 && (partly < 0 || state[HH_REFLEX_S_HOLD + i] <
+                                                                                  state[HH_REFLEX_S_HOLD + partly]))
+            partly = i;
+    double all[3][2];
+    int code = squeeze(params, in, touching, touching, all);
+    if (code != HH_REFLEX_OK || n_touching < 3 || partly < 0) {
+        for (int i = 0; i < 3; i++)
+            if (touching[i]) {
+                g[i][0] = all[i][0];
+                g[i][1] = all[i][1];
+            }
+        return code;
     }
-    return HH_REFLEX_OK;
+    int others[3] = {1, 1, 1};
+    others[partly] = 0;
+    double two[3][2];
+    code = squeeze(params, in, others, touching, two);
+    double hold = state[HH_REFLEX_S_HOLD + partly];
+    for (int i = 0; i < 3; i++) {
+        g[i][0] = hold * all[i][0] + (1.0 - hold) * two[i][0];
+        g[i][1] = hold * all[i][1] + (1.0 - hold) * two[i][1];
+    }
+    return code;
 }
 
 void hh_reflex_forces(const double *params, const double *state, const double g[3][2], const int touching[3],
@@ -179,10 +276,8 @@ void hh_reflex_forces(const double *params, const double *state, const double g[
 {
     for (int i = 0; i < 3; i++) {
         double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
-        double handed = state[HH_REFLEX_S_HANDED + i];
         double scale = !touching[i] ? params[HH_REFLEX_P_APPROACH] / hh_max(length, SHORTEST_DIRECTION)
-                       : handed > 0.0 ? hh_min(state[HH_REFLEX_S_SCALE], handed)
-                                      : state[HH_REFLEX_S_SCALE];
+                                    : state[HH_REFLEX_S_SCALE];
         f[i][0] = g[i][0] * scale;
         f[i][1] = g[i][1] * scale;
     }
@@ -198,9 +293,12 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
         return code;
     hh_reflex_forces(params, state, (const double(*)[2])g, touching, f);
     for (int i = 0; i < 3; i++) {
-        double u[3][2], pts[4][2], jac[2][3];
+        double u[3][2], pts[4][2], jac[2][3], point[2];
         hh_finger_frames(m->fingers[i], q + 3 * i, u, pts);
-        hh_finger_point_jacobian((const double(*)[2])pts, pts[3][0], pts[3][1], jac);
+        acting_point(params, in, touching, i, point);
+        /* the point's offset from the tip centre as measured, carried to the tip at q */
+        hh_finger_point_jacobian((const double(*)[2])pts, pts[3][0] + point[0] - in->tip[3 * i],
+                                 pts[3][1] + point[1] - in->tip[3 * i + 1], jac);
         for (int j = 0; j < 3; j++)
             out[HH_REFLEX_O_TAU + 3 * i + j] = jac[0][j] * f[i][0] + jac[1][j] * f[i][1];
         out[HH_REFLEX_O_FORCE + i] = sqrt(f[i][0] * f[i][0] + f[i][1] * f[i][1]);
@@ -209,32 +307,37 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
     return HH_REFLEX_OK;
 }
 
-/* The fingers the suppresser has handed to voluntary motion: among those held (in the
- * grasp and touching), a finger whose command keeps less than release_share of its
- * grasping torque, least share first, as long as two fingers stay held. Its contact force
- * is no longer the reflex's to restore; counting it would wind the shared scale up while
- * the finger is pulled off. Two fingers always stay with the reflex: they are the grasp
- * (a pinch whose posture PD resists the squeeze keeps only about 0.9 of its torque). */
-static void hand_over(const double *params, const double *share, const int grasp[3], const int touching[3],
-                      int released[3])
+/* How much the reflex holds each finger (hold, 3): two fingers are the grasp, so the two
+ * touching fingers the suppresser spares most (largest share) it holds whole, and makes up
+ * with squeeze what the suppresser takes from them. Any other touching finger it holds by 1
+ * while the suppresser lets through at least hold_share of its grasping torque (the
+ * sigmoid at rest passes a little less than all of it), falling linearly to 0 as its share
+ * falls to release_share: a contact whose command the sigmoid is switching off is not the
+ * reflex's to correct. It drives the integrator by that much (counting it
+ * whole would wind the shared scale up while voluntary motion pulls the finger off the
+ * object: its |f_t| / f_n climbs as it lets go of its load), and shares the squeeze by that
+ * much from the next hit on (hh_reflex_directions). A finger not touching keeps its hold. */
+static void holds(const double *params, const double *state, const double *share, const int touching[3],
+                  double hold[3])
 {
-    int held = 0;
-    for (int i = 0; i < 3; i++) {
-        released[i] = 0;
-        held += grasp[i] && touching[i];
-    }
-    if (share == NULL)
-        return;
-    while (held > 2) {
-        int least = -1;
+    int kept[3] = {0, 0, 0};
+    for (int n = 0; n < 2; n++) {
+        int best = -1;
         for (int i = 0; i < 3; i++)
-            if (grasp[i] && touching[i] && !released[i] && share[i] < params[HH_REFLEX_P_RELEASE_SHARE] &&
-                (least < 0 || share[i] < share[least]))
-                least = i;
-        if (least < 0)
-            return;
-        released[least] = 1;
-        held -= 1;
+            if (touching[i] && !kept[i] && (best < 0 || (share != NULL && share[i] > share[best])))
+                best = i;
+        if (best >= 0)
+            kept[best] = 1;
+    }
+    double release = params[HH_REFLEX_P_RELEASE_SHARE];
+    double whole = params[HH_REFLEX_P_HOLD_SHARE];
+    for (int i = 0; i < 3; i++) {
+        if (!touching[i])
+            hold[i] = state[HH_REFLEX_S_HOLD + i];
+        else if (share == NULL || kept[i])
+            hold[i] = 1.0;
+        else /* release_share < hold_share, checked by the block */
+            hold[i] = hh_min(hh_max((share[i] - release) / (whole - release), 0.0), 1.0);
     }
 }
 
@@ -249,32 +352,34 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
     int code = hh_reflex_directions(params, state, in, g, grasp, touching);
     if (code != HH_REFLEX_OK)
         return code;
-    int released[3];
-    hand_over(params, in->share, grasp, touching, released);
     double scale = state[HH_REFLEX_S_SCALE];
+    double weight[3];
+    holds(params, state, params[HH_REFLEX_P_FOLLOW] != 0.0 ? in->share : NULL, touching, weight);
     int held = 0;
     double shortfall = -INFINITY;
     for (int i = 0; i < 3; i++)
-        if (grasp[i] && touching[i] && !released[i]) {
+        if (grasp[i] && touching[i]) {
             held += 1;
+            if (weight[i] == 0.0) /* wholly handed over: not the reflex's to correct at all */
+                continue;
             double gain = g[i][0] * in->normal[2 * i] + g[i][1] * in->normal[2 * i + 1]; /* per unit scale */
             double length = sqrt(g[i][0] * g[i][0] + g[i][1] * g[i][1]);
             double need = hh_max(params[HH_REFLEX_P_MIN_FORCE] * length, fabs(ft[i]) / params[HH_REFLEX_P_RATIO]);
-            shortfall = hh_max(shortfall, (need - in->fn[i]) / hh_max(gain, SMALLEST_GAIN));
+            shortfall = hh_max(shortfall, weight[i] * (need - in->fn[i]) / hh_max(gain, SMALLEST_GAIN));
         }
     if (held >= 2)
         scale = hh_min(hh_max(scale + params[HH_REFLEX_P_KI] * dt * shortfall, 0.0), params[HH_REFLEX_P_MAX_FORCE]);
     next[HH_REFLEX_S_SCALE] = scale;
     /* whether a finger was the reflex's or voluntary motion's when it last touched: a
-     * finger that loses contact while the reflex holds it (a bounce) is pushed back, one
-     * that voluntary motion took off is left alone. A finger handed over keeps at most the
-     * squeeze it had then: the squeeze the others need as they take its load over must not
-     * press it back onto the object */
+     * finger that loses contact while the reflex holds it whole (a bounce) is pushed back,
+     * one the reflex was letting go of (hold below 1: the suppresser was taking it over) is
+     * left alone */
     for (int i = 0; i < 3; i++) {
         double handed = state[HH_REFLEX_S_HANDED + i];
         if (touching[i])
-            handed = !released[i] ? 0.0 : handed > 0.0 ? handed : hh_max(state[HH_REFLEX_S_SCALE], DBL_MIN);
+            handed = weight[i] < 1.0 ? 1.0 : 0.0;
         next[HH_REFLEX_S_HANDED + i] = handed;
+        next[HH_REFLEX_S_HOLD + i] = weight[i];
     }
     return HH_REFLEX_OK;
 }

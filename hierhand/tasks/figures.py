@@ -8,7 +8,7 @@ import numpy as np
 
 from blocks import Results
 
-from .summaries import FORE, SAFETY_RATIO, THUMB, TaskBlocks
+from .summaries import FORE, THUMB, TaskBlocks, safety_ratio_of
 
 FINGER_NAMES = ("thumb", "forefinger", "middle finger")
 
@@ -26,7 +26,8 @@ def _ratio_axes(ax, results: Results, fingers, b: TaskBlocks, title: str, styles
     t, ratio = results[f"{b.plant}.ratio"]
     for f, style in zip(fingers, styles):
         ax.plot(t, ratio[:, f], style, lw=1.2, label=FINGER_NAMES[f])
-    ax.axhline(SAFETY_RATIO, color="k", ls="--", lw=0.8, label="safety ratio 0.6")
+    safety = safety_ratio_of(results, b)
+    ax.axhline(safety, color="k", ls="--", lw=0.8, label=f"safety ratio {safety:g}")
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("|f_t| / f_n")
     ax.set_title(title)
@@ -55,10 +56,10 @@ def _torque_axes(ax, results: Results, joint: int, b: TaskBlocks, title: str) ->
     ax.legend(loc="best", fontsize="small")
 
 
-def _mark(ax, t: float | None, text: str) -> None:
+def _mark(ax, t: float | None, text: str, height: float = 0.98) -> None:
     if t is not None:
         ax.axvline(t, color="0.5", ls=":", lw=1)
-        ax.annotate(text, (t, 0.98), xycoords=("data", "axes fraction"), fontsize=8, ha="left", va="top")
+        ax.annotate(text, (t, height), xycoords=("data", "axes fraction"), fontsize=8, ha="left", va="top")
 
 
 def _save(fig, path: Path) -> Path:
@@ -113,17 +114,52 @@ def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBloc
     fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
     for ax, key, label in ((axes[0], "regrasp", "with suppresser"),
                            (axes[1], "regrasp_unsuppressed", "without suppresser")):
-        _ratio_axes(ax, runs[key], (FORE,), b, f"Fig. 13: forefinger friction ratio, re-grasp {label}")
+        _ratio_axes(ax, runs[key], (FORE,), b, f"Fig. 13 ({label}): forefinger friction ratio, re-grasp")
         run_key = "suppressed" if key == "regrasp" else "unsuppressed"
         _mark(ax, r[run_key]["middle_contact_time_s"], " middle touches")
         _mark(ax, r[run_key]["fore_separation_time_s"], " forefinger leaves")
     written.append(_save(fig, out / "fig13.png"))
 
-    fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
-    for ax, key, label in ((axes[0], "regrasp", "with suppresser"),
-                           (axes[1], "regrasp_unsuppressed", "without suppresser")):
-        _torque_axes(ax, runs[key], fore_joint1, b, f"Fig. 14: forefinger joint 1, re-grasp {label}")
-        run_key = "suppressed" if key == "regrasp" else "unsuppressed"
-        _mark(ax, r[run_key]["fore_separation_time_s"], " forefinger leaves")
-    written.append(_save(fig, out / "fig14.png"))
+    written.append(_fig14(runs, r, out, b, fore_joint1))
     return written
+
+
+def _fig14(runs: dict[str, Results], r: dict, out: Path, b: TaskBlocks, joint: int) -> Path:
+    """Fig. 14: the forefinger's grasp torque before and after the suppresser, its |tau_m|
+    against S_b and the suppresser's factor while it withdraws; below, the same run without
+    the suppresser."""
+    plt = _pyplot()
+    s = r["suppressed"]
+    run = runs["regrasp"]
+    t, tau_g = run[f"{b.reflex}.tau_g"]
+    _, applied = run[f"{b.suppresser}.tau_g_eff"]
+    tau_m = np.abs(run.held(f"{b.manipulation}.tau_m", t)[:, joint])
+    factor = np.divide(applied[:, joint], tau_g[:, joint], out=np.full(t.size, np.nan), where=tau_g[:, joint] != 0)
+    s_b = float(np.mean(run.info["parameters"][b.suppresser]["S_b"]))
+    start = s["withdrawal_start_s"] - 0.05
+    end = (s["fore_separation_time_s"] or s["withdrawal_end_s"]) + 0.05
+    shown = (t >= start) & (t <= end)
+    fig, axes = plt.subplots(3, 1, figsize=(8.5, 8.5), gridspec_kw={"height_ratios": [3, 1.6, 3]})
+    ax = axes[0]
+    ax.plot(t[shown], tau_g[shown, joint], ls="--", lw=1.0, color="C0", label="grasp torque from the reflex")
+    ax.plot(t[shown], applied[shown, joint], lw=1.6, color="C0", label="grasp torque applied (after the suppresser)")
+    ax.plot(t[shown], tau_m[shown], lw=1.2, color="C1", label="|manipulation torque| (PD)")
+    ax.axhline(s_b, color="C1", ls=":", lw=1.0, label=f"S_b = {s_b:g} N m")
+    ax.set_ylabel("torque (N m)")
+    ax.set_title("Fig. 14: forefinger joint 1 while it withdraws, re-grasp with suppresser")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    axes[1].plot(t[shown], factor[shown], lw=1.4, color="C3")
+    axes[1].axhline(0.5, color="k", ls=":", lw=0.8)
+    axes[1].set_ylim(0, 1.05)
+    axes[1].set_ylabel("suppression\nfactor")
+    for ax in axes[:2]:
+        ax.set_xlim(start, end)
+        ax.grid(alpha=0.3)
+        _mark(ax, s["withdrawal_start_s"], " withdrawal starts")
+        _mark(ax, s["fore_factor_leaves_s"], " factor < 0.9", height=0.86)
+        _mark(ax, s["fore_separation_time_s"], " forefinger leaves", height=0.74)
+    _torque_axes(axes[2], runs["regrasp_unsuppressed"], joint, b,
+                 "Fig. 14, below: the same joint, re-grasp without suppresser")
+    axes[2].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
+    _mark(axes[2], r["unsuppressed"]["withdrawal_start_s"], " withdrawal starts")
+    return _save(fig, out / "fig14.png")

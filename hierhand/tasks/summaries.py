@@ -15,6 +15,7 @@ import numpy as np
 from blocks import Results
 
 SAFETY_RATIO = 0.6
+"""The paper's friction safety ratio, the reflex's default."""
 DROP_DISTANCE = 0.02
 """An object that ends more than 2 cm below where it started has been dropped."""
 
@@ -34,6 +35,25 @@ class TaskBlocks:
     reflex: str = "reflex"
     manipulation: str = "manip"
     suppresser: str = "suppress"
+
+
+def handover_time(parameters: dict) -> float | None:
+    """When the support lets the object go (the ``support`` block's ``until``, or ``time``
+    for a Step), or None for a diagram without one."""
+    support = parameters.get("support", {})
+    value = support.get("until", support.get("time"))
+    return None if value is None else float(value)
+
+
+def withdrawal(parameters: dict, b: TaskBlocks = TaskBlocks()) -> tuple[float, float]:
+    """(start, end) of the forefinger's trajectory in a re-grasp diagram."""
+    waypoints = parameters[b.manipulation]["trajectories"]["fore"]["waypoints"]
+    return float(waypoints[0][0]), float(waypoints[-1][0])
+
+
+def safety_ratio_of(results: Results, b: TaskBlocks = TaskBlocks()) -> float:
+    """The safety ratio the run's reflex kept to (its parameter, or the paper's 0.6)."""
+    return float(results.info.get("parameters", {}).get(b.reflex, {}).get("safety_ratio", SAFETY_RATIO))
 
 
 def _signal(results: Results, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -59,15 +79,16 @@ def first_time(t: np.ndarray, condition: np.ndarray, after: float = -math.inf) -
 def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = TaskBlocks(),
                   fingers: tuple[int, ...] = (THUMB, FORE), steady_window: float = 0.2,
                   handover_time: float | None = None) -> dict:
-    """Peak |f_t|/f_n after the disturbance, when it is back under the safety ratio for
-    good, its maximum over the last ``steady_window`` seconds, how far the object moved,
+    """Peak |f_t|/f_n after the disturbance, when it is back under the run's safety ratio
+    for good, its maximum over the last ``steady_window`` seconds, how far the object moved,
     and the peak while the fingers close (before ``handover_time``, when the support lets
     the object go; None without one)."""
+    safety = safety_ratio_of(results, b)
     t, ratio = _signal(results, f"{b.plant}.ratio")
     worst = ratio[:, list(fingers)].max(axis=1)
     after = t >= disturbance_time
     peak = float(worst[after].max())
-    above = np.flatnonzero(after & (worst > SAFETY_RATIO))
+    above = np.flatnonzero(after & (worst > safety))
     if above.size == 0:
         recovery = 0.0
     elif above[-1] + 1 < t.size:
@@ -79,6 +100,7 @@ def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = Tas
     i0 = max(int(np.searchsorted(t_obj, disturbance_time)) - 1, 0)  # the last pose before the push
     closing = t < handover_time if handover_time is not None else np.zeros(t.size, dtype=bool)
     return {
+        "safety_ratio": safety,
         "disturbance_time_s": float(disturbance_time),
         "peak_ratio": peak,
         "recovery_time_s": recovery,
@@ -113,6 +135,7 @@ def manipulation_summary(results: Results, trajectories: dict, initial_pose: np.
     _, obj = _signal(results, f"{b.plant}.obj")
     final = obj[-1]
     return {
+        "safety_ratio": safety_ratio_of(results, b),
         "max_ratio_after_settle": float(ratio[t >= settle][:, [THUMB, FORE]].max()),
         "target_pose": [float(v) for v in target],
         "final_pose": [float(v) for v in final],
@@ -136,11 +159,13 @@ def regrasp_events(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
     }
 
 
-def holding_kept(results: Results, since: float | None, b: TaskBlocks = TaskBlocks()) -> float | None:
+def holding_kept(results: Results, since: float | None, b: TaskBlocks = TaskBlocks(),
+                 quantile: float | None = None) -> float | None:
     """The smallest share of its grasp torque that any joint of the holding fingers (thumb
-    and middle) kept through the suppresser from ``since`` on, over the samples where that
-    joint's grasp torque is at least a tenth of the largest among those joints; None
-    without such samples."""
+    and middle) kept through the suppresser from ``since`` on (or that ``quantile`` of the
+    shares, e.g. 0.01: what they kept 99 % of the time), over the samples where that joint's
+    grasp torque is at least a tenth of the largest among those joints; None without such
+    samples."""
     if since is None:
         return None
     t, tau_g = _signal(results, f"{b.reflex}.tau_g")
@@ -148,38 +173,129 @@ def holding_kept(results: Results, since: float | None, b: TaskBlocks = TaskBloc
     joints = [*range(3 * THUMB, 3 * THUMB + 3), *range(3 * MIDDLE, 3 * MIDDLE + 3)]
     g, a = tau_g[t >= since][:, joints], applied[t >= since][:, joints]
     large = np.abs(g) >= 0.1 * np.abs(g).max() if g.size and np.abs(g).max() > 0 else np.zeros(g.shape, bool)
-    return float((a[large] / g[large]).min()) if large.any() else None
+    if not large.any():
+        return None
+    kept = a[large] / g[large]
+    return float(kept.min() if quantile is None else np.quantile(kept, quantile))
+
+
+FACTOR_LEAVES = 0.9
+"""The suppression factor below which the sigmoid counts as acting (Fig. 14)."""
 
 
 def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBlocks = TaskBlocks(),
                     joint: int = 3 * FORE) -> dict:
-    """``regrasp_events``, ``holding_kept`` from the middle finger's first contact, and the
-    paper's Fig. 14 relation on the forefinger's ``joint`` (its MP joint by default) while it
-    withdraws: the applied grasp torque (``suppress.tau_g_eff``) at the start of the
-    withdrawal, its peak and its last value CONTACT_FADE before separation, and its
-    correlation with |tau_m| over that window (negative: the grasp torque falls as the
-    manipulation torque grows). ``withdrawal`` is the forefinger trajectory's (start, end)
-    time."""
+    """``regrasp_events``, ``holding_kept`` from the middle finger's first contact, the
+    paper's Fig. 14 on the forefinger's ``joint`` (its MP joint by default) while it
+    withdraws, and how it slides before it lets go. Fig. 14: the applied grasp torque
+    (``suppress.tau_g_eff``) at the start of the withdrawal, its peak and its last value
+    CONTACT_FADE before separation, the share of it gone by then, its correlation with
+    |tau_m| over that window (negative: the grasp torque falls as the manipulation torque
+    grows), the suppresser's factor (applied over reflex torque) there, and when the factor
+    first fell below FACTOR_LEAVES. ``withdrawal`` is the forefinger trajectory's (start,
+    end) time."""
     events = regrasp_events(results, b)
-    t_g, tau_g = _signal(results, f"{b.suppresser}.tau_g_eff")
+    t_g, tau_g_eff = _signal(results, f"{b.suppresser}.tau_g_eff")
+    _, tau_g = _signal(results, f"{b.reflex}.tau_g")
     _signal(results, f"{b.manipulation}.tau_m")  # a clear error if it was not logged
     held_m = np.abs(results.held(f"{b.manipulation}.tau_m", t_g)[:, joint])
     separation = events["fore_separation_time_s"]
     end = separation - CONTACT_FADE if separation is not None else math.inf
     window = (t_g >= withdrawal[0]) & (t_g < end)
-    grasp, manipulation = tau_g[window, joint], held_m[window]
+    grasp, manipulation = tau_g_eff[window, joint], held_m[window]
+    reflex = tau_g[window, joint]
+    factor = np.divide(grasp, reflex, out=np.ones_like(grasp), where=reflex != 0)
     varied = grasp.size > 2 and np.ptp(grasp) > 0 and np.ptp(manipulation) > 0
+    acting = np.flatnonzero(factor < FACTOR_LEAVES)
+    leaves = float(t_g[window][acting[0]]) if acting.size else None
     return {
         **events,
         "holding_grasp_torque_kept": holding_kept(results, events["middle_contact_time_s"], b),
+        "holding_grasp_torque_kept_99": holding_kept(results, events["middle_contact_time_s"], b, quantile=0.01),
         "withdrawal_start_s": float(withdrawal[0]),
         "withdrawal_end_s": float(withdrawal[1]),
         "fore_grasp_torque_at_withdrawal_Nm": float(grasp[0]) if grasp.size else None,
         "fore_grasp_torque_peak_Nm": float(grasp.max()) if grasp.size else None,
         "fore_grasp_torque_last_Nm": float(grasp[-1]) if grasp.size else None,
+        "fore_grasp_torque_gone": float(1.0 - grasp[-1] / grasp[0]) if grasp.size and grasp[0] else None,
+        "fore_reflex_torque_last_Nm": float(reflex[-1]) if grasp.size else None,
+        "fore_suppression_factor_last": float(factor[-1]) if grasp.size else None,
+        "fore_factor_leaves_s": leaves,
         "fore_manipulation_torque_last_Nm": float(manipulation[-1]) if grasp.size else None,
         "grasp_vs_manipulation_correlation": float(np.corrcoef(grasp, manipulation)[0, 1]) if varied else None,
+        **sliding_before_separation(results, withdrawal[0], separation, b),
     }
+
+
+def sliding_before_separation(results: Results, start: float, separation: float | None,
+                              b: TaskBlocks = TaskBlocks()) -> dict:
+    """How the forefinger's contact went between the start of its withdrawal and its
+    separation: its largest |f_t|/f_n, and how long it was above the safety ratio and at
+    the sliding limit (mu_d, where the contact law clips a sliding contact)."""
+    t, ratio = _signal(results, f"{b.plant}.ratio")
+    window = (t >= start) & (t < (separation if separation is not None else math.inf))
+    fore = ratio[window, FORE]
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    mu_d = float(results.info.get("parameters", {}).get(b.plant, {}).get("contact", {}).get("mu_d", 0.9))
+    return {
+        "fore_ratio_peak_before_separation": float(fore.max()) if fore.size else None,
+        "fore_above_safety_before_separation_s": float(np.count_nonzero(fore > safety_ratio_of(results, b)) * step),
+        "fore_sliding_before_separation_s": float(np.count_nonzero(fore >= mu_d * (1 - 1e-9)) * step),
+    }
+
+
+def ratio_excursions(results: Results, since: float, fingers: tuple[int, ...], b: TaskBlocks = TaskBlocks(),
+                     until: float = math.inf) -> dict[int, dict]:
+    """Per finger, over [since, until): its largest |f_t|/f_n while in contact and how long
+    it was above the run's safety ratio."""
+    t, ratio = _signal(results, f"{b.plant}.ratio")
+    window = (t >= since) & (t < until)
+    step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
+    safety = safety_ratio_of(results, b)
+    return {f: {"peak": float(ratio[window, f].max()) if window.any() else None,
+                "above_safety_s": float(np.count_nonzero(ratio[window, f] > safety) * step)} for f in fingers}
+
+
+def reaction_times(results: Results, since: float, fingers: tuple[int, ...] = (THUMB, FORE),
+                   b: TaskBlocks = TaskBlocks(), window: float = 0.2, part: float = 0.1,
+                   label: str = "reacts") -> dict:
+    """When the grasp torque (the reflex's) and the manipulation torque (the PD's) first
+    react to a disturbance at ``since`` (the paper's Fig. 10): per torque, the first time
+    after ``since`` at which some joint of the ``fingers`` has moved from its value just
+    before by ``part`` of its largest move within ``window`` (keys
+    ``grasp_torque_<label>_s``, ``manipulation_torque_<label>_s``); None where it does not move."""
+    out = {}
+    for key, signal in (("grasp", f"{b.reflex}.tau_g"), ("manipulation", f"{b.manipulation}.tau_m")):
+        t, tau = _signal(results, signal)
+        joints = [j for f in fingers for j in range(3 * f, 3 * f + 3)]
+        before = tau[max(int(np.searchsorted(t, since)) - 1, 0), joints]
+        after = (t >= since) & (t <= since + window)
+        moved = np.abs(tau[after][:, joints] - before)
+        largest = moved.max(axis=0) if moved.size else np.zeros(len(joints))
+        reacting = np.flatnonzero(np.any((moved >= part * largest) & (largest > 0), axis=1))
+        out[f"{key}_torque_{label}_s"] = float(t[after][reacting[0]] - since) if reacting.size else None
+    return out
+
+
+POSITION_TOLERANCE = 1e-3
+"""m: the manipulated object ends within this of its target position ..."""
+ANGLE_TOLERANCE = math.radians(1.0)
+"""... and within this of its target angle."""
+
+
+def grasp_succeeded(summary: dict) -> bool:
+    """The grasp task as the paper describes it: the object is held through the push and
+    |f_t|/f_n is back under the safety ratio by the end (over the last 0.2 s)."""
+    return not summary["object_dropped"] and summary["steady_ratio_max"] <= summary["safety_ratio"]
+
+
+def manipulation_succeeded(summary: dict) -> bool:
+    """The manipulation task as the paper describes it: the object reaches its new position
+    and posture (``POSITION_TOLERANCE``, ``ANGLE_TOLERANCE``) with |f_t|/f_n within the
+    safety ratio once the grasp has settled, and is not dropped."""
+    return (not summary["object_dropped"] and summary["position_error_m"] <= POSITION_TOLERANCE
+            and summary["angle_error_rad"] <= ANGLE_TOLERANCE
+            and summary["max_ratio_after_settle"] <= summary["safety_ratio"])
 
 
 def regrasp_succeeded(summary: dict) -> bool:

@@ -1,10 +1,10 @@
-"""Blocks with compiled kernels (blocks/compiled.py, blocks/csrc/runner.c).
+"""Blocks with compiled kernels (blocks/compiled.py), run by the C core (blocks/csrc/core.c).
 
 A diagram runs the same whether a block goes through its kernel or its Python methods:
 the same logged samples to the last bit, the same status when a block fails, the same
-end when a Python block ends the run. The test kernels (``kernel_sources/leak.c``) are
-compiled with the calling convention's header by the ``library`` fixture (conftest.py);
-their Python twins below compute the same arithmetic in numpy.
+end when a Python block ends the run. The test blocks (``compiled_blocks.py``) have
+kernels (``kernel_sources/leak.c``, compiled by the ``library`` fixture, conftest.py) and
+Python twins that compute the same arithmetic in numpy.
 """
 
 from __future__ import annotations
@@ -14,178 +14,14 @@ import threading
 import numpy as np
 import pytest
 
-from blocks import Block, BlockError, EndRun, loads_diagram, simulate
-from blocks.kernel import Kernel
-from blocks.registry import block_types
+from blocks import loads_diagram, simulate
 
-from .kernel_library import function
-
-
-CALLS: dict[str, int] = {}
-"""How often the Python methods of the test blocks ran, per block type and method."""
-
-
-def counted(key: str) -> None:
-    CALLS[key] = CALLS.get(key, 0) + 1
-
-
-class Leak(Block):
-    """x <- a x + b u, outputs y = x and sum(x); an update past ``limit`` fails."""
-
-    type_name = "TestLeak"
-    lib = None
-
-    def __init__(self, a=0.9, b=0.1, width=2, limit=1e9, x0=0.0, compiled=True, parts="output,update,advance"):
-        self.params = np.array([a, b, limit, width], dtype=float)
-        self.a, self.b, self.limit, self.width, self.x0 = float(a), float(b), float(limit), int(width), float(x0)
-        self.compiled, self.parts = compiled, parts.split(",")
-        self.inputs = {"u": width}
-        self.outputs = {"y": width, "sum": 1}
-        self.feedthrough = False
-
-    def initial_state(self):
-        return np.full(self.width, self.x0)
-
-    def output(self, t, state, inputs):
-        counted("Leak.output")
-        total = 0.0
-        for x in state:
-            total += x
-        return {"y": state.copy(), "sum": np.array([total])}
-
-    def step(self, t, state, u):
-        new = self.a * state + self.b * u
-        bad = np.flatnonzero(np.abs(new) > self.limit)
-        if bad.size:
-            raise self.error(7, int(bad[0]), t, "update")
-        state[:] = new
-        return state
-
-    def update(self, t, state, inputs):
-        counted("Leak.update")
-        return self.step(t, state, inputs["u"])
-
-    def advance(self, t, state, inputs, n):
-        counted("Leak.advance")
-        dt = float(self.period)
-        rows = np.empty((n, self.width + 1))
-        for i in range(n):
-            try:
-                self.step(t + i * dt, state, inputs["u"])
-            except BlockError as exc:
-                exc.rows = {"y": rows[:i, :-1], "sum": rows[:i, -1:]}
-                raise
-            out = self.output(0.0, state, inputs)
-            rows[i] = np.concatenate((out["y"], out["sum"]))
-        return state, {"y": rows[:, :-1], "sum": rows[:, -1:]}
-
-    @staticmethod
-    def error(code, which, t, phase):
-        return BlockError(f"x[{which}] past the limit in the step at t={t:.6g} s (code {code})", port="y")
-
-    def kernel(self):
-        if not self.compiled:
-            return None
-        names = {"output": "leak_output", "update": "leak_update", "advance": "leak_advance"}
-        return Kernel(context=self.params.ctypes.data, owners=(self.params, self.lib), error=self.error,
-                      **{part: function(self.lib, names[part]) for part in self.parts})
-
-
-class Scale(Block):
-    """y = k u, feedthrough."""
-
-    type_name = "TestScale"
-    lib = None
-
-    def __init__(self, k=2.0, width=2, compiled=True):
-        self.k, self.compiled = float(k), compiled
-        self.params = np.array([k, width], dtype=float)
-        self.inputs = {"u": width}
-        self.outputs = {"y": width}
-
-    def output(self, t, state, inputs):
-        counted("Scale.output")
-        return {"y": self.k * inputs["u"]}
-
-    def kernel(self):
-        if not self.compiled:
-            return None
-        return Kernel(context=self.params.ctypes.data, output=function(self.lib, "scale_output"),
-                      owners=(self.params, self.lib))
-
-
-class Wave(Block):
-    """A Python source: sin(t) and cos(t)."""
-
-    type_name = "TestWave"
-    time_varying = True
-
-    def __init__(self):
-        self.inputs = {}
-        self.outputs = {"y": 2}
-
-    def output(self, t, state, inputs):
-        return {"y": np.array([np.sin(7 * t), np.cos(3 * t)])}
-
-
-class Mix(Block):
-    """A Python block with state that keeps what it was given (as a delay might)."""
-
-    type_name = "TestMix"
-
-    def __init__(self, stop_at=None):
-        self.stop_at = stop_at
-        self.inputs = {"a": 2, "b": 2}
-        self.outputs = {"y": 2}
-        self.feedthrough = {"y": {"a"}}
-
-    def initial_state(self):
-        return [np.zeros(2)]
-
-    def output(self, t, state, inputs):
-        return {"y": inputs["a"] - 0.5 * state[0]}
-
-    def update(self, t, state, inputs):
-        if self.stop_at is not None and t >= self.stop_at:
-            raise EndRun("enough", state=[inputs["b"]])
-        return [inputs["b"]]  # kept, not copied: the executor hands it a copy of compiled outputs
-
-
-class Ticker(Block):
-    """Counts its updates; the C kernel sends SIGINT when the count reaches ``at``."""
-
-    type_name = "TestTicker"
-    lib = None
-
-    def __init__(self, at=1e9, nogil=False):
-        self.params = np.array([at], dtype=float)
-        self.nogil = nogil
-        self.inputs, self.outputs, self.feedthrough = {}, {"y": 1}, False
-
-    def initial_state(self):
-        return np.zeros(1)
-
-    def output(self, t, state, inputs):
-        return {"y": state.copy()}
-
-    def update(self, t, state, inputs):
-        return state + 1.0
-
-    def advance(self, t, state, inputs, n):
-        raise AssertionError("runs compiled")
-
-    def kernel(self):
-        return Kernel(context=self.params.ctypes.data, output=function(self.lib, "ticker_output"),
-                      advance=function(self.lib, "ticker_advance"), owners=(self.params, self.lib),
-                      nogil=self.nogil)
+from .compiled_blocks import CALLS, Leak, Scale, register
 
 
 @pytest.fixture(autouse=True)
 def registered(library, monkeypatch):
-    Leak.lib = Scale.lib = Ticker.lib = library
-    for cls in (Leak, Scale, Wave, Mix, Ticker):
-        monkeypatch.setitem(block_types(), cls.type_name, cls)
-    CALLS.clear()
+    register(library, monkeypatch)
 
 
 MIXED = """
@@ -303,7 +139,7 @@ def test_ctrl_c_in_a_long_compiled_advance_stops_after_the_chunk_it_came_in(nogi
     ADVANCE_CHUNK hits; SIGINT in the third chunk stops the run at its end, everything up
     to there logged. The same with the GIL released around the chunks (a nogil kernel,
     while another thread waits): the check between chunks takes it back."""
-    from blocks.simulate import ADVANCE_CHUNK
+    from blocks.optable import ADVANCE_CHUNK
 
     text = f"""
 time: {{t_end: 1000 s}}

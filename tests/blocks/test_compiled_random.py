@@ -1,47 +1,49 @@
-"""Random diagrams of library blocks run the same compiled and in Python.
+"""Random diagrams of library blocks run the same compiled and in Python, in either interpreter.
 
 The diagrams of the loader's fuzz test (``wired_document``: random topology, rates,
 offsets, delays with initial values, decimated logs, loops) that load and plan are run
-twice: with the library's kernels, and with the compiled side switched off. Both give
-the same status, the same sample times and the same values (to round-off: a matrix
-Gain or state-space block's products are summed in another order in C).
+three ways: with the library's kernels in the C core, the same in the reference loop
+(the same samples to the last bit: one table, the same kernels), and with every block
+through its Python methods. The last gives the same status, the same sample times and
+the same values to round-off (a matrix Gain or state-space block's products are summed
+in another order in C).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import blocks
 import blocks.compiled
 
-from .test_diagram_fuzz import FUZZ_SETTINGS, short_t_end, wired_document
+from .test_diagram_fuzz import FUZZ_SETTINGS, wired_document
+from .test_reference import loaded
 
 
-def run(diagram, t_end, compiled: bool, monkeypatch):
+def run(diagram, t_end, compiled: bool, monkeypatch, engine: str = "native"):
     with monkeypatch.context() as m:
         if not compiled:
-            m.setattr(blocks.compiled, "NativeRunner", None)
-        return blocks.simulate(diagram, t_end=t_end)
+            m.setattr(blocks.compiled, "usable_kernel", lambda *args: None)
+        return blocks.simulate(diagram, t_end=t_end, engine=engine)
 
 
 @settings(max_examples=500, **FUZZ_SETTINGS)
 @given(doc=wired_document(), ticks=st.integers(min_value=1, max_value=60))
 def test_random_diagrams_give_the_same_results_compiled_and_in_python(doc, ticks, tmp_path, monkeypatch):
-    text = yaml.safe_dump(doc, sort_keys=False)
-    try:
-        diagram = blocks.loads_diagram(text, filename="random.yaml", base_dir=tmp_path)
-    except blocks.DiagramError:
+    if (found := loaded(doc, ticks, tmp_path)) is None:
         return
-    t_end = short_t_end(diagram, ticks)
-    if t_end is None:
-        return
+    diagram, t_end = found
     try:
         compiled = run(diagram, t_end, True, monkeypatch)
     except blocks.DiagramError:
         return
+    reference = run(diagram, t_end, True, monkeypatch, engine="reference")
+    assert compiled.status == reference.status and list(compiled) == list(reference)
+    for name in compiled:
+        assert np.array_equal(compiled[name][0], reference[name][0]), name
+        assert np.array_equal(compiled[name][1], reference[name][1]), name
     python = run(diagram, t_end, False, monkeypatch)
     assert compiled.status == python.status
     assert set(compiled) == set(python)

@@ -12,8 +12,8 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
 from blocks import build_schedule, load_diagram, loads_diagram
-from blocks.graph import (crossings, draw, effective_rate, geometry, is_feedthrough, layered, rate_colors, render,
-                          to_dot)
+from blocks.graph import (crossings, draw, effective_rate, geometry, is_feedthrough, layered, picture, rate_colors,
+                          render, to_dot)
 
 ROOT = Path(__file__).resolve().parents[2]
 TOY = ROOT / "diagrams" / "toy.yaml"
@@ -85,14 +85,15 @@ def test_the_figure_draws_every_connection_once():
 
 
 def test_layers_follow_the_feedthrough_and_the_loop_runs_back_through_the_plant():
-    d, _ = toy()
-    lay = layered(d)
+    d, s = toy()
+    pic = picture(d, s)
+    lay = layered(pic)
     assert [str(c) for c in lay.feedback] == ["u.y -> plant.u"]
     for c in d.connections:
         if c not in lay.feedback:
             assert lay.layer[c.src_block] < lay.layer[c.dst_block], c
     for c in d.connections:
-        if is_feedthrough(d, c):
+        if is_feedthrough(pic, c):
             assert c not in lay.feedback, c
     assert lay.layer["ref"] == lay.layer["plant"] == 0
     assert lay.layer["err"] == 1 and lay.layer["integ"] == lay.layer["prop"] == 2 and lay.layer["u"] == 3
@@ -101,7 +102,7 @@ def test_layers_follow_the_feedthrough_and_the_loop_runs_back_through_the_plant(
 def test_a_loop_through_a_delay_is_broken_at_the_delay_and_drawn_dashed_with_its_mark():
     d = loads_diagram(DELAYED_LOOP)
     s = build_schedule(d, None)
-    lay = layered(d)
+    lay = layered(picture(d, s))
     assert [str(c) for c in lay.feedback] == ["gain.y -> sum.u1 (delay 1)"]
     fig = draw(d, s)
     assert len(wires(fig)) == len(d.connections)
@@ -185,15 +186,16 @@ blocks:
   last_a: {type: Gain, params: {k: 1.0}}
 connections: [b.y -> fed_by_b.u, a.y -> fed_by_a.u, fed_by_b.y -> last_b.u, fed_by_a.y -> last_a.u]
 """)
-    lay = layered(d)
-    assert crossings(d, lay) == 0
+    pic = picture(d, build_schedule(d, None))
+    lay = layered(pic)
+    assert crossings(pic, lay) == 0
     assert lay.columns[1] == ["fed_by_a", "fed_by_b"] and lay.columns[2] == ["last_a", "last_b"]
 
 
 def test_boxes_do_not_overlap_and_the_figure_grows_with_the_diagram():
     d, s = toy()
-    rates = rate_colors(d, s)
-    geo = geometry(d, s, layered(d), rates)
+    pic = picture(d, s)
+    geo = geometry(pic, layered(pic))
     for (a, p), (b, q) in combinations(geo.boxes.items(), 2):
         apart = p.x + p.w <= q.x or q.x + q.w <= p.x or p.y + p.h <= q.y or q.y + q.h <= p.y
         assert apart, (a, b)

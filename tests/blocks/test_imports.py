@@ -61,7 +61,7 @@ def import_graph() -> nx.DiGraph:
 
 def test_the_import_reader_sees_imports_inside_functions_and_relative_ones():
     assert "blocks.library" in imported("blocks.registry")  # inside block_types()
-    assert "blocks.block" in imported("blocks.loader")  # from .block import ...
+    assert "blocks.block" in imported("blocks.construct")  # from .block import ...
     assert "blocks.fmu.interrupt" in imported("blocks.fmu.block")  # from . import interrupt
     assert "blocks.timebase" in imported("blocks.fmu.block")  # from ..timebase import ...
 
@@ -89,9 +89,11 @@ def test_the_blocks_modules_import_each_other_without_a_cycle():
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c + [c[0]]) for c in cycles)
 
 
-LAYERS = ["blocks.issues", "blocks.diagram", "blocks.loader", "blocks.schedule", "blocks.load", "blocks.simulate"]
-"""The core modules from the lowest layer up: data, loader, planner, load (loader +
-planner), executor."""
+LAYERS = ["blocks.issues", "blocks.diagram", "blocks.records", "blocks.schedule", "blocks.assemble", "blocks.builder",
+          "blocks.loader", "blocks.load", "blocks.simulate"]
+"""The core modules from the lowest layer up: data, what a diagram records, planner, the
+checks that make a Diagram, the builder (checks + planner), its YAML front end, load
+(front end + builder), executor."""
 
 
 @pytest.mark.parametrize("lower, higher", [(a, b) for i, a in enumerate(LAYERS) for b in LAYERS[i + 1:]])

@@ -91,14 +91,16 @@ def test_every_block_of_the_regrasp_diagram_has_a_kernel(diagram):
     b = _blocks(diagram)
     kernels = _native.kernels()
     assert set(kernels) == {"HandPlant.output", "HandPlant.update", "HandPlant.advance", "GraspReflex.output",
-                            "GraspReflex.update", "ManipulationPD.output", "Suppresser.output",
+                            "GraspReflex.update", "ManipulationPD.output", "Suppresser.output", "Suppresser.update",
                             "ObjectSupport.output"}
     assert all(isinstance(a, int) and a != 0 for a in kernels.values())
     plant, reflex = b["plant"].kernel(), b["reflex"].kernel()
     assert plant.output and plant.update and plant.advance and plant.bind and plant.nogil
     assert _run_kernel(b["plant"]).context and _run_kernel(b["plant"]).nogil
     assert reflex.output and reflex.update and not reflex.advance and reflex.nogil
-    for name in ("manip", "suppress", "support"):
+    suppress = b["suppress"].kernel()  # the shipped suppresser low-passes: it has a state
+    assert suppress.output and suppress.update and not suppress.advance and suppress.nogil
+    for name in ("manip", "support"):
         k = b[name].kernel()
         assert k.output and not k.update and not k.advance and k.context and k.nogil
 
@@ -117,7 +119,7 @@ def test_kernels_equal_the_python_methods_along_a_regrasp(diagram):
     dt_plant, dt_reflex = float(plant.period), float(reflex.period)
     steps = round(dt_reflex / dt_plant)  # plant steps per reflex hit
     per_manip = round(float(manip.period) / dt_reflex)
-    x, s = plant.initial_state(), reflex.initial_state()
+    x, s, z = plant.initial_state(), reflex.initial_state(), suppress.initial_state()
     share = np.ones(3)
     checked_update = False
     for k in range(200):  # 200 ms in 1 ms hits
@@ -125,12 +127,15 @@ def test_kernels_equal_the_python_methods_along_a_regrasp(diagram):
         y = _check_output(plant, t, x, {})
         if k % per_manip == 0:
             f_ext = _check_output(support, t, None, {})["y"]
-            m = _check_output(manip, t, None, {"q": y["q"], "qd": y["qd"], "fn": y["fn"], "support": f_ext})
+            m = _check_output(manip, t, None, {"q": y["q"], "qd": y["qd"], "fn": y["fn"], "support": f_ext,
+                                               "normal": y["normal"], "obj": y["obj"]})
         reflex_in = {"q": y["q"], "tip": y["tip"], "fn": y["fn"], "ft": y["ft"], "normal": y["normal"],
                      "share": share}
         g = _check_output(reflex, t, s, reflex_in)
-        u = _check_output(suppress, t, None, {"tau_g": g["tau_g"], "tau_m": m["tau_m"], "tau_ff": m["tau_ff"]})
+        suppress_in = {"tau_g": g["tau_g"], "tau_m": m["tau_m"], "tau_ff": m["tau_ff"]}
+        u = _check_output(suppress, t, z, suppress_in)
         s = _check_update(reflex, t, s, reflex_in)
+        z = _check_update(suppress, t, z, suppress_in)
         share = u["share"].copy()
         plant_in = {"tau": u["tau"], "f_ext": f_ext}
         if k % 50 == 7:  # one update by itself now and then
@@ -158,13 +163,19 @@ def test_the_support_switches_off_at_until_in_both(diagram):
 
 
 def test_the_suppresser_takes_any_torques(diagram):
-    suppress = _blocks(diagram)["suppress"]
+    from hierhand.control.suppresser import Suppresser
+
+    filtered = _blocks(diagram)["suppress"]
+    static = Suppresser(S_a=filtered.S_a, S_b=filtered.S_b, mode=filtered.mode)
     rng = np.random.default_rng(5)
+    state = rng.normal(scale=0.05, size=9)
     for _ in range(20):
         tau_g, tau_m, tau_ff = rng.normal(scale=0.2, size=(3, 9))
         tau_g[rng.integers(9)] = 0.0
-        _check_output(suppress, 0.0, None, {"tau_g": tau_g, "tau_m": tau_m, "tau_ff": tau_ff})
-    _check_output(suppress, 0.0, None, {"tau_g": tau_g, "tau_m": tau_m})  # tau_ff at its default
+        _check_output(static, 0.0, None, {"tau_g": tau_g, "tau_m": tau_m, "tau_ff": tau_ff})
+        _check_output(filtered, 0.0, state, {"tau_g": tau_g, "tau_m": tau_m, "tau_ff": tau_ff})
+        state = _check_update(filtered, 0.0, state, {"tau_g": tau_g, "tau_m": tau_m, "tau_ff": tau_ff})
+    _check_output(static, 0.0, None, {"tau_g": tau_g, "tau_m": tau_m})  # tau_ff at its default
 
 
 def _kernel_error(block, code, which, t, phase):
@@ -240,7 +251,10 @@ def test_coincident_contacts_fail_the_reflex_as_in_python(diagram):
     reflex = _blocks(diagram)["reflex"]
     kernel = reflex.kernel()
     state = reflex.initial_state()
-    given = {"q": np.zeros(9), "tip": np.tile([0.03, 0.05, 1.0], 3), "fn": np.array([1.0, 1.0, 0.0]),
+    # tip centres placed so that the contact points (centre plus radius along the normal) coincide
+    tip = np.tile([0.03, 0.05, 1.0], 3)
+    tip[0::3] -= reflex.hand.tip_radius
+    given = {"q": np.zeros(9), "tip": tip, "fn": np.array([1.0, 1.0, 0.0]),
              "ft": np.zeros(3), "normal": np.tile([1.0, 0.0], 3)}
     listed, mapping = _inputs(reflex, given)
     for phase in ("output", "update"):
@@ -267,7 +281,8 @@ def test_an_unreachable_target_fails_the_manipulation_as_in_python():
     # reads too) and in the trajectory the Python path names the error from
     manip._waypoints[2, :, 1] += 1.0
     manip.trajectories[2]._w[:, 1] += 1.0
-    given = {"q": manip.hand.q0.copy(), "qd": np.zeros(9), "fn": np.zeros(3)}
+    given = {"q": manip.hand.q0.copy(), "qd": np.zeros(9), "fn": np.zeros(3), "normal": np.zeros(6),
+             "obj": manip.hand.object_pose0}
     listed, mapping = _inputs(manip, given)
     with pytest.raises(UnreachableError) as python:
         manip.output(0.2, None, mapping)

@@ -34,7 +34,7 @@ blocks:
   limit: {type: Saturation, params: {lower: 0.0, upper: 1.0}}
   plant: {type: HandPlant, period: 0.1 ms}
   tau: {type: Step, period: 1 ms, params: {time: 0.002, before: [0, 0, 0, 0, 0, 0, 0, 0, 0],
-                                           after: [0, 0, 0, 0, 1.0e150, 0, 0, 0, 0]}}
+                                           after: [0, 0, 0, 0, 0, 0, 0, 1.0e150, 0]}}
 connections: [ramp.y -> limit.u, tau.y -> plant.tau]
 log: [limit.y, plant.q]
 """

@@ -38,7 +38,7 @@ ModelObject *hh_py_model(PyObject *obj, const char *what);
  * PyBuffer_Release. */
 int hh_py_doubles(PyObject *obj, Py_buffer *view, Py_ssize_t n, int writable, const char *what);
 
-enum { HH_PY_MOST_BUFFERS = 8 };
+enum { HH_PY_MOST_BUFFERS = 12 };
 
 /* The buffers one call holds, released together: start with {.held = 0}. */
 typedef struct {

@@ -71,7 +71,7 @@ static int reflex_arguments(held_buffers *h, PyObject *const *args, const double
     if ((*state = hh_py_hold(h, args[1], -1, 0, "state")) == NULL)
         return -1;
     if (hh_py_last_count(h) != HH_REFLEX_N_STATE) {
-        PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 4 entries [scale, handed(3)]");
+        PyErr_SetString(PyExc_ValueError, "GraspReflex: state must have 7 entries [scale, handed(3), hold(3)]");
         return -1;
     }
     if ((in->tip = reflex_input(h, args[2], 9, "tip")) == NULL ||
@@ -452,22 +452,37 @@ static PyObject *py_manipulation_output(PyObject *module, PyObject *const *args,
     ModelObject *model;
     hh_trajectories tr;
     double t;
-    const double *params, *q, *qd, *fn, *support;
+    const double *params;
+    hh_manip_inputs in;
     double *out;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 10, "manipulation_output") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
+    if (hh_py_nargs(nargs, 12, "manipulation_output") != 0 || (model = hh_py_model(args[0], "model")) == NULL ||
         hh_py_double(args[4], &t, "t") != 0)
         return NULL;
     if ((params = hh_py_hold(&h, args[1], HH_MANIP_N_PARAMS, 0, "params")) != NULL &&
         manip_trajectories(&h, args[2], args[3], &tr) == 0 &&
-        (q = hh_py_hold(&h, args[5], HH_JOINTS, 0, "q")) != NULL &&
-        (qd = hh_py_hold(&h, args[6], HH_JOINTS, 0, "qd")) != NULL &&
-        (fn = hh_py_hold(&h, args[7], HH_FINGERS, 0, "fn")) != NULL &&
-        (support = hh_py_hold(&h, args[8], 3, 0, "support")) != NULL &&
-        (out = hh_py_hold(&h, args[9], HH_MANIP_N_OUT, 1, "out")) != NULL)
-        result = PyLong_FromLong(hh_manipulation_output(&model->model, params, &tr, t, q, qd, fn, support, out));
+        (in.q = hh_py_hold(&h, args[5], HH_JOINTS, 0, "q")) != NULL &&
+        (in.qd = hh_py_hold(&h, args[6], HH_JOINTS, 0, "qd")) != NULL &&
+        (in.fn = hh_py_hold(&h, args[7], HH_FINGERS, 0, "fn")) != NULL &&
+        (in.support = hh_py_hold(&h, args[8], 3, 0, "support")) != NULL &&
+        (in.normal = hh_py_hold(&h, args[9], 2 * HH_FINGERS, 0, "normal")) != NULL &&
+        (in.obj = hh_py_hold(&h, args[10], 3, 0, "obj")) != NULL &&
+        (out = hh_py_hold(&h, args[11], HH_MANIP_N_OUT, 1, "out")) != NULL)
+        result = PyLong_FromLong(hh_manipulation_output(&model->model, params, &tr, t, &in, out));
     hh_py_release_all(&h);
     return result;
+}
+
+static PyObject *py_matched_gains(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    double inertia, kp, kd, period, kp_t, kd_t;
+    if (hh_py_nargs(nargs, 4, "matched_gains") != 0 || hh_py_double(args[0], &inertia, "inertia") != 0 ||
+        hh_py_double(args[1], &kp, "kp") != 0 || hh_py_double(args[2], &kd, "kd") != 0 ||
+        hh_py_double(args[3], &period, "period") != 0)
+        return NULL;
+    hh_matched_gains(inertia, kp, kd, period, &kp_t, &kd_t);
+    return Py_BuildValue("(dd)", kp_t, kd_t);
 }
 
 /* -- suppresser ------------------------------------------------------------------------------ */
@@ -476,17 +491,39 @@ static PyObject *py_suppress(PyObject *module, PyObject *const *args, Py_ssize_t
 {
     (void)module;
     held_buffers h = {.held = 0};
-    const double *params, *tau_g, *tau_m, *tau_ff;
+    const double *params, *tau_g, *g = NULL, *tau_m, *tau_ff;
     double *out;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 5, "suppress") != 0)
+    if (hh_py_nargs(nargs, 6, "suppress") != 0)
         return NULL;
     if ((params = hh_py_hold(&h, args[0], HH_SUPPRESS_N_PARAMS, 0, "params")) != NULL &&
         (tau_g = hh_py_hold(&h, args[1], HH_JOINTS, 0, "tau_g")) != NULL &&
-        (tau_m = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau_m")) != NULL &&
-        (tau_ff = hh_py_hold(&h, args[3], HH_JOINTS, 0, "tau_ff")) != NULL &&
-        (out = hh_py_hold(&h, args[4], HH_SUPPRESS_N_OUT, 1, "out")) != NULL) {
-        hh_suppress(params, tau_g, tau_m, tau_ff, out);
+        (args[2] == Py_None || (g = hh_py_hold(&h, args[2], HH_JOINTS, 0, "g")) != NULL) &&
+        (tau_m = hh_py_hold(&h, args[3], HH_JOINTS, 0, "tau_m")) != NULL &&
+        (tau_ff = hh_py_hold(&h, args[4], HH_JOINTS, 0, "tau_ff")) != NULL &&
+        (out = hh_py_hold(&h, args[5], HH_SUPPRESS_N_OUT, 1, "out")) != NULL) {
+        hh_suppress(params, tau_g, g, tau_m, tau_ff, out);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}
+
+static PyObject *py_suppress_update(PyObject *module, PyObject *const *args, Py_ssize_t nargs)
+{
+    (void)module;
+    held_buffers h = {.held = 0};
+    const double *params, *state, *tau_g, *tau_m;
+    double *next;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 5, "suppress_update") != 0)
+        return NULL;
+    if ((params = hh_py_hold(&h, args[0], HH_SUPPRESS_N_PARAMS, 0, "params")) != NULL &&
+        (state = hh_py_hold(&h, args[1], HH_JOINTS, 0, "state")) != NULL &&
+        (tau_g = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau_g")) != NULL &&
+        (tau_m = hh_py_hold(&h, args[3], HH_JOINTS, 0, "tau_m")) != NULL &&
+        (next = hh_py_hold(&h, args[4], HH_JOINTS, 1, "next")) != NULL) {
+        hh_suppress_update(params, state, tau_g, tau_m, next);
         result = Py_NewRef(Py_None);
     }
     hh_py_release_all(&h);
@@ -521,7 +558,8 @@ static PyObject *py_suppress_joints(PyObject *module, PyObject *const *args, Py_
         (tau_m = hh_py_hold(&h, args[1], n, 0, "tau_m")) != NULL && (s_a = hh_py_hold(&h, args[2], n, 0, "S_a")) != NULL &&
         (s_b = hh_py_hold(&h, args[3], n, 0, "S_b")) != NULL) {
         for (Py_ssize_t i = 0; i < n; i++)
-            out[i] = hh_suppressed(tau_g[i], tau_m[i], s_a[i], s_b[i], (double)mode);
+            out[i] = hh_suppressed(tau_g[i], hh_suppression_input(tau_g[i], tau_m[i], (double)mode), s_a[i], s_b[i],
+                                   (double)mode);
         result = Py_NewRef(Py_None);
     }
     hh_py_release_all(&h);
@@ -532,16 +570,15 @@ static PyObject *py_finger_shares(PyObject *module, PyObject *const *args, Py_ss
 {
     (void)module;
     held_buffers h = {.held = 0};
-    const double *tau_g, *tau_g_eff, *tau_m;
+    const double *tau_g, *tau_g_eff;
     double *share;
     PyObject *result = NULL;
-    if (hh_py_nargs(nargs, 4, "finger_shares") != 0)
+    if (hh_py_nargs(nargs, 3, "finger_shares") != 0)
         return NULL;
     if ((tau_g = hh_py_hold(&h, args[0], HH_JOINTS, 0, "tau_g")) != NULL &&
         (tau_g_eff = hh_py_hold(&h, args[1], HH_JOINTS, 0, "tau_g_eff")) != NULL &&
-        (tau_m = hh_py_hold(&h, args[2], HH_JOINTS, 0, "tau_m")) != NULL &&
-        (share = hh_py_hold(&h, args[3], HH_FINGERS, 1, "share")) != NULL) {
-        hh_finger_shares(tau_g, tau_g_eff, tau_m, share);
+        (share = hh_py_hold(&h, args[2], HH_FINGERS, 1, "share")) != NULL) {
+        hh_finger_shares(tau_g, tau_g_eff, share);
         result = Py_NewRef(Py_None);
     }
     hh_py_release_all(&h);
@@ -588,17 +625,24 @@ PyMethodDef hh_py_control_methods[] = {
     {"trajectory_velocity", FASTCALL(py_trajectory_velocity),
      "trajectory_velocity(waypoints, interpolation, t, velocity): its time derivative at t."},
     {"manipulation_output", FASTCALL(py_manipulation_output),
-     "manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, out) -> status: rows tau_m, tau_ff, "
+     "manipulation_output(model, params, waypoints, meta, t, q, qd, fn, support, normal, obj, out) -> status: "
+     "rows tau_m, tau_ff, "
      "q_ref into out (3x9); MANIP_OK, or MANIP_UNREACHABLE + f when a target of finger f is out of reach."},
+    {"matched_gains", FASTCALL(py_matched_gains),
+     "matched_gains(inertia, kp, kd, period) -> (kp_T, kd_T): the gains a torque held for each period needs "
+     "to give a joint of that inertia the closed-loop poles of the continuous PD loop."},
     {"suppress", FASTCALL(py_suppress),
-     "suppress(params, tau_g, tau_m, tau_ff, out): tau (9), tau_g_eff (9) and share (3) into out (SUPPRESS_N_OUT)."},
+     "suppress(params, tau_g, g, tau_m, tau_ff, out): tau (9), tau_g_eff (9) and share (3) into out (SUPPRESS_N_OUT); "
+     "g: the low-passed suppression inputs (9), or None for the static law."},
+    {"suppress_update", FASTCALL(py_suppress_update),
+     "suppress_update(params, state, tau_g, tau_m, next): the low-passed suppression inputs (9) into next."},
     {"sigmoid", FASTCALL(py_sigmoid), "sigmoid(x, out): the logistic function of every value of x into out."},
     {"suppress_joints", FASTCALL(py_suppress_joints),
      "suppress_joints(tau_g, tau_m, S_a, S_b, mode, out): the suppressed grasping torque of n joints (n values "
      "each) into out, mode SUPPRESS_PASS, _MAGNITUDE or _SIGNED."},
     {"finger_shares", FASTCALL(py_finger_shares),
-     "finger_shares(tau_g, tau_g_eff, tau_m, share): per finger (3) the share of its grasping torque its command "
-     "keeps."},
+     "finger_shares(tau_g, tau_g_eff, share): per finger (3) the share of its grasping torque the suppresser "
+     "lets through."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -611,21 +655,22 @@ static const struct {
     LAYOUT_ENTRY(HH_REFLEX_P_THRESHOLD), LAYOUT_ENTRY(HH_REFLEX_P_APPROACH), LAYOUT_ENTRY(HH_REFLEX_P_KI),
     LAYOUT_ENTRY(HH_REFLEX_P_DT), LAYOUT_ENTRY(HH_REFLEX_P_MIN_FORCE), LAYOUT_ENTRY(HH_REFLEX_P_RATIO),
     LAYOUT_ENTRY(HH_REFLEX_P_MAX_FORCE), LAYOUT_ENTRY(HH_REFLEX_P_INITIAL), LAYOUT_ENTRY(HH_REFLEX_P_COINCIDENT_RTOL),
-    LAYOUT_ENTRY(HH_REFLEX_P_RELEASE_SHARE),
-    LAYOUT_ENTRY(HH_REFLEX_N_PARAMS), LAYOUT_ENTRY(HH_REFLEX_S_SCALE), LAYOUT_ENTRY(HH_REFLEX_S_HANDED),
+    LAYOUT_ENTRY(HH_REFLEX_P_RELEASE_SHARE), LAYOUT_ENTRY(HH_REFLEX_P_TIP_RADIUS), LAYOUT_ENTRY(HH_REFLEX_P_FOLLOW), LAYOUT_ENTRY(HH_REFLEX_P_HOLD_SHARE),
+    LAYOUT_ENTRY(HH_REFLEX_N_PARAMS), LAYOUT_ENTRY(HH_REFLEX_S_SCALE), LAYOUT_ENTRY(HH_REFLEX_S_HANDED), LAYOUT_ENTRY(HH_REFLEX_S_HOLD),
     LAYOUT_ENTRY(HH_REFLEX_N_STATE), LAYOUT_ENTRY(HH_REFLEX_O_TAU), LAYOUT_ENTRY(HH_REFLEX_O_FORCE),
     LAYOUT_ENTRY(HH_REFLEX_O_ACTIVE), LAYOUT_ENTRY(HH_REFLEX_N_OUT), LAYOUT_ENTRY(HH_REFLEX_OK),
     LAYOUT_ENTRY(HH_REFLEX_COINCIDENT), LAYOUT_ENTRY(HH_REFLEX_NO_PERIOD),
     LAYOUT_ENTRY(HH_MANIP_P_Q0), LAYOUT_ENTRY(HH_MANIP_P_KP), LAYOUT_ENTRY(HH_MANIP_P_KD), LAYOUT_ENTRY(HH_MANIP_P_GX),
     LAYOUT_ENTRY(HH_MANIP_P_GY), LAYOUT_ENTRY(HH_MANIP_P_WX), LAYOUT_ENTRY(HH_MANIP_P_WY),
     LAYOUT_ENTRY(HH_MANIP_P_THRESHOLD), LAYOUT_ENTRY(HH_MANIP_P_GRAVITY_COMP), LAYOUT_ENTRY(HH_MANIP_P_LOAD_COMP),
-    LAYOUT_ENTRY(HH_MANIP_P_STEP), LAYOUT_ENTRY(HH_MANIP_P_REACH_RTOL), LAYOUT_ENTRY(HH_MANIP_N_PARAMS),
+    LAYOUT_ENTRY(HH_MANIP_P_STEP), LAYOUT_ENTRY(HH_MANIP_P_REACH_RTOL), LAYOUT_ENTRY(HH_MANIP_P_DT),
+    LAYOUT_ENTRY(HH_MANIP_P_MATCHED), LAYOUT_ENTRY(HH_MANIP_P_CONTACT_COMP), LAYOUT_ENTRY(HH_MANIP_N_PARAMS),
     LAYOUT_ENTRY(HH_MANIP_W_T), LAYOUT_ENTRY(HH_MANIP_W_X), LAYOUT_ENTRY(HH_MANIP_W_Y), LAYOUT_ENTRY(HH_MANIP_W_PHI),
     LAYOUT_ENTRY(HH_MANIP_W_COLS), LAYOUT_ENTRY(HH_MANIP_M_COUNT), LAYOUT_ENTRY(HH_MANIP_M_INTERP),
     LAYOUT_ENTRY(HH_MANIP_N_META), LAYOUT_ENTRY(HH_MANIP_INTERP_LINEAR), LAYOUT_ENTRY(HH_MANIP_INTERP_MINJERK),
     LAYOUT_ENTRY(HH_MANIP_O_TAU_M), LAYOUT_ENTRY(HH_MANIP_O_TAU_FF), LAYOUT_ENTRY(HH_MANIP_O_Q_REF),
-    LAYOUT_ENTRY(HH_MANIP_N_OUT), LAYOUT_ENTRY(HH_MANIP_OK), LAYOUT_ENTRY(HH_MANIP_UNREACHABLE),
-    LAYOUT_ENTRY(HH_SUPPRESS_P_S_A), LAYOUT_ENTRY(HH_SUPPRESS_P_S_B), LAYOUT_ENTRY(HH_SUPPRESS_P_MODE),
+    LAYOUT_ENTRY(HH_MANIP_N_OUT), LAYOUT_ENTRY(HH_MANIP_OK), LAYOUT_ENTRY(HH_MANIP_UNREACHABLE), LAYOUT_ENTRY(HH_MANIP_NO_PERIOD),
+    LAYOUT_ENTRY(HH_SUPPRESS_P_S_A), LAYOUT_ENTRY(HH_SUPPRESS_P_S_B), LAYOUT_ENTRY(HH_SUPPRESS_P_MODE), LAYOUT_ENTRY(HH_SUPPRESS_P_ALPHA),
     LAYOUT_ENTRY(HH_SUPPRESS_N_PARAMS), LAYOUT_ENTRY(HH_SUPPRESS_PASS), LAYOUT_ENTRY(HH_SUPPRESS_MAGNITUDE),
     LAYOUT_ENTRY(HH_SUPPRESS_SIGNED), LAYOUT_ENTRY(HH_SUPPRESS_O_TAU), LAYOUT_ENTRY(HH_SUPPRESS_O_TAU_G_EFF),
     LAYOUT_ENTRY(HH_SUPPRESS_O_SHARE), LAYOUT_ENTRY(HH_SUPPRESS_N_OUT),

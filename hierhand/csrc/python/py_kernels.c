@@ -13,7 +13,8 @@
  * so the blocks' Kernels say nogil and the executor runs them with the GIL released.
  * - GraspReflex: uintptr_t[2] = {Model object, params};
  * - ManipulationPD: uintptr_t[5] = {Model object, params, waypoints, meta, capacity};
- * - Suppresser: the params (HH_SUPPRESS_N_PARAMS doubles);
+ * - Suppresser: the params (HH_SUPPRESS_N_PARAMS doubles); its state, the low-passed
+ *   suppression inputs (9), or none for the static law (the kernel's output gets NULL);
  * - ObjectSupport: double[4] = {fx, fy, torque, until}.
  *
  * Inputs arrive in the order of the block's ``inputs`` and outputs leave in the order of
@@ -156,7 +157,7 @@ static int reflex_update(const void *ctx, double t, double *state, const double 
     return code;
 }
 
-/* -- ManipulationPD: inputs q, qd, fn, support; out: tau_m, tau_ff, q_ref --------------------- */
+/* -- ManipulationPD: inputs q, qd, fn, support, normal, obj; out: tau_m, tau_ff, q_ref ------- */
 
 static int manipulation_output(const void *ctx, double t, const double *state, const double *const *inputs,
                                double *out, int *which)
@@ -166,8 +167,9 @@ static int manipulation_output(const void *ctx, double t, const double *state, c
     const ModelObject *model = (const ModelObject *)c[0];
     hh_trajectories tr = {.waypoints = (const double *)c[2], .meta = (const double *)c[3], .capacity = (long)c[4]};
     double buffer[HH_MANIP_N_OUT];
-    int status = hh_manipulation_output(&model->model, (const double *)c[1], &tr, t, inputs[0], inputs[1], inputs[2],
-                                        inputs[3], buffer);
+    hh_manip_inputs in = {.q = inputs[0], .qd = inputs[1], .fn = inputs[2], .support = inputs[3],
+                          .normal = inputs[4], .obj = inputs[5]};
+    int status = hh_manipulation_output(&model->model, (const double *)c[1], &tr, t, &in, buffer);
     if (status == HH_MANIP_OK) {
         *which = 0;
         memcpy(out, buffer, sizeof buffer);
@@ -183,9 +185,18 @@ static int suppresser_output(const void *ctx, double t, const double *state, con
                              double *out, int *which)
 {
     (void)t;
-    (void)state;
     *which = 0;
-    hh_suppress((const double *)ctx, inputs[0], inputs[1], inputs[2], out);
+    hh_suppress((const double *)ctx, inputs[0], state, inputs[1], inputs[2], out); /* state NULL: static law */
+    return 0;
+}
+
+static int suppresser_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
+{
+    (void)t;
+    *which = 0;
+    double next[HH_JOINTS];
+    hh_suppress_update((const double *)ctx, state, inputs[0], inputs[1], next);
+    memcpy(state, next, sizeof next);
     return 0;
 }
 
@@ -218,7 +229,7 @@ static const block_kernels KERNELS[] = {
     {"HandPlant", plant_output, plant_update, plant_advance},
     {"GraspReflex", reflex_output, reflex_update, NULL},
     {"ManipulationPD", manipulation_output, NULL, NULL},
-    {"Suppresser", suppresser_output, NULL, NULL},
+    {"Suppresser", suppresser_output, suppresser_update, NULL},
     {"ObjectSupport", support_output, NULL, NULL},
 };
 

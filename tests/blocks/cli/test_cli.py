@@ -144,6 +144,31 @@ def test_validate_prints_tick_hyperperiod_and_order(tmp_path):
         assert name in order
 
 
+def test_validate_plan_prints_the_op_table_with_names(tmp_path):
+    """The plan the C core runs, readably: each program's ops by block and port, the
+    events that run it, the copies into delayed inputs and the log entries."""
+    proc = hierhand("validate", TOY, "--plan", "--t-end", "20 ms", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    plan = proc.stdout.split("op table: ", 1)[1]
+    assert plan.startswith("200 ticks of 1/10000 s, hyperperiod 100 ticks; 6 blocks")
+    assert "  2  plant  y@2[1]  in: u<-@5[1]  every 1 ticks, advance rows @6[10 x 1]" in plan
+    events = plan.split("  2  at ticks 10, 20, 30, 40, 50, 60, ... (mod 100)", 1)[1].split("\n  3  ", 1)[0]
+    assert events.split("\n")[1:] == ["       output err", "       output integ", "       output u",
+                                       "       update integ",
+                                       "       advance plant to the next event, logging plant.y "
+                                       "(the event's last advance)"]
+    assert "  3  the end, at tick 200:" in plan
+    assert "  0  plant.y: every hit, columns 0..0 of plant, at most 201 rows" in plan
+
+
+def test_validate_plan_without_an_end_time_says_so(tmp_path):
+    text = TOY.read_text(encoding="utf-8").replace("time: {t_end: 1 s}\n", "")
+    diagram = tmp_path / "endless.yaml"
+    diagram.write_text(text, encoding="utf-8")
+    proc = hierhand("validate", diagram, "--plan", cwd=tmp_path)
+    assert proc.returncode == 2 and "no end time" in proc.stderr and "Traceback" not in proc.stderr
+
+
 def test_graph_prints_dot_with_every_block(tmp_path):
     proc = hierhand("graph", TOY, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr

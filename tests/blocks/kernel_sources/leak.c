@@ -129,3 +129,21 @@ int gate_output(const void *ctx, double t, const double *state, const double *co
     out[0] = 1.0;
     return 0;
 }
+
+/* Stopper: state [count]; y = [count, t]. Each update adds one, and the update that brings
+   the count to ctx[0] asks to end the run (BLK_END_RUN), the new count kept. */
+int stopper_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
+                   int *which)
+{
+    (void)ctx, (void)inputs, (void)which;
+    out[0] = state[0];
+    out[1] = t;
+    return 0;
+}
+
+int stopper_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
+{
+    (void)t, (void)inputs, (void)which;
+    state[0] += 1.0;
+    return state[0] == ((const double *)ctx)[0] ? BLK_END_RUN : 0;
+}

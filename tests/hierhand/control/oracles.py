@@ -6,8 +6,8 @@ blocks and the Python API of ``hierhand.control`` call. These are independent of
 written from the formulas (``numpy.linalg.pinv`` for the grasp-matrix projection, the
 link walk for the kinematics, ``numpy.searchsorted`` for the trajectory segments), so the
 tests can tell a wrong formula from round-off. Most were the package's numpy
-implementations before the laws were written once (issue 14); the C agrees with them to
-round-off, often to the bit.
+implementations before the laws were written once (issue 14), rewritten with the laws
+since; the C agrees with them to round-off, often to the bit.
 """
 
 from __future__ import annotations
@@ -33,31 +33,45 @@ def sigmoid(x: Any) -> np.ndarray:
     return np.where(x >= 0, 1.0 / (1.0 + e), e / (1.0 + e))
 
 
-def suppress(tau_g: Any, tau_m: Any, s_a: Any, s_b: Any, mode: str = "magnitude") -> np.ndarray:
-    """``tau_g * sigmoid(S_a (S_b - g(tau_m)))``, ``g = |tau_m|`` or ``tau_m``."""
-    tau_m = np.asarray(tau_m, dtype=float)
-    g = np.abs(tau_m) if mode == "magnitude" else tau_m
+def suppression_input(tau_g: Any, tau_m: Any, mode: str) -> np.ndarray:
+    """``g(tau_m)``: ``|tau_m|``, or ``tau_m`` signed positive against the grasping torque."""
+    tau_g, tau_m = np.asarray(tau_g, dtype=float), np.asarray(tau_m, dtype=float)
+    return np.abs(tau_m) if mode == "magnitude" else np.where(tau_g >= 0, -tau_m, tau_m)
+
+
+def suppress(tau_g: Any, tau_m: Any, s_a: Any, s_b: Any, mode: str = "signed") -> np.ndarray:
+    """``tau_g * sigmoid(S_a (S_b - g(tau_m)))``."""
+    g = suppression_input(tau_g, tau_m, mode)
     return np.asarray(tau_g, dtype=float) * sigmoid(np.asarray(s_a, dtype=float) * (np.asarray(s_b, dtype=float) - g))
 
 
-def finger_shares(tau_g: Any, tau_g_eff: Any, tau_m: Any) -> np.ndarray:
-    """Per finger ``(tau_g_eff_i + tau_m_i) . tau_g_i / |tau_g_i|^2``, 1 where ``tau_g_i = 0``."""
+def finger_shares(tau_g: Any, tau_g_eff: Any) -> np.ndarray:
+    """Per finger ``tau_g_eff_i . tau_g_i / |tau_g_i|^2``, 1 where ``tau_g_i = 0``."""
     g = np.asarray(tau_g, dtype=float).reshape(3, 3)
-    kept = (np.asarray(tau_g_eff, dtype=float) + np.asarray(tau_m, dtype=float)).reshape(3, 3)
+    kept = np.asarray(tau_g_eff, dtype=float).reshape(3, 3)
     squared = (g * g).sum(axis=1)
     along = (kept * g).sum(axis=1)
     return np.where(squared > 0.0, along / np.where(squared > 0.0, squared, 1.0), 1.0)
 
 
-def suppresser_output(block, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """A ``Suppresser`` block's output ports."""
+def suppresser_output(block, inputs: Mapping[str, np.ndarray], state: Any = None) -> dict[str, np.ndarray]:
+    """A ``Suppresser`` block's output ports; ``state``: the low-passed g of a filtered one."""
     tau_g, tau_m = np.asarray(inputs["tau_g"], dtype=float), np.asarray(inputs["tau_m"], dtype=float)
     tau_ff = np.asarray(inputs.get("tau_ff", np.zeros(9)), dtype=float)
     if not block.enabled:
         return {"tau": (tau_g + tau_m) + tau_ff, "tau_g_eff": tau_g.copy(), "share": np.ones(3)}
-    effective = suppress(tau_g, tau_m, block.S_a, block.S_b, block.mode)
-    return {"tau": (effective + tau_m) + tau_ff, "tau_g_eff": effective,
-            "share": finger_shares(tau_g, effective, tau_m)}
+    g = suppression_input(tau_g, tau_m, block.mode) if state is None else np.asarray(state, dtype=float)
+    effective = tau_g * sigmoid(block.S_a * (block.S_b - g))
+    return {"tau": (effective + tau_m) + tau_ff, "tau_g_eff": effective, "share": finger_shares(tau_g, effective)}
+
+
+def suppresser_update(block, state: np.ndarray, inputs: Mapping[str, np.ndarray], period: float) -> np.ndarray:
+    """A filtered ``Suppresser``'s next state: g low-passed with time constant ``block.time_constant``."""
+    if not block.enabled:
+        return np.asarray(state, dtype=float).copy()
+    alpha = 1.0 - math.exp(-period / block.time_constant)
+    g = suppression_input(inputs["tau_g"], inputs["tau_m"], block.mode)
+    return state + alpha * (g - state)
 
 
 # -- internal forces -------------------------------------------------------------------------
@@ -96,10 +110,35 @@ def internal_directions(points: np.ndarray) -> np.ndarray:
 
 def reflex_members(reflex, state: np.ndarray, fn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(fingers in the grasp, fingers touching): touching ones, and those listed in 'grasp'
-    that are not touching and were not handed over when they last touched."""
+    that are not touching and were not marked handed over when they last touched."""
     touching = fn > reflex.threshold
-    approaching = reflex.initial & (state[1:] == 0.0) & ~touching
+    approaching = reflex.initial & (state[1:4] == 0.0) & ~touching
     return touching | approaching, touching
+
+
+def acting_points(reflex, tip, normal, touching) -> np.ndarray:
+    """(3, 2): a touching finger's contact point (tip centre plus radius along the normal), else its tip centre."""
+    points = np.asarray(tip, dtype=float).reshape(3, 3)[:, :2]
+    return points + np.where(touching, reflex.hand.tip_radius, 0.0)[:, None] * np.asarray(normal, dtype=float).reshape(3, 2)
+
+
+def _squeeze(points, push, members) -> tuple[np.ndarray, bool]:
+    """(g (3, 2) over the members, largest row 1; whether the centroid squeeze was the fallback)."""
+    g = np.zeros((3, 2))
+    idx = np.flatnonzero(members)
+    internal = project_internal(points[idx], push[idx].ravel()).reshape(-1, 2)
+    fallback = bool(np.any(np.einsum("ij,ij->i", internal, push[idx]) <= 0))
+    if fallback:
+        internal = internal_directions(points[idx])
+    g[idx] = internal / np.max(np.linalg.norm(internal, axis=1))
+    return g, fallback
+
+
+def _toward(tip, members, i) -> np.ndarray:
+    """A unit push from finger i's tip centre toward the members' tip centres' centroid."""
+    centres = np.asarray(tip, dtype=float).reshape(3, 3)[:, :2]
+    toward = centres[members & (np.arange(3) != i)].mean(axis=0) - centres[i]
+    return toward / max(np.linalg.norm(toward), 1e-12)
 
 
 def reflex_directions(reflex, state, tip, normal, fn) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
@@ -108,57 +147,77 @@ def reflex_directions(reflex, state, tip, normal, fn) -> tuple[np.ndarray, np.nd
     g = np.zeros((3, 2))
     if grasp.sum() < 2:
         return g, grasp, touching, False
-    points = tip.reshape(3, 3)[:, :2]
-    push = normal.reshape(3, 2).copy()
-    for i in np.flatnonzero(grasp & ~touching):
-        toward = points[grasp & (np.arange(3) != i)].mean(axis=0) - points[i]
-        push[i] = toward / max(np.linalg.norm(toward), 1e-12)
-    idx = np.flatnonzero(grasp)
-    internal = project_internal(points[idx], push[idx].ravel()).reshape(-1, 2)
-    fallback = bool(np.any(np.einsum("ij,ij->i", internal, push[idx]) <= 0))
-    if fallback:
-        internal = internal_directions(points[idx])
-    g[idx] = internal / np.max(np.linalg.norm(internal, axis=1))
+    points = acting_points(reflex, tip, normal, touching)
+    push = np.asarray(normal, dtype=float).reshape(3, 2).copy()
+    if touching.sum() < 2:  # all of the grasp close on each other
+        for i in np.flatnonzero(grasp & ~touching):
+            push[i] = _toward(tip, grasp, i)
+        g, fallback = _squeeze(points, push, grasp)
+        return g, grasp, touching, fallback
+    g, fallback = _squeeze(points, push, touching)
+    hold = state[4:7]
+    partial = [i for i in np.flatnonzero(touching) if hold[i] < 1.0]
+    if touching.sum() == 3 and partial:
+        i = min(partial, key=lambda j: hold[j])
+        two, fallback_two = _squeeze(points, push, touching & (np.arange(3) != i))
+        g = hold[i] * g + (1.0 - hold[i]) * two
+        fallback = fallback or fallback_two
+    for i in np.flatnonzero(grasp & ~touching):  # approaching the touching ones
+        g[i] = _toward(tip, touching, i)
     return g, grasp, touching, fallback
 
 
 def reflex_forces(reflex, state, inputs) -> tuple[np.ndarray, np.ndarray]:
-    """(f (3, 2), grasp): ``s g_i`` touching (at most the scale handed over at), else ``g_i``
-    scaled to the approach force."""
+    """(f (3, 2), grasp): ``s g_i`` touching, else ``g_i`` scaled to the approach force."""
     g, grasp, touching, _ = reflex_directions(reflex, state, inputs["tip"], inputs["normal"], inputs["fn"])
     length = np.linalg.norm(g, axis=1)
-    held_at = np.where(state[1:] > 0, np.minimum(state[0], state[1:]), state[0])
-    scale = np.where(touching, held_at, reflex.approach_force / np.maximum(length, 1e-300))
+    scale = np.where(touching, state[0], reflex.approach_force / np.maximum(length, 1e-300))
     return g * scale[:, None], grasp
 
 
 def reflex_output(reflex, state, inputs) -> dict[str, np.ndarray]:
-    """A ``GraspReflex`` block's output ports: ``J_i^T f_i``, ``|f_i|``, the grasp flags."""
+    """A ``GraspReflex`` block's output ports: ``J_i^T f_i`` at the acting points (their offsets
+    from the measured tip centres carried to the tips at ``q``), ``|f_i|``, the grasp flags."""
     f, grasp = reflex_forces(reflex, state, inputs)
-    jac = reflex.hand.tip_jacobians(inputs["q"])
-    tau = np.concatenate([jac[i].T @ f[i] for i in range(3)])
+    touching = np.asarray(inputs["fn"]) > reflex.threshold
+    offsets = acting_points(reflex, inputs["tip"], inputs["normal"], touching) - np.asarray(
+        inputs["tip"], dtype=float).reshape(3, 3)[:, :2]
+    q = np.asarray(inputs["q"], dtype=float)
+    points = reflex.hand.tip_positions(q) + offsets
+    tau = np.concatenate([reflex.hand.point_jacobian(q, i, points[i]).T @ f[i] for i in range(3)])
     return {"tau_g": tau, "force": np.linalg.norm(f, axis=1), "active": grasp.astype(float)}
 
 
+def reflex_holds(reflex, state, share, touching) -> np.ndarray:
+    """How much the reflex holds each finger: the two touching ones with the largest share 1, a
+    third 1 down to hold_share falling linearly to 0 at release_share; one out of contact keeps its hold."""
+    hold = np.asarray(state[4:7], dtype=float).copy()
+    order = sorted(np.flatnonzero(touching), key=lambda i: -share[i])  # stable: the first of equals
+    for rank, i in enumerate(order):
+        if rank < 2 or not reflex.follow_suppression:
+            hold[i] = 1.0
+        else:
+            hold[i] = min(max((share[i] - reflex.release_share) / (reflex.hold_share - reflex.release_share), 0.0), 1.0)
+    return hold
+
+
 def reflex_update(reflex, state, inputs) -> np.ndarray:
-    """A ``GraspReflex`` block's next state: the integral step over the fingers it holds."""
+    """A ``GraspReflex`` block's next state: the holds, the integral step weighted by them, the marks."""
     fn, ft = inputs["fn"], inputs["ft"]
     g, grasp, touching, _ = reflex_directions(reflex, state, inputs["tip"], inputs["normal"], fn)
-    share = inputs.get("share", np.ones(3))
-    released = np.zeros(3, dtype=bool)
-    for i in np.argsort(share, kind="stable"):  # the least share first, while two others stay held
-        if grasp[i] and touching[i] and share[i] < reflex.release_share and (grasp & touching & ~released).sum() > 2:
-            released[i] = True
-    held = grasp & touching & ~released
+    hold = reflex_holds(reflex, state, np.asarray(inputs.get("share", np.ones(3)), dtype=float), touching)
     scale = state[0]
-    if held.sum() >= 2:
-        normal = inputs["normal"].reshape(3, 2)[held]
-        gain = np.einsum("ij,ij->i", g[held], normal)
-        need = np.maximum(reflex.min_force * np.linalg.norm(g[held], axis=1), np.abs(ft[held]) / reflex.ratio_target)
-        shortfall = float(np.max((need - fn[held]) / np.maximum(gain, 1e-3)))
-        scale = min(max(scale + reflex.ki * reflex.dt * shortfall, 0.0), reflex.max_force)
-    first = np.where(state[1:] > 0, state[1:], max(state[0], np.finfo(float).tiny))
-    return np.concatenate(([scale], np.where(touching, np.where(released, first, 0.0), state[1:])))
+    if touching.sum() >= 2:
+        normal = inputs["normal"].reshape(3, 2)[touching]
+        gain = np.einsum("ij,ij->i", g[touching], normal)
+        need = np.maximum(reflex.min_force * np.linalg.norm(g[touching], axis=1),
+                          np.abs(ft[touching]) / reflex.ratio_target)
+        driving = hold[touching] > 0  # a finger wholly handed over does not count at all
+        if driving.any():
+            shortfall = float(np.max((hold[touching] * (need - fn[touching]) / np.maximum(gain, 1e-3))[driving]))
+            scale = min(max(scale + reflex.ki * reflex.dt * shortfall, 0.0), reflex.max_force)
+    handed = np.where(touching, (hold < 1.0).astype(float), state[1:4])
+    return np.concatenate(([scale], handed, hold))
 
 
 # -- kinematics ----------------------------------------------------------------------------------
@@ -253,10 +312,39 @@ def trajectory_velocity(waypoints, interpolation: str, t: float) -> np.ndarray:
 # -- manipulation PD ----------------------------------------------------------------------------
 
 
+def matched_gains(inertia: float, kp: float, kd: float, period: float) -> tuple[float, float]:
+    """The held gains whose sampled loop on a pure inertia has the poles exp(s T) of the
+    continuous loop J s^2 + kd s + kp: from the ZOH model x+ = x + T v + T^2 u / (2J),
+    v+ = v + T u / J with u = -kp_T x - kd_T v, whose characteristic polynomial is
+    z^2 - (2 - a/2 - b) z + (1 - b + a/2) (a = kp_T T^2 / J, b = kd_T T / J)."""
+    s = np.roots([inertia, kd, kp])
+    z = np.exp(s * period)
+    trace, det = float(np.real(z.sum())), float(np.real(np.prod(z)))
+    b = (3.0 - trace - det) / 2.0
+    a = 2.0 * (2.0 - trace - b)
+    return a * inertia / period ** 2, b * inertia / period
+
+
+def distribute(points: np.ndarray, weights: np.ndarray, origin: np.ndarray, wrench: np.ndarray) -> np.ndarray:
+    """(k, 2): forces with the least sum of |f_i|^2 / w_i giving ``wrench`` (fx, fy, moment
+    about origin): the weighted pseudo-inverse of the grasp matrix, by numpy. One point
+    cannot balance a moment: it takes the force and the moment is dropped (the pseudo-inverse
+    about ``origin`` would trade some of the force for the moment)."""
+    if len(points) == 1:
+        return np.asarray(wrench, dtype=float)[None, :2].copy()
+    g = grasp_matrix(points, origin)
+    w = np.repeat(np.asarray(weights, dtype=float), 2)
+    f = w * (g.T @ np.linalg.pinv(g @ (w[:, None] * g.T)) @ np.asarray(wrench, dtype=float))
+    return f.reshape(-1, 2)
+
+
 def manipulation_output(pd, t: float, inputs: Mapping[str, np.ndarray], step: float = 1e-3) -> dict[str, np.ndarray]:
     """A ``ManipulationPD`` block's output ports: targets by IK of the sampled trajectories
-    (velocity by central differences ``step`` either side), joint PD, gravity and load
-    feedforward through the hand model. ``ValueError`` for a target out of reach."""
+    (velocity by central differences ``step`` either side), moved for fingers in contact by
+    fn / k_n along their normal, joint PD (gains matched to each joint's inertia for a
+    'matched' PD), gravity and load feedforward through the hand model (the load shared by the
+    grasp matrix at the contact points, weighted by the normal forces). ``ValueError`` for a
+    target out of reach."""
     hand = pd.hand
     q_ref, qd_ref = hand.q0.copy(), np.zeros(9)
     for f, traj in enumerate(pd.trajectories):
@@ -274,13 +362,31 @@ def manipulation_output(pd, t: float, inputs: Mapping[str, np.ndarray], step: fl
         if np.any(trajectory_velocity(waypoints, traj.interpolation, t)):
             qd_ref[3 * f:3 * f + 3] = (target(t + step) - target(t - step)) / (2 * step)
     q, qd = np.asarray(inputs["q"], dtype=float), np.asarray(inputs["qd"], dtype=float)
-    tau_m = pd.kp * (q_ref - q) + pd.kd * (qd_ref - qd)
+    fn, normal = np.asarray(inputs["fn"], dtype=float), np.asarray(inputs["normal"], dtype=float).reshape(3, 2)
+    carrying = fn > pd.threshold
+    if pd.contact_compensation:
+        for f in np.flatnonzero(carrying):
+            base, angle, lengths = finger_geometry(hand, f)
+            x, y, phi = finger_fk(base, angle, lengths, q_ref[3 * f:3 * f + 3])
+            depth = fn[f] / hand.params.contact.k_n
+            moved = finger_ik_near(hand, f, (x + depth * normal[f, 0], y + depth * normal[f, 1], phi),
+                                   q_ref[3 * f:3 * f + 3])
+            if moved is not None:
+                q_ref[3 * f:3 * f + 3] = moved
+    kp, kd = np.array(pd.kp, dtype=float), np.array(pd.kd, dtype=float)
+    if pd.discretization == "matched":
+        inertia = np.diag(hand.mass_matrix(q))
+        for j in range(9):
+            kp[j], kd[j] = matched_gains(inertia[j], kp[j], kd[j], float(pd.period))
+    tau_m = kp * (q_ref - q) + kd * (qd_ref - qd)
     tau_ff = hand.bias(q, np.zeros(9)) if pd.gravity_compensation else np.zeros(9)
-    carrying = np.asarray(inputs["fn"]) > pd.threshold
     if pd.load_compensation and carrying.any():
         support = np.asarray(inputs.get("support", np.zeros(3)), dtype=float)
-        share = -(pd.weight + support[:2]) / carrying.sum()
-        jac = hand.tip_jacobians(q)
-        for f in np.flatnonzero(carrying):
-            tau_ff[3 * f:3 * f + 3] += jac[f].T @ share
+        tips = hand.tip_positions(q)
+        idx = np.flatnonzero(carrying)
+        points = tips[idx] + hand.tip_radius[idx, None] * normal[idx]
+        load = np.concatenate((-(pd.weight + support[:2]), [-support[2]]))
+        shares = distribute(points, fn[idx], np.asarray(inputs["obj"], dtype=float)[:2], load)
+        for share, f, point in zip(shares, idx, points):
+            tau_ff[3 * f:3 * f + 3] += hand.point_jacobian(q, f, point).T @ share
     return {"tau_m": tau_m, "tau_ff": tau_ff, "q_ref": q_ref}

@@ -37,7 +37,7 @@ GEOMETRY = np.array([0.0, 0.0, 0.0, 0.04, 0.03, 0.01])
         (lambda: _native.suppress_joints(*np.zeros((4, 2)), 7, np.zeros(2)), ValueError, "^mode must be"),
         (lambda: _native.suppress_joints(np.zeros(2), np.zeros(2), np.zeros(1), np.zeros(2), 1, np.zeros(2)),
          ValueError, "^S_a must hold 2 values, got 1$"),
-        (lambda: _native.finger_shares(np.zeros(9), np.zeros(9), np.zeros(9), np.zeros(9)), ValueError,
+        (lambda: _native.finger_shares(np.zeros(9), np.zeros(9), np.zeros(9)), ValueError,
          "^share must hold 3 values, got 9$"),
         (lambda: _native.trajectory_velocity(np.zeros(4), 1, 0.0, np.zeros(4)), ValueError,
          "^out must hold 3 values, got 4$"),

@@ -1,9 +1,9 @@
 """The reflex's compiled law against its numpy oracle (``oracles.reflex_*``).
 
 The oracle projects with ``numpy.linalg.pinv``, falls back to the centroid squeeze and
-maps forces through ``Hand.tip_jacobians``; ``GraspReflex`` must agree with it to
-round-off on random 2- and 3-contact grasps, approaching fingers and the fallback
-included.
+maps forces through ``Hand.point_jacobian`` at the contact points; ``GraspReflex`` must
+agree with it to round-off on random 2- and 3-contact grasps, approaching fingers, fingers
+held in part and the fallback included.
 """
 
 from __future__ import annotations
@@ -17,6 +17,8 @@ from hierhand.control.reflex_kernel import (
     P_APPROACH,
     P_COINCIDENT_RTOL,
     P_DT,
+    P_FOLLOW,
+    P_HOLD_SHARE,
     P_INITIAL,
     P_KI,
     P_MAX_FORCE,
@@ -24,6 +26,7 @@ from hierhand.control.reflex_kernel import (
     P_RATIO,
     P_RELEASE_SHARE,
     P_THRESHOLD,
+    P_TIP_RADIUS,
     pack_params,
     reflex_directions,
     reflex_output,
@@ -48,15 +51,17 @@ def random_case(rng, reflex, k, inward: bool):
     tip[:, :2] = rng.uniform(-0.05, 0.05, size=(3, 2)) + [0.0, 0.06]
     chosen = rng.permutation(3)[:k]
     fn = np.zeros(3)
-    state = np.array([rng.uniform(0.0, 10.0), 0.0, 0.0, 0.0])
+    # [scale, handed over (3), hold (3): whole, or in part for some fingers]
+    state = np.concatenate(([rng.uniform(0.0, 10.0)], np.zeros(3), np.where(rng.random(3) < 0.5, 1.0,
+                                                                            rng.uniform(0.0, 1.0, 3))))
     initial = reflex.initial
     for i in chosen:
         if initial[i] and rng.random() < 0.3:
             continue  # still approaching: listed in 'grasp', not handed over, not touching
         fn[i] = rng.uniform(0.1, 8.0)
-        state[1 + i] = rng.choice([0.0, rng.uniform(0.5, 12.0)])  # held, or handed over at some scale
+        state[1 + i] = rng.choice([0.0, 1.0])  # held when it last touched, or handed over
     for i in set(range(3)) - set(chosen):
-        state[1 + i] = rng.uniform(0.5, 12.0) if initial[i] else rng.choice([0.0, 3.0])  # out of the grasp
+        state[1 + i] = 1.0 if initial[i] else rng.choice([0.0, 1.0])  # out of the grasp
     centre = tip[chosen, :2].mean(axis=0)
     normal = np.zeros((3, 2))
     for i in range(3):
@@ -102,33 +107,50 @@ def test_compiled_directions_forces_and_ports_match_the_oracle(k):
     assert min(seen.values()) > 10, seen  # every branch exercised
 
 
-def test_the_projection_is_internal_and_nearest_to_the_pushes():
-    """(I - G^+ G) n: zero net force and moment, and n minus it lies in G's row space."""
+def test_the_squeeze_is_internal_at_the_contact_points():
+    """(I - G^+ G) n at the contact points (tip centre plus radius along the normal), and its
+    blend toward a two-finger squeeze for a finger held in part: zero net force and zero
+    moment about any point, so the squeeze neither pushes nor turns the object."""
     rng = np.random.default_rng(7)
     reflex = make_reflex(["thumb", "fore", "middle"])
+    radius = reflex.hand.tip_radius
+    partly = 0
     for _ in range(200):
         state, inputs = random_case(rng, reflex, 3, inward=True)
         inputs["fn"][:] = 2.0
+        partly += int(np.any(state[4:7] < 1.0))
         g, grasp, _ = reflex.directions(state, inputs["tip"], inputs["normal"], inputs["fn"])
-        p = inputs["tip"].reshape(3, 3)[:, :2]
+        p = inputs["tip"].reshape(3, 3)[:, :2] + radius[:, None] * inputs["normal"].reshape(3, 2)
         np.testing.assert_allclose(g.sum(axis=0), 0.0, atol=1e-12)
         r = p - p.mean(axis=0)
         assert abs(np.sum(r[:, 0] * g[:, 1] - r[:, 1] * g[:, 0])) < 1e-13
+    assert partly > 50
+
+
+def coincident_tips(reflex, normal=(1.0, 0.0), point=(0.02, 0.06)) -> np.ndarray:
+    """Tip poses whose contact points (tip centre plus radius along ``normal``) coincide at ``point``."""
+    tips = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 3.0], [0.05, 0.05, 2.6]])
+    for i in (0, 1):
+        tips[i, :2] = np.asarray(point) - reflex.hand.tip_radius[i] * np.asarray(normal)
+    return tips.ravel()
 
 
 def test_coincident_points_behave_as_the_oracle():
     reflex = make_reflex(["thumb", "fore"])
     state = reflex.initial_state()
-    tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
     fn = np.array([2.0, 2.0, 0.0])
-    # opposite normals: the pseudo-inverse drops the moment row, the pushes stay
+    # opposite normals at coincident contact points: the pseudo-inverse drops the moment
+    # row, the pushes stay
     opposite = np.array([1.0, 0.0, -1.0, 0.0, 0.0, 0.0])
+    tip = coincident_tips(reflex)
+    tip[3:5] = np.array([0.02, 0.06]) + reflex.hand.tip_radius[1] * np.array([1.0, 0.0])
     g, _, _ = reflex.directions(state, tip, opposite, fn)
     np.testing.assert_allclose(g, oracles.reflex_directions(reflex, state, tip, opposite, fn)[0], atol=1e-15)
+    tip = coincident_tips(reflex)
     # equal normals: nothing internal is left (the SVD's pinv leaves round-off, which the
     # oracle then normalises) and no squeeze direction exists: the fallback's error
     with pytest.raises(ValueError, match="all contact points coincide"):
-        oracles.internal_directions(tip.reshape(3, 3)[:2, :2])
+        oracles.internal_directions(oracles.acting_points(reflex, tip, np.array([1.0, 0.0] * 3), [True] * 3)[:2])
     same = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="^internal forces are undefined: all contact points coincide$"):
         reflex.directions(state, tip, same, fn)
@@ -142,7 +164,7 @@ def test_output_ports_are_fresh_and_update_needs_the_period():
     for port in a:
         assert not np.shares_memory(a[port], b[port]) and not np.shares_memory(a[port], state)
     new = reflex.update(0.0, state, inputs)
-    assert new is not state and new.shape == (4,)
+    assert new is not state and new.shape == (7,)
     unbound = GraspReflex(hand=Hand.default())
     with pytest.raises(ValueError, match="explicit period"):
         unbound.update(0.0, unbound.initial_state(), inputs)
@@ -161,8 +183,8 @@ def test_coincident_points_are_an_error_of_every_entry_point():
     """The C law's status for coincident points becomes the oracle's ValueError in
     output and update too, not only in directions."""
     reflex = make_reflex(["thumb", "fore"])
-    state = np.array([2.0, 1.0, 1.0, 0.0])
-    tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
+    state = np.array([2.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0])
+    tip = coincident_tips(reflex)
     inputs = {"q": reflex.hand.q0, "tip": tip, "normal": np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
               "fn": np.array([2.0, 2.0, 0.0]), "ft": np.zeros(3)}
     message = "^internal forces are undefined: all contact points coincide$"
@@ -178,8 +200,8 @@ def test_the_period_is_checked_before_the_directions():
     """An unbound reflex's update names the missing period even where the directions
     would fail; output needs no period."""
     reflex = GraspReflex(hand=Hand.default())
-    state = np.array([2.0, 1.0, 1.0, 0.0])
-    tip = np.array([0.01, 0.06, 0.0, 0.01, 0.06, 3.0, 0.05, 0.05, 2.6])
+    state = np.array([2.0, 1.0, 1.0, 0.0, 1.0, 1.0, 1.0])
+    tip = coincident_tips(reflex)
     normal, fn, ft = np.array([1.0, 0.0, 1.0, 0.0, 0.0, 0.0]), np.array([2.0, 2.0, 0.0]), np.zeros(3)
     with pytest.raises(ValueError, match=r"^GraspReflex needs an explicit period \(the paper's is 1 ms\)$"):
         reflex_update(reflex._params, state, tip, normal, fn, ft)
@@ -198,7 +220,7 @@ def test_input_widths_are_checked_naming_the_port(port, width):
     inputs[port] = [0.0] * (width - 1)  # converted first, then refused for its width
     with pytest.raises(ValueError, match=f"^GraspReflex: input '{port}' must have {width} entries$"):
         call(0.0, state, inputs)
-    with pytest.raises(ValueError, match=r"state must have 4 entries \[scale, handed\(3\)\]"):
+    with pytest.raises(ValueError, match=r"state must have 7 entries \[scale, handed\(3\), hold\(3\)\]"):
         reflex.update(0.0, np.zeros(3), random_case(np.random.default_rng(9), reflex, 2, inward=True)[1])
 
 
@@ -208,8 +230,12 @@ def test_packed_parameters_land_in_the_slots_control_h_defines():
     from hierhand.control.internal_forces import _COINCIDENT_RTOL
 
     slots = [P_THRESHOLD, P_APPROACH, P_KI, P_DT, P_MIN_FORCE, P_RATIO, P_MAX_FORCE, P_INITIAL, P_INITIAL + 1,
-             P_INITIAL + 2, P_COINCIDENT_RTOL, P_RELEASE_SHARE]
+             P_INITIAL + 2, P_COINCIDENT_RTOL, P_RELEASE_SHARE, P_TIP_RADIUS, P_TIP_RADIUS + 1, P_TIP_RADIUS + 2,
+             P_FOLLOW, P_HOLD_SHARE]
     assert sorted(slots) == list(range(N_PARAMS))
-    p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True], release_share=0.75)
-    assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL and p[P_RELEASE_SHARE] == 0.75
+    p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True], release_share=0.75,
+                    tip_radius=(0.009, 0.008, 0.007), follow_suppression=False, hold_share=0.85)
+    assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL and p[P_RELEASE_SHARE] == 0.75 and p[P_FOLLOW] == 0.0
+    assert p[P_HOLD_SHARE] == 0.85
+    assert p[P_TIP_RADIUS:P_TIP_RADIUS + 3].tolist() == [0.009, 0.008, 0.007]
     assert p[P_INITIAL:P_INITIAL + 3].tolist() == [1.0, 0.0, 1.0] and p[P_KI] == 50.0

@@ -1,5 +1,5 @@
-"""The suppresser's law: stable sigmoid, magnitude and signed modes, limits, shares; the
-compiled law against its numpy oracle."""
+"""The suppresser's law: stable sigmoid, signed and magnitude modes, limits, shares, the
+low-pass filter; the compiled law against its numpy oracle."""
 
 from __future__ import annotations
 
@@ -47,30 +47,34 @@ def test_sigmoid_keeps_shape_and_returns_floats_for_scalars():
 @given(st.floats(-5, 5), st.floats(0, 50), st.floats(-1, 1))
 def test_magnitude_mode_at_zero_manipulation_torque(tau_g, s_a, s_b):
     expected = tau_g / (1.0 + math.exp(-s_a * s_b))
-    assert suppress(tau_g, 0.0, s_a, s_b) == pytest.approx(expected, rel=1e-13, abs=1e-300)
+    assert suppress(tau_g, 0.0, s_a, s_b, "magnitude") == pytest.approx(expected, rel=1e-13, abs=1e-300)
 
 
 @pytest.mark.parametrize("tau_m", [-10.0, 10.0, -1e6, 1e6])
 def test_magnitude_mode_suppresses_large_torques_of_either_sign(tau_m):
-    out = suppress(np.array([0.3, -0.2, 1.0]), np.full(3, tau_m), 50.0, 0.05)
+    out = suppress(np.array([0.3, -0.2, 1.0]), np.full(3, tau_m), 50.0, 0.05, "magnitude")
     np.testing.assert_allclose(out, 0.0, atol=1e-9)
 
 
-def test_signed_mode_passes_large_negative_torques_and_suppresses_positive_ones():
+def test_signed_mode_suppresses_only_manipulation_torque_against_the_grasp():
+    """The paper's literal formula, with tau_m signed positive against the joint's grasping
+    torque: a large torque along the grasp passes it, one against it switches it off."""
     tau_g = np.array([0.3, -0.2, 1.0])
-    np.testing.assert_allclose(suppress(tau_g, np.full(3, -10.0), 50.0, 0.05, mode="signed"), tau_g, rtol=1e-12)
-    np.testing.assert_allclose(suppress(tau_g, np.full(3, 10.0), 50.0, 0.05, mode="signed"), 0.0, atol=1e-9)
+    along, against = 10.0 * np.sign(tau_g), -10.0 * np.sign(tau_g)
+    np.testing.assert_allclose(suppress(tau_g, along, 50.0, 0.05, mode="signed"), tau_g, rtol=1e-12)
+    np.testing.assert_allclose(suppress(tau_g, against, 50.0, 0.05, mode="signed"), 0.0, atol=1e-9)
 
 
 @given(st.floats(-5, 5), st.floats(0, 1e3), st.floats(0, 50), st.floats(-1, 1))
-def test_modes_agree_for_non_negative_manipulation_torque(tau_g, tau_m, s_a, s_b):
-    assert suppress(tau_g, tau_m, s_a, s_b, "signed") == suppress(tau_g, tau_m, s_a, s_b, "magnitude")
+def test_modes_agree_for_manipulation_torque_against_the_grasp(tau_g, size, s_a, s_b):
+    against = -size if tau_g >= 0 else size
+    assert suppress(tau_g, against, s_a, s_b, "signed") == suppress(tau_g, against, s_a, s_b, "magnitude")
 
 
 @given(st.floats(0.01, 5), st.floats(0, 10), st.floats(0, 10), st.floats(0.1, 50), st.floats(-1, 1))
 def test_magnitude_mode_never_grows_with_the_torque_size(tau_g, a, b, s_a, s_b):
     small, large = sorted([a, b])
-    assert suppress(tau_g, -large, s_a, s_b) <= suppress(tau_g, small, s_a, s_b)
+    assert suppress(tau_g, -large, s_a, s_b, "magnitude") <= suppress(tau_g, small, s_a, s_b, "magnitude")
 
 
 @pytest.mark.parametrize("s_a", [0.0, 1e-12])
@@ -87,7 +91,7 @@ def test_per_joint_parameters_broadcast():
     s_a = np.array([10.0, 20.0, 30.0])
     s_b = np.array([0.05, 0.1, 0.0])
     expected = tau_g / (1 + np.exp(-s_a * (s_b - np.abs(tau_m))))
-    np.testing.assert_allclose(suppress(tau_g, tau_m, s_a, s_b), expected, rtol=1e-14)
+    np.testing.assert_allclose(suppress(tau_g, tau_m, s_a, s_b, "magnitude"), expected, rtol=1e-14)
     assert isinstance(suppress(1.0, 0.0, 1.0, 0.0), float)
 
 
@@ -123,12 +127,12 @@ def test_suppress_matches_the_oracle_to_round_off():
 def test_finger_shares_project_the_kept_torque_on_the_grasp_torque():
     tau_g = np.array([1.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 0.0])
     kept = np.array([0.5, 3.0, 0.0, 0.0, -1.0, 0.0, 1.0, 1.0, 1.0])  # the part across tau_g does not count
-    np.testing.assert_array_equal(finger_shares(tau_g, kept, np.zeros(9)), [0.5, -0.5, 1.0])
+    np.testing.assert_array_equal(finger_shares(tau_g, kept), [0.5, -0.5, 1.0])
     rng = np.random.default_rng(43)
     for _ in range(200):
-        tau_g, tau_g_eff, tau_m = rng.normal(size=(3, 9))
-        np.testing.assert_allclose(finger_shares(tau_g, tau_g_eff, tau_m),
-                                   oracles.finger_shares(tau_g, tau_g_eff, tau_m), rtol=1e-14)
+        tau_g, tau_g_eff = rng.normal(size=(2, 9))
+        np.testing.assert_allclose(finger_shares(tau_g, tau_g_eff), oracles.finger_shares(tau_g, tau_g_eff),
+                                   rtol=1e-14)
 
 
 @pytest.mark.parametrize("mode", ["magnitude", "signed"])
@@ -159,3 +163,20 @@ def test_the_block_at_edge_values_and_with_unusual_inputs():
     np.testing.assert_allclose(listed["tau_g_eff"], 0.3 / (1 + math.exp(-20.0)), rtol=1e-14)
     with pytest.raises(ValueError, match="^tau_m must hold 9 values, got 8$"):
         s.output(0.0, None, {"tau_g": np.zeros(9), "tau_m": np.zeros(8)})
+
+
+@pytest.mark.parametrize("mode", ["magnitude", "signed"])
+def test_the_filtered_block_matches_the_oracle(mode):
+    s = Suppresser(S_a=[150.0, 0.0, 50.0] * 3, S_b=[0.02, 0.2, 0.0] * 3, mode=mode, time_constant=0.02)
+    s.bind(0.001)
+    rng = np.random.default_rng(9)
+    state, expected_state = s.initial_state(), np.zeros(9)
+    for k in range(300):
+        inputs = {"tau_g": rng.normal(0.0, 0.1, 9), "tau_m": rng.normal(0.0, 0.05, 9),
+                  "tau_ff": rng.normal(0.0, 0.1, 9)}
+        out, expected = s.output(0.0, state, inputs), oracles.suppresser_output(s, inputs, expected_state)
+        for port in expected:
+            np.testing.assert_allclose(out[port], expected[port], rtol=1e-13, atol=1e-15)
+        state = s.update(0.0, state, inputs)
+        expected_state = oracles.suppresser_update(s, expected_state, inputs, 0.001)
+        np.testing.assert_allclose(state, expected_state, rtol=1e-13, atol=1e-16)

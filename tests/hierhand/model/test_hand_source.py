@@ -69,12 +69,15 @@ def test_every_block_of_a_diagram_models_the_plants_hand_after_overrides():
     np.testing.assert_array_equal(reflex.output(0.0, state, inputs)["tau_g"], own.output(0.0, state, inputs)["tau_g"])
 
     # the PD's load feedforward and the support carry 0.36 kg
-    fn = np.array([2.0, 2.0, 0.0])
-    tau_ff = manip.output(0.0, None, {"q": hand.q0, "qd": np.zeros(9), "fn": fn})["tau_ff"]
-    jac = hand.tip_jacobians(hand.q0)
-    share = -0.36 * hand.gravity / 2
-    expected = hand.bias(hand.q0, np.zeros(9)) + np.concatenate([jac[0].T @ share, jac[1].T @ share, np.zeros(3)])
-    np.testing.assert_allclose(tau_ff, expected, rtol=1e-12, atol=1e-15)
+    normal = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 0.0]])
+    tau_ff = manip.output(0.0, None, {"q": hand.q0, "qd": np.zeros(9), "fn": np.array([2.0, 2.0, 0.0]),
+                                      "normal": normal.ravel(), "obj": hand.object_pose0})["tau_ff"]
+    load = tau_ff - hand.bias(hand.q0, np.zeros(9))
+    points = hand.tip_positions(hand.q0) + hand.tip_radius[:, None] * normal
+    carried = sum(np.linalg.lstsq(hand.point_jacobian(hand.q0, f, points[f]).T, load[3 * f:3 * f + 3],
+                                  rcond=None)[0] for f in (0, 1))
+    np.testing.assert_allclose(carried, -0.36 * hand.gravity, rtol=1e-9, atol=1e-12)
+    np.testing.assert_array_equal(load[6:], 0.0)
     np.testing.assert_array_equal(support.output(0.0, None, {})["y"], [0.0, 0.36 * 9.81, 0.0])
 
 

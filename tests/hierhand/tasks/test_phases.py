@@ -22,11 +22,11 @@ def test_regrasp_phases_from_the_diagram():
     assert phase_at(phases, 0.12) == "support released"
     assert phase_at(phases, 0.2) == "middle finger moving in (0.15-0.35 s)"
     assert phase_at(phases, 0.36) == "middle finger in place"
-    assert phase_at(phases, 0.5) == "forefinger withdrawing (0.38-0.68 s)"
+    assert phase_at(phases, 0.5) == "forefinger withdrawing (0.46-0.76 s)"
     assert phase_at(phases, 0.9) == "forefinger withdrawn"
     # with the contacts of the run: a withdrawal that did not let go says so
     assert (phase_at(phases, 0.9, lambda f: f != "middle")
-            == "forefinger told to withdraw (by 0.68 s) but still in contact")
+            == "forefinger told to withdraw (by 0.76 s) but still in contact")
     assert phase_at(phases, 0.36, lambda f: f != "middle") == "middle finger moved in (by 0.35 s) but not in contact"
 
 

@@ -1,34 +1,49 @@
-"""The re-grasp holds over the corners of the audited parameter ranges, not only at the
-shipped values (the full 300-point experiment is benchmarks/robustness.py)."""
+"""The suppresser decides the re-grasp, over a sample of the spread and not only at the
+shipped point (the 300-point experiment is benchmarks/robustness.py): with it the
+forefinger separates during its withdrawal and stays off while thumb and middle finger
+keep the object; with only the sigmoid switched off, it never separates."""
 
 from __future__ import annotations
 
-import itertools
 from pathlib import Path
 
 import pytest
 
 import blocks
-from hierhand.tasks.summaries import regrasp_events, regrasp_succeeded, regrasp_summary
-from hierhand.tasks.reproduce import withdrawal
+from hierhand.tasks.robustness import regrasp_outcome, unsuppressed_outcome
+from hierhand.tasks.variations import carry, sample
 
 DIAGRAMS = Path(__file__).resolve().parents[3] / "diagrams"
-CORNERS = list(itertools.product((0.24, 0.36), (0.8, 1.2), (0.8, 1.2), (0.9, 1.1)))
-"""Object mass (kg) and factors on the PD's kp, the suppresser's S_b and the friction."""
+REGRASP = DIAGRAMS / "regrasp.yaml"
+POINTS = [v for v in sample(60, 24) if v.sees_slip][:12]
+"""Points of the spread where the reflex can see slip (its safety ratio below mu_d)."""
+SIGMOID_OFF = {"S_b so large that the factor is 1": {"suppress.S_b": 100.0},
+               "enabled: false": {"suppress.enabled": False}}
 
 
-def corner_overrides(mass: float, kp: float, s_b: float, friction: float) -> dict:
-    return {"plant.object.mass": mass, "plant.contact.mu_s": 1.0 * friction, "plant.contact.mu_d": 0.9 * friction,
-            "manip.kp": 1.0 * kp, "suppress.S_b": 0.1 * s_b}
+@pytest.fixture(scope="module")
+def carried():
+    parameters = blocks.load_diagram(REGRASP).parameters()
+    return [carry(parameters, v) for v in POINTS]
 
 
-@pytest.mark.parametrize("mass, kp, s_b, friction", CORNERS)
-def test_regrasp_succeeds_with_the_suppresser_and_not_without(mass, kp, s_b, friction):
-    overrides = corner_overrides(mass, kp, s_b, friction)
-    run = blocks.simulate(blocks.load_diagram(DIAGRAMS / "regrasp.yaml", overrides=overrides))
-    summary = regrasp_summary(run, withdrawal(run.info["parameters"]))
-    assert regrasp_succeeded(summary), summary
-    assert summary["grasp_vs_manipulation_correlation"] < 0  # Fig. 14: the grasp torque falls as tau_m grows
-    without = regrasp_events(blocks.simulate(blocks.load_diagram(DIAGRAMS / "regrasp_unsuppressed.yaml",
-                                                                 overrides=overrides)))
-    assert without["fore_separation_time_s"] is None and not without["object_dropped"]
+@pytest.mark.parametrize("point", range(len(POINTS)))
+def test_with_the_suppresser_the_forefinger_lets_go_and_the_others_keep_the_object(carried, point):
+    run = blocks.simulate(blocks.load_diagram(REGRASP, overrides=carried[point]))
+    assert regrasp_outcome(run) == "", POINTS[point]
+
+
+@pytest.mark.parametrize("off", SIGMOID_OFF)
+@pytest.mark.parametrize("point", range(len(POINTS)))
+def test_with_only_the_sigmoid_switched_off_the_forefinger_never_lets_go(carried, point, off):
+    run = blocks.simulate(blocks.load_diagram(REGRASP, overrides={**carried[point], **SIGMOID_OFF[off]}))
+    assert unsuppressed_outcome(run) == "", POINTS[point]
+
+
+def test_the_unsuppressed_diagram_differs_from_the_suppressed_in_the_suppresser_alone():
+    with_it, without = (blocks.load_diagram(DIAGRAMS / name) for name in ("regrasp.yaml", "regrasp_unsuppressed.yaml"))
+    assert [str(c) for c in with_it.connections] == [str(c) for c in without.connections]
+    assert [e.signal for e in with_it.log] == [e.signal for e in without.log]
+    a, b = with_it.parameters(), without.parameters()
+    assert b.pop("suppress") == {**a.pop("suppress"), "enabled": False}
+    assert a == b

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -23,17 +24,22 @@ def reproduced(tmp_path_factory):
 
 def test_summary_has_exactly_the_documented_keys(reproduced):
     _, s = reproduced
-    assert set(s) == {"grasp", "manipulation", "regrasp", "separation_relation"}
-    assert set(s["grasp"]) == {"disturbance_time_s", "peak_ratio", "recovery_time_s", "steady_ratio_max",
-                               "closing_peak_ratio", "object_displacement_m", "object_dropped"}
-    assert set(s["manipulation"]) == {"max_ratio_after_settle", "target_pose", "final_pose",
+    assert set(s) == {"grasp", "manipulation", "regrasp", "ratio_excursions", "separation_relation", "ablations"}
+    assert set(s["grasp"]) == {"safety_ratio", "disturbance_time_s", "peak_ratio", "recovery_time_s",
+                               "steady_ratio_max", "closing_peak_ratio", "object_displacement_m", "object_dropped",
+                               "grasp_torque_reacts_s", "manipulation_torque_reacts_s",
+                               "grasp_torque_first_moves_s", "manipulation_torque_first_moves_s"}
+    assert set(s["manipulation"]) == {"safety_ratio", "max_ratio_after_settle", "target_pose", "final_pose",
                                       "position_error_m", "angle_error_rad", "object_dropped"}
     for case in ("suppressed", "unsuppressed"):
         assert set(s["regrasp"][case]) == {
             "middle_contact_time_s", "fore_separation_time_s", "fore_stays_off", "object_dropped",
             "withdrawal_start_s", "withdrawal_end_s", "fore_grasp_torque_at_withdrawal_Nm",
-            "fore_grasp_torque_peak_Nm", "fore_grasp_torque_last_Nm", "fore_manipulation_torque_last_Nm",
-            "grasp_vs_manipulation_correlation", "holding_grasp_torque_kept", "succeeded"}
+            "fore_grasp_torque_peak_Nm", "fore_grasp_torque_last_Nm", "fore_grasp_torque_gone",
+            "fore_reflex_torque_last_Nm", "fore_suppression_factor_last", "fore_factor_leaves_s",
+            "fore_manipulation_torque_last_Nm", "grasp_vs_manipulation_correlation", "holding_grasp_torque_kept",
+            "holding_grasp_torque_kept_99", "fore_ratio_peak_before_separation",
+            "fore_above_safety_before_separation_s", "fore_sliding_before_separation_s", "succeeded"}
 
 
 def test_grasp_closes_within_the_safety_ratio_and_recovers_from_the_disturbance(reproduced):
@@ -53,12 +59,18 @@ def test_manipulation_reaches_the_target_pose(reproduced):
     assert not m["object_dropped"]
 
 
+def test_the_grasp_torque_reacts_to_the_push_before_the_manipulation_torque(reproduced):
+    g = reproduced[1]["grasp"]
+    assert g["grasp_torque_first_moves_s"] < g["manipulation_torque_first_moves_s"]  # Fig. 10
+    assert g["grasp_torque_first_moves_s"] <= 0.002 and g["manipulation_torque_first_moves_s"] == pytest.approx(0.01)
+
+
 def test_regrasp_forefinger_separates_only_with_the_suppresser(reproduced):
     r = reproduced[1]["regrasp"]
     s, u = r["suppressed"], r["unsuppressed"]
     assert s["middle_contact_time_s"] < s["withdrawal_start_s"] < s["fore_separation_time_s"] < s["withdrawal_end_s"]
     assert s["fore_stays_off"] and not s["object_dropped"] and s["succeeded"]
-    assert s["holding_grasp_torque_kept"] >= 0.9  # suppression leaves thumb and middle finger alone
+    assert s["holding_grasp_torque_kept_99"] >= 0.9  # suppression leaves thumb and middle finger alone
     assert u["middle_contact_time_s"] is not None
     assert u["fore_separation_time_s"] is None  # held on through t = 1.0 s
     assert not u["object_dropped"] and not u["succeeded"]
@@ -67,7 +79,9 @@ def test_regrasp_forefinger_separates_only_with_the_suppresser(reproduced):
 def test_fig14_grasp_torque_falls_as_the_manipulation_torque_grows_only_with_the_suppresser(reproduced):
     s, u = reproduced[1]["regrasp"]["suppressed"], reproduced[1]["regrasp"]["unsuppressed"]
     assert s["grasp_vs_manipulation_correlation"] < -0.5
-    assert s["fore_grasp_torque_last_Nm"] < s["fore_grasp_torque_at_withdrawal_Nm"]
+    assert s["fore_grasp_torque_gone"] >= 0.5  # at least half of it gone before the finger lets go
+    assert s["fore_suppression_factor_last"] < 0.8  # the sigmoid itself takes part of it ...
+    assert s["fore_separation_time_s"] - s["fore_factor_leaves_s"] > 0.01  # ... leaving 1 well before separation
     assert u["grasp_vs_manipulation_correlation"] > 0.5  # both torques grow against each other
     assert u["fore_grasp_torque_last_Nm"] > 2 * u["fore_grasp_torque_at_withdrawal_Nm"]
 
@@ -91,7 +105,19 @@ def test_figures_and_report_are_written(reproduced):
         assert (out / f"fig{n:02d}.png").stat().st_size > 10_000
     report = (out / "report.md").read_text()
     assert "![Fig. 14](fig14.png)" in report
-    assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 9
+    assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 10
+    assert "| NOT reproduced |" not in report
+    from hierhand.tasks.ablations import ABLATIONS
+
+    for ablation in ABLATIONS:  # one row per addition beyond the paper, each switched off alone
+        escaped = f"| {ablation.name.replace('|', chr(92) + '|')} | {ablation.off} |"
+        assert escaped in report
+    section = report.split("## Each addition switched off alone")[1].split("\n## ")[0]
+    rows = [line for line in section.splitlines() if line.startswith("|")]
+    assert len(rows) == 2 + 1 + len(ABLATIONS)
+    assert {len(re.split(r"(?<!\\)\|", row)) for row in rows} == {8}  # six cells each, '|' escaped
+    assert [row["name"] for row in s["ablations"]] == ["as shipped", *(a.name for a in ABLATIONS)]
+    assert all(row[task] == "" for row in s["ablations"][:1] for task in ("grasp", "manipulate", "regrasp"))
     for task in ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed"):
         assert (out / "runs" / task / "signals.npz").is_file()
 

@@ -1,0 +1,114 @@
+"""Each task judged on one point of the spread: did it do what the paper says, and if not, why.
+
+``judge(variation, diagrams)`` runs the shipped task diagrams carried onto the variation
+(``variations.carry``) and gives each task's outcome: ``""`` when it succeeded, else the
+first thing that went wrong (``"dropped"``, ``"forefinger holds on"``, ...), or
+``"unreachable"`` when a pose of the task is out of the varied hand's reach. The
+re-grasp without the suppresser succeeds when the forefinger never lets go and the object
+stays held. ``benchmarks/robustness.py`` runs the spread; the tests run a sample of it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Mapping
+
+import blocks
+from blocks import Results
+
+from ..control.inverse_kinematics import UnreachableError
+from ..model import load_hand
+from .summaries import (POSITION_TOLERANCE, grasp_summary, grasp_succeeded, handover_time, manipulation_summary,
+                        manipulation_succeeded, regrasp_events, regrasp_succeeded, regrasp_summary, withdrawal)
+from .variations import Variation, carry
+
+UNREACHABLE = "unreachable"
+
+
+def grasp_outcome(results: Results) -> str:
+    summary = grasp_summary(results, float(results.info["parameters"]["push"]["time"]),
+                            handover_time=handover_time(results.info["parameters"]))
+    if summary["object_dropped"]:
+        return "dropped"
+    return "" if grasp_succeeded(summary) else "ratio above the safety ratio at the end"
+
+
+def manipulation_outcome(results: Results) -> str:
+    parameters = results.info["parameters"]
+    summary = manipulation_summary(results, parameters["manip"]["trajectories"],
+                                   load_hand(parameters["plant"]).object_pose0)
+    if summary["object_dropped"]:
+        return "dropped"
+    if summary["position_error_m"] > POSITION_TOLERANCE:
+        return "off its target position"
+    if not manipulation_succeeded(summary):
+        return ("off its target angle" if summary["angle_error_rad"] > math.radians(1.0)
+                else "ratio above the safety ratio")
+    return ""
+
+
+def regrasp_outcome(results: Results) -> str:
+    summary = regrasp_summary(results, withdrawal(results.info["parameters"]))
+    if summary["object_dropped"]:
+        return "dropped"
+    if summary["middle_contact_time_s"] is None:
+        return "middle finger never touches"
+    if summary["fore_separation_time_s"] is None:
+        return "forefinger holds on"
+    if not summary["fore_stays_off"]:
+        return "forefinger comes back"
+    return "" if regrasp_succeeded(summary) else "separates outside the withdrawal"
+
+
+def unsuppressed_outcome(results: Results) -> str:
+    events = regrasp_events(results)
+    if events["object_dropped"]:
+        return "dropped"
+    return "forefinger separates" if events["fore_separation_time_s"] is not None else ""
+
+
+@dataclass(frozen=True)
+class Task:
+    """A shipped task diagram, whether it moves the object, and how it is judged."""
+
+    name: str
+    moves_object: bool
+    outcome: Callable[[Results], str]
+
+
+TASKS = (
+    Task("grasp", False, grasp_outcome),
+    Task("manipulate", True, manipulation_outcome),
+    Task("regrasp", False, regrasp_outcome),
+    Task("regrasp_unsuppressed", False, unsuppressed_outcome),
+)
+
+
+def judge(variation: Variation, diagrams: Path, extra: Mapping[str, Mapping[str, Any]] | None = None,
+          tasks: tuple[Task, ...] = TASKS) -> dict[str, str]:
+    """Each task's outcome on the variation; ``extra``: more ``--set`` values per task name
+    (an ablation), applied after the variation's."""
+    outcomes = {}
+    for task in tasks:
+        path = diagrams / f"{task.name}.yaml"
+        try:
+            overrides = carry(blocks.load_diagram(path).parameters(), variation, task.moves_object)
+        except UnreachableError:
+            outcomes[task.name] = UNREACHABLE
+            continue
+        overrides.update((extra or {}).get(task.name, {}))
+        outcomes[task.name] = _outcome(task, path, overrides)
+    return outcomes
+
+
+def run_shipped(diagrams: Path, extra: Mapping[str, Mapping[str, Any]], tasks: tuple[Task, ...] = TASKS) -> dict[str, str]:
+    """Each task's outcome at the shipped point, with ``extra`` ``--set`` values per task name."""
+    return {task.name: _outcome(task, diagrams / f"{task.name}.yaml", dict(extra.get(task.name, {})))
+            for task in tasks}
+
+
+def _outcome(task: Task, path: Path, overrides: dict[str, Any]) -> str:
+    results = blocks.simulate(blocks.load_diagram(path, overrides=overrides))
+    return task.outcome(results) if results.complete else f"run failed: {results.status}"
