@@ -238,6 +238,14 @@ def test_an_fmu_that_kills_its_process_fails_the_run_naming_the_call(tmp_path, m
     assert simulate(d).status == results.status                  # a new process for the next run
 
 
+def test_a_crash_inside_cvode_names_the_call_cvode_made(tmp_path, misbehaving):
+    """CVode calls the FMU from its right-hand side (fmu_me.c), which traces the call too."""
+    path = misbehaving_fmu(tmp_path / "bad.fmu", "me2", misbehaving["me2"], "fmi2GetDerivatives abort 0.25")
+    results = simulate(diagram(path, "me2", params="solver: cvode"))
+    assert re.match(r"failed at t=0\.[12] s: block 'f' \(FMU\) update: FMU '.*' crashed in fmi2GetDerivatives \(the "
+                    r"step from t=0\.[12] s to 0\.[23] s\): SIGABRT", results.status), results.status
+
+
 def test_a_crash_on_the_python_path_is_the_same_failure(tmp_path, misbehaving, monkeypatch):
     path = misbehaving_fmu(tmp_path / "bad.fmu", "cs2", misbehaving["cs2"], "fmi2DoStep segv 0.2")
     compiled = simulate(diagram(path))
