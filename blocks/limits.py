@@ -27,6 +27,12 @@ an anchored value. An alias repeats its anchor's whole value, so ten levels of t
 make 10^10 values from 1 KB of text (the 'billion laughs'); a diagram that shares a
 matrix or a block's settings repeats a few hundred."""
 
+MAX_NUMBER_CHARS = 100
+"""Longest number a YAML value may write, in characters (digits, sign, point, exponent).
+A float64 holds 17 significant digits and the largest integer a parameter takes (a
+seed below 2^64) has 20; Python refuses to read integers of over 4300 digits at all, and a
+5000-digit integer in a file would otherwise surface as an error deep inside a block."""
+
 MAX_PORT_WIDTH = 1_000_000
 """Widest port a block may declare: a signal is copied at every hit, so a width beyond
 this is a mistake in a block's parameters rather than a signal anyone logs."""

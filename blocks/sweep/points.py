@@ -18,9 +18,8 @@ from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
-import yaml
 
-from blocks.yamlsource import YamlSourceError, read_yaml_file
+from blocks.yamlsource import YamlSourceError, load_yaml_value, read_yaml_file
 
 from .errors import SweepError
 
@@ -45,10 +44,9 @@ def check_key(key: str, option: str) -> str:
 def parse_value(text: str, where: str) -> Any:
     """One value read as YAML (as ``run --set`` does), '1e-3' included as a number."""
     try:
-        value = yaml.safe_load(text) if text.strip() else None
-    except yaml.YAMLError as exc:
-        raise SweepError(f"{where}: {text.strip()!r} is not valid YAML "
-                         f"({str(exc).splitlines()[0]})") from None
+        value = load_yaml_value(text, where) if text.strip() else None
+    except ValueError as exc:
+        raise SweepError(str(exc)) from None
     if value is None:
         raise SweepError(f"{where}: empty value")
     if isinstance(value, str) and _FLOAT.match(value):
@@ -85,7 +83,7 @@ def parse_grid(items: Sequence[str]) -> dict[str, list[Any]]:
         key = check_key(key, f"--grid {item!r}")
         if key in axes:
             raise SweepError(f"--grid {item!r}: {key} is already an axis")
-        axes[key] = [parse_value(v, f"--grid {item!r}") for v in split_top_level(text)]
+        axes[key] = [parse_value(v, f"--grid {key}") for v in split_top_level(text)]
     return axes
 
 
@@ -140,12 +138,16 @@ def random_points(dists: dict[str, tuple[str, float, float]], samples: int, seed
 def csv_points(path: Path) -> list[Point]:
     """Points from a CSV file whose header names ``block.param`` columns; cells read as YAML."""
     try:
-        rows = list(csv.reader(io.StringIO(read_yaml_file(path, "CSV"), newline="")))
+        reader = csv.reader(io.StringIO(read_yaml_file(path, "CSV"), newline=""))
+        rows = list(reader)
     except FileNotFoundError:
         raise SweepError(f"--points {path}: no such file") from None
     except YamlSourceError as exc:
         where = f"{path}:{exc.line}" if exc.line else str(path)
         raise SweepError(f"--points {where}: {exc.message}" + (f" (hint: {exc.hint})" if exc.hint else "")) from None
+    except csv.Error as exc:
+        raise SweepError(f"--points {path}:{reader.line_num}: not CSV: {exc} (hint: a cell holds one "
+                         "value; quote cells that contain commas)") from None
     if not rows or not any(cell.strip() for cell in rows[0]):
         raise SweepError(f"--points {path}: empty file; the first line names the BLOCK.PARAM columns")
     keys = [check_key(k, f"--points {path}: column") for k in rows[0]]
