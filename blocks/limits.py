@@ -33,6 +33,12 @@ A float64 holds 17 significant digits and the largest integer a parameter takes 
 seed below 2^64) has 20; Python refuses to read integers of over 4300 digits at all, and a
 5000-digit integer in a file would otherwise surface as an error deep inside a block."""
 
+MAX_SWEEP_POINTS = 1_000_000
+"""Most points one sweep may have, counted before any is made: a grid's axes multiply
+(three axes of 1000 values are 10^9 points, gigabytes before the first run), and each
+point is held with its hash while the sweep runs. A million re-grasp points take about
+2.5 hours of one core; a bigger study is several sweeps (a points file each)."""
+
 MAX_PORT_WIDTH = 1_000_000
 """Widest port a block may declare: a signal is copied at every hit, so a width beyond
 this is a mistake in a block's parameters rather than a signal anyone logs."""

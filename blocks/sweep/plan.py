@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..safepath import link_out_of
 from .bundle import bundle_for, discard
 from .errors import SweepError
 from .metrics import Metric, parse_metrics
@@ -166,6 +167,9 @@ def keep_run(output: str | Path, h: str, outcome: Outcome) -> None:
     go of them; nothing for an outcome without results."""
     if outcome.results is not None:
         outcome.results.info.setdefault("sweep", {})["point_hash"] = h
+        if link_out_of(Path(output) / RUNS, h) is not None:
+            raise SweepError(f"{Path(output) / RUNS / h} is a symbolic link out of the sweep folder: the sweep "
+                             "writes only inside it (hint: remove the link)")
         outcome.results.save(Path(output) / RUNS / h)
         outcome.results = None
 

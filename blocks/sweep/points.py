@@ -13,12 +13,14 @@ import hashlib
 import io
 import itertools
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
 
+from blocks.limits import MAX_SWEEP_POINTS
 from blocks.yamlsource import YamlSourceError, load_yaml_value, read_yaml_file
 
 from .errors import SweepError
@@ -87,8 +89,17 @@ def parse_grid(items: Sequence[str]) -> dict[str, list[Any]]:
     return axes
 
 
+def check_count(count: int, what: str) -> None:
+    """Refuse a sweep of more than MAX_SWEEP_POINTS points before any is made."""
+    if count > MAX_SWEEP_POINTS:
+        raise SweepError(f"{what} make {count:.4g} points, more than a sweep may have ({MAX_SWEEP_POINTS}) "
+                         "(hint: fewer values per axis, or split the study into several sweeps)")
+
+
 def grid_points(axes: dict[str, list[Any]]) -> list[Point]:
-    """The cartesian product of the axes, the last axis varying fastest."""
+    """The cartesian product of the axes, the last axis varying fastest (at most
+    MAX_SWEEP_POINTS points)."""
+    check_count(math.prod(len(v) for v in axes.values()), f"the --grid axes ({' x '.join(str(len(v)) for v in axes.values())})")
     keys = list(axes)
     return [dict(zip(keys, values)) for values in itertools.product(*(axes[k] for k in keys))]
 
@@ -109,6 +120,9 @@ def parse_random(items: Sequence[str]) -> dict[str, tuple[str, float, float]]:
             a, b = float(m.group(2)), float(m.group(3))
         except ValueError:
             raise SweepError(f"{where}: the distribution's arguments must be numbers") from None
+        if not (math.isfinite(a) and math.isfinite(b)) or (m.group(1) == "uniform" and not math.isfinite(b - a)):
+            raise SweepError(f"{where}: the distribution's arguments must be finite numbers whose difference "
+                             "is finite too")
         if m.group(1) == "uniform" and not a < b:
             raise SweepError(f"{where}: uniform(a,b) needs a < b")
         if m.group(1) == "normal" and not b > 0:
@@ -127,6 +141,9 @@ def random_points(dists: dict[str, tuple[str, float, float]], samples: int, seed
     """
     if samples < 1:
         raise SweepError(f"--samples must be at least 1, got {samples}")
+    check_count(samples, f"--samples {samples}")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise SweepError(f"--seed must be a whole number of 0 or more, got {seed!r}")
     rng = np.random.default_rng(seed)
     columns = {}
     for key, (kind, a, b) in dists.items():
@@ -159,6 +176,7 @@ def csv_points(path: Path) -> list[Point]:
             continue
         if len(row) != len(keys):
             raise SweepError(f"--points {path}:{n}: {len(row)} values for {len(keys)} columns")
+        check_count(len(points) + 1, f"--points {path}: the rows")
         points.append({k: parse_value(v, f"--points {path}:{n}: column {k}") for k, v in zip(keys, row)})
     if not points:
         raise SweepError(f"--points {path}: no rows after the header")
@@ -182,6 +200,7 @@ def combine(grid: list[Point], sampled: list[Point]) -> list[Point]:
         return sampled
     if not sampled:
         return grid
+    check_count(len(grid) * len(sampled), f"{len(grid)} grid points crossed with {len(sampled)} samples")
     return [{**g, **s} for g in grid for s in sampled]
 
 
