@@ -18,6 +18,7 @@ from typing import Iterator
 
 import numpy as np
 
+from .api_args import boolean
 from .limits import MAX_RESULTS_BYTES
 from .npzfile import read_npz
 from .results_folder import RUN_JSON, SIGNALS_CSV, SIGNALS_NPZ, reading, writing
@@ -137,7 +138,9 @@ class Results:
 
     def save(self, directory: str | Path, csv: bool = False) -> Path:
         """Write signals.npz and run.json (and signals.csv) into ``directory``, replacing
-        the result files of the run saved there before as one set."""
+        the result files of the run saved there before as one set (a complete run's kept
+        in ``previous-complete-run`` when this one is not complete: ``results_folder``)."""
+        boolean("csv", csv)
         with writing(directory) as staged:
             self.write_files(staged, csv)
         return Path(directory)

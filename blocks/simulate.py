@@ -22,6 +22,7 @@ from typing import Any, Callable
 
 from .binding import Binding
 from . import compiled
+from .api_args import boolean
 from .diagram import Diagram
 from .host import run_native
 from .issues import DiagramError
@@ -68,6 +69,7 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     the run's tick times are exact in double) or 'reference' (the plain Python loop);
     both give the same samples.
     """
+    boolean("raise_on_failure", raise_on_failure)
     t_end = _end_time(diagram, t_end)
     refused = diagram.open_issue()
     if refused is not None:

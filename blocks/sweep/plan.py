@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..api_args import boolean
 from ..safepath import link_out_of
 from .bundle import bundle_for, discard
 from .errors import SweepError
@@ -234,6 +235,8 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
     Raises ``DiagramError`` or ``SweepError`` before anything runs when the sweep cannot
     work, and ``SweepInterrupted`` on Ctrl-C, with only whole rows in the file.
     """
+    for name, flag in (("serial", serial), ("trust", trust), ("progress", progress), ("keep_results", keep_results)):
+        boolean(name, flag)
     plan = prepare(diagram, points, parse_metrics(metrics), t_end=None if t_end is None else str(t_end),
                    trust=trust, axes=axes, origins=origins, keep_results=keep_results)
     t0 = time.perf_counter()
