@@ -281,6 +281,10 @@ class Diagram:
         block, port = signal.rsplit(".", 1)
         return self.blocks[block].block.outputs[port]
 
+    def element_labels(self, block: str, port: str) -> list[str] | None:
+        """The names of the elements of port ``block.port`` (None: numbered from 0)."""
+        return self.blocks[block].block.element_labels(port)
+
     def split_key(self, key: str) -> tuple[str, str] | None:
         """``ctrl.prop.k.0`` -> (``ctrl.prop``, ``k.0``): the block a ``block.param`` key
         names and the path into its parameters; None when no block of it is named."""
