@@ -126,7 +126,8 @@ class _Writer:
         return entry
 
     def wire(self, level: Composite, c) -> str | dict:
-        text = (level.name_of(f"{c.src_block}.{c.src_port}"), level.name_of(f"{c.dst_block}.{c.dst_port}"))
+        text = (level.name_of(c.src) + ("" if c.src_select is None else f"[{c.src_select}]"),
+                level.name_of(c.dst) + ("" if c.dst_select is None else f"[{c.dst_select}]"))
         if not c.delay:
             return f"{text[0]} -> {text[1]}"
         out: dict[str, Any] = {"from": text[0], "to": text[1], "delay": c.delay}

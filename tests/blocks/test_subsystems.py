@@ -231,7 +231,8 @@ def test_widths_are_checked_across_the_boundary(toy):
                                "ref:   {type: Constant, params: {value: [1.0, 2.0]}}"))
     issues = problems(toy)
     assert f"{toy}:12: connection 'err.y -> ctrl.e': width mismatch: err.y has width 2, ctrl.e (ctrl.integ.u) has " \
-           "width 1 (hint: insert a Gain with a matrix k to map between widths, or fix the block parameters)" in issues
+           "width 1 (hint: insert a Gain with a matrix k to map between widths, select elements (c.y[0:2] -> g.u), " \
+           "or fix the block parameters)" in issues
 
 
 def test_a_loop_through_a_subsystem_names_the_inner_port_chain(toy):
