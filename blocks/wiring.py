@@ -308,8 +308,10 @@ class Wiring:
                                    "connect it to a block with fixed widths or give it a width parameter")
                     continue
                 spec.block.set_width(inferred[name])
-        self.resolve_elements()
+        unresolved = self.resolve_elements()
         for c in self.connections:
+            if id(c) in unresolved:
+                continue
             ws, wd = carried(c, blocks), received(c, blocks)
             wire = self.written[id(c)]
             dst = c.dst_text if wire.dst == c.dst else f"{wire.dst_text} ({c.dst})"
@@ -325,10 +327,10 @@ class Wiring:
                                f"connection '{wire.src_text} -> {wire.dst_text}': 'initial' has "
                                f"{len(c.initial)} values, the signal has width {ws}")
 
-    def resolve_elements(self) -> None:
+    def resolve_elements(self) -> set[int]:
         """The elements each connection's selections name, now that the widths are known;
-        a selection that names none is reported at its connection."""
-        resolved = []
+        a selection that names none is reported at its connection (the ids of those returned)."""
+        resolved, unresolved = [], set()
         for c in self.connections:
             wire = self.written.pop(id(c))
             if c.by_element and all(w is not None for w in (self.specs[c.src_block].block.outputs[c.src_port],
@@ -339,9 +341,11 @@ class Wiring:
                     self.ctx.error(c.file or self.top.file, c.line, f"connection '{wire.src_text} -> "
                                    f"{wire.dst_text}': {exc}", "elements by label, by index from 0, or a slice "
                                    "start:stop, e.g. plant.q[fore.1], c.y[0:3]")
+                    unresolved.add(id(c))
             resolved.append(c)
             self.written[id(c)] = wire
         self.connections[:] = resolved
+        return unresolved
 
     def labels(self, block: str, port: str):
         """The element names of ``block.port`` (an output or input), or None."""
