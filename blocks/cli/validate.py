@@ -37,6 +37,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     print("blocks:")
     print_block_tree(diagram, s)
     print_ports(diagram)
+    print_element_wiring(diagram)
     print_references_and_notes(diagram)
     print("execution order:")
     print(f"  t = 0: {s.initial.describe()}")
@@ -122,6 +123,26 @@ def print_ports(diagram) -> None:
         print("references the including diagram binds:")
         for ref in refs.values():
             print(f"  {ref.name}" + (f" (stand-in here: {ref.type_name})" if ref.type_name else ""))
+
+
+def print_element_wiring(diagram) -> None:
+    """The connections that name elements, each with the 0-based elements it stands for
+    (``m.y[pos.1] -> g.u  (m.y[2] -> g.u)``)."""
+    wires = [c for c in diagram.connections if c.by_element]
+    if not wires:
+        return
+    print("wiring by element:")
+    for c in wires:
+        src = c.src if c.src_elements is None else f"{c.src}[{index_text(c.src_elements)}]"
+        dst = c.dst if c.dst_elements is None else f"{c.dst}[{index_text(c.dst_elements)}]"
+        print(f"  {c}" + ("" if (src, dst) == (c.src_text, c.dst_text) else f"  ({src} -> {dst})"))
+
+
+def index_text(indices) -> str:
+    """0-based indices as a selection writes them: ``2``, ``0:3``, ``3,0,1``."""
+    if len(indices) > 1 and list(indices) == list(range(indices[0], indices[0] + len(indices))):
+        return f"{indices[0]}:{indices[0] + len(indices)}"
+    return ",".join(str(j) for j in indices)
 
 
 def print_references_and_notes(diagram) -> None:

@@ -306,3 +306,24 @@ def test_wiring_by_element_gives_the_samples_of_selector_and_mux_blocks(docs):
         for name in first:
             assert np.array_equal(first[name][0], other[name][0]), name
             assert np.array_equal(first[name][1], other[name][1]), name
+
+
+def test_validate_and_graph_show_the_elements(tmp_path, capsys):
+    from blocks.cli import PROGRAM
+    from blocks.cli.program import main
+    from blocks.graph.dot import to_dot
+
+    path = tmp_path / "el.yaml"
+    path.write_text(HEAD + "  - m.y[pos.1] -> g.u\n  - m.y[0] -> h.u[2]\n  - c.y[3,1] -> h.u[0:2]\nlog: [h.y]\n")
+    assert main(PROGRAM, ["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "wiring by element:\n  c.y[3] -> m.u0\n  c.y[0:2] -> m.u1\n  m.y[pos.1] -> g.u  (m.y[2] -> g.u)\n" \
+           "  m.y[0] -> h.u[2]\n  c.y[3,1] -> h.u[0:2]\n" in out
+    d = blocks.load_diagram(path)
+    dot = to_dot(d, blocks.build_schedule(d, d.t_end))
+    assert '"c":out_y:e -> "h":in_u:w [color="#c2189b", taillabel="[3,1]", headlabel="[0:2]"];' in dot
+    from blocks.graph.drawing import draw
+
+    figure = draw(d, blocks.build_schedule(d, d.t_end))
+    shown = sorted(t.get_text() for t in figure.axes[0].texts if (t.get_gid() or "").startswith("elements:"))
+    assert shown == sorted(["[3]", "[0:2]", "[pos.1]", "[0]", "[2]", "[3,1]", "[0:2]"])
