@@ -89,6 +89,18 @@ def timed(fn, repeat: int) -> tuple[float, object]:
     return statistics.median(times), result
 
 
+def timed_pair(first, second, repeat: int) -> tuple[float, float]:
+    """Median seconds of ``first`` and of ``second``, run by turns (so that a change in the
+    machine's load falls on both alike)."""
+    times: tuple[list[float], list[float]] = ([], [])
+    for _ in range(repeat):
+        for fn, into in ((first, times[0]), (second, times[1])):
+            t0 = time.perf_counter()
+            fn()
+            into.append(time.perf_counter() - t0)
+    return statistics.median(times[0]), statistics.median(times[1])
+
+
 def chain_text(n: int) -> str:
     """A diagram of a Constant and ``n`` Gain blocks in a line, over 2 base ticks of 1 ms."""
     lines = ["time: {t_end: 2 ms}", "blocks:", "  src: {type: Constant, period: 1 ms, params: {value: 1.0}}"]
@@ -167,8 +179,7 @@ def main() -> None:
 
     t_hand, ref = timed(lambda: hand_loop(n_ticks), args.repeat)
     t_full, res = timed(framework, args.repeat)
-    t_exec, _ = timed(executor_only, args.repeat)
-    t_unchecked, _ = timed(executor_unchecked, args.repeat)
+    t_exec, t_unchecked = timed_pair(executor_only, executor_unchecked, args.repeat)
     t_python, res_python = timed(with_python_block, args.repeat)
     t_python_exec, _ = timed(python_block_executor_only, args.repeat)
     err = float(np.max(np.abs(res["plant.y"][1][:, 0] - ref)))

@@ -268,9 +268,24 @@ static int step(interp *x, int64_t index, const int64_t *op, int64_t ke, int *wh
     return k->update(k->ctx, t, k->state, inputs, which);
 }
 
-/* The index of the first of n values that is not finite, or -1. */
+/* The index of the first of n values that is not finite, or -1. The values are looked over
+   first as bits, without a branch, which compilers vectorise (GCC when asked, at -O2): the
+   hand plant's advance rows alone are some 500 000 values per simulated second. A NaN or an
+   infinity has every exponent bit set, so adding one to its exponent carries into the sign. */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("tree-vectorize")))
+#endif
 static int64_t first_nonfinite(const double *v, int64_t n)
 {
+    const uint64_t exponent = 0x7ff0000000000000u, one = 0x0010000000000000u;
+    uint64_t carried = 0;
+    for (int64_t i = 0; i < n; i++) {
+        uint64_t bits;
+        memcpy(&bits, v + i, sizeof bits);
+        carried |= (bits & exponent) + one;
+    }
+    if (!(carried >> 63))
+        return -1;
     for (int64_t i = 0; i < n; i++)
         if (!isfinite(v[i]))
             return i;
@@ -347,13 +362,12 @@ static int advance(interp *x, int64_t index, const int64_t *op, int64_t ke, int6
         else
             code = k->advance(k->ctx, t, k->state, x->pointers + b[BLK_B_FIRST_INPUT], m, rows, &done, &which);
         int logged = code ? (done < 0 ? 0 : done > m ? m : done) : m;
-        int64_t bad = -1;
-        for (int i = 0; !r->allow_nonfinite && i < logged; i++)
-            if ((bad = first_nonfinite(rows + i * width, width)) >= 0) {
-                memcpy(out, rows + i * width, (size_t)width * sizeof(double));
-                logged = i;
-                break;
-            }
+        int64_t bad = r->allow_nonfinite || width == 0 ? -1 : first_nonfinite(rows, logged * width);
+        if (bad >= 0) { /* the row that has it becomes the outputs, those before it are logged */
+            logged = (int)(bad / width);
+            bad -= logged * width;
+            memcpy(out, rows + logged * width, (size_t)width * sizeof(double));
+        }
         for (int i = 0; i < logged; i++)
             for (int64_t e = op[BLK_OP_B]; e < op[BLK_OP_C]; e++)
                 log_row(r, e, rows + i * width);
