@@ -72,6 +72,19 @@ class BlockSpec:
     """The type as the diagram names it (``Gain``, ``python:mod:Cls``); None: ``type_name``."""
     scope: FileScope = field(default_factory=FileScope)
     """Where the relative paths of its file lead."""
+    units: dict[str, str | list[str]] = field(default_factory=dict)
+    """The units the diagram gives its ports (``blocks.annotations``), by port."""
+    labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """The element names the diagram gives its ports, by port."""
+
+    def port_units(self, port: str) -> str | list[str] | None:
+        """The unit(s) of ``port``: the diagram's, else the block's own (None: unknown)."""
+        return self.units.get(port) or self.block.port_units(port)
+
+    def element_labels(self, port: str) -> list[str] | None:
+        """The element names of ``port``: the diagram's, else the block's (None: numbered)."""
+        given = self.labels.get(port)
+        return list(given) if given is not None else self.block.element_labels(port)
 
 
 @dataclass(frozen=True)
@@ -306,8 +319,13 @@ class Diagram:
         return self.blocks[block].block.outputs[port]
 
     def element_labels(self, block: str, port: str) -> list[str] | None:
-        """The names of the elements of port ``block.port`` (None: numbered from 0)."""
-        return self.blocks[block].block.element_labels(port)
+        """The names of the elements of port ``block.port``, the diagram's or its block's
+        (None: numbered from 0)."""
+        return self.blocks[block].element_labels(port)
+
+    def port_units(self, block: str, port: str) -> str | list[str] | None:
+        """The unit(s) of port ``block.port``, the diagram's or its block's (None: unknown)."""
+        return self.blocks[block].port_units(port)
 
     def split_key(self, key: str) -> tuple[str, str] | None:
         """``ctrl.prop.k.0`` -> (``ctrl.prop``, ``k.0``): the block a ``block.param`` key

@@ -21,6 +21,7 @@ from .block import checked_units
 from .build_context import BuildContext, known, suggest
 from .records import PortEntry, Site, WireEntry
 from .diagram import BlockSpec, Composite, Connection, DeclaredReference, DiagramPort, LogEntry
+from .annotations import annotate, check_connected_units
 from .element_wiring import carried, check_assembled, received, resolve
 from .elements import ElementError
 from .scopes import NAME, Level
@@ -308,6 +309,7 @@ class Wiring:
                                    "connect it to a block with fixed widths or give it a width parameter")
                     continue
                 spec.block.set_width(inferred[name])
+        annotate(self.top.levels(), blocks, self.failed, self.report)
         unresolved = self.resolve_elements()
         for c in self.connections:
             if id(c) in unresolved:
@@ -349,14 +351,17 @@ class Wiring:
 
     def labels(self, block: str, port: str):
         """The element names of ``block.port`` (an output or input), or None."""
-        return self.specs[block].block.element_labels(port)
+        return self.specs[block].element_labels(port)
+
+    def report(self, file: str | None, line: int | None, message: str, hint: str = "") -> None:
+        self.ctx.error(file or self.top.file, line, message, hint)
 
     def check_inputs(self) -> None:
         """Every input is driven, has a default, or is one of the top diagram's own inputs;
         a subsystem's input that nothing drives is reported at its entry; the elements of
         an input that connections assemble are each driven once."""
-        check_assembled(self.connections, self.written, self.specs,
-                        lambda file, line, message, hint: self.ctx.error(file or self.top.file, line, message, hint))
+        check_assembled(self.connections, self.written, self.specs, self.report)
+        check_connected_units(self.connections, self.written, self.specs, self.report)
         driven = {(c.dst_block, c.dst_port) for c in self.connections}
         fed_by_port = set()
         for level in self.top.levels():
@@ -481,14 +486,14 @@ class Wiring:
                 f"{b}.{p} [{getattr(self.specs[b].block, kind)[p]}]" for b, p in signals),
                 "the inputs one diagram input feeds take the same signal"))
         units = labels = None
-        for blk, p in blocks:
+        for (b, p), (blk, _) in zip(signals, blocks):
             if units is None:
                 try:
-                    units = checked_units(blk.port_units(p), getattr(blk, kind)[p], p)
+                    units = checked_units(self.specs[b].port_units(p), getattr(blk, kind)[p], p)
                 except ValueError:
                     units = None
             if labels is None:
-                found = blk.element_labels(p)
+                found = self.specs[b].element_labels(p)
                 labels = tuple(str(x) for x in found) if found is not None else None
         return DiagramPort(name, tuple(f"{b}.{p}" for b, p in signals), min(widths), units, labels, site.line,
                            self.file_of(site))

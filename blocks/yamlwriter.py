@@ -107,6 +107,10 @@ class _Writer:
             params[key] = plain(value, f"block '{name}' parameter '{key}'")
         if params:
             entry["params"] = params
+        if spec.units:
+            entry["units"] = {port: plain(units, f"block '{name}' units") for port, units in spec.units.items()}
+        if spec.labels:
+            entry["elements"] = {port: list(names) for port, names in spec.labels.items()}
         return entry
 
     def subsystem_entry(self, sub: Composite) -> dict:

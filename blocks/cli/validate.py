@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from blocks.block import checked_units
+
 from .options import diagram_args, end_time, load
 from .program import EXIT_OK
 
@@ -77,8 +79,8 @@ def print_block_tree(diagram, s) -> None:
                 print(f"{indent(path)}{path}: subsystem {sub.origin} (diagram {sub.diagram_name!r})"
                       + "".join(f"; {part}" for part in subsystem_parts(sub)))
         blk = spec.block
-        ins = ", ".join(f"{p}[{w}]" for p, w in blk.inputs.items()) or "-"
-        outs = ", ".join(f"{p}[{w}]" for p, w in blk.outputs.items()) or "-"
+        ins = ", ".join(port_of(spec, p, w) for p, w in blk.inputs.items()) or "-"
+        outs = ", ".join(port_of(spec, p, w) for p, w in blk.outputs.items()) or "-"
         notes = []
         if name in s.advanced:
             notes.append("advanced between events")
@@ -91,6 +93,22 @@ def print_block_tree(diagram, s) -> None:
         label = indent(name) + name
         print(f"{label:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
               + (f"  ({', '.join(notes)})" if notes else ""))
+
+
+def port_of(spec, port: str, width: int) -> str:
+    """A block's port as ``validate`` lists it: ``y[3]``, with the unit(s) where the block or
+    the diagram gives them (``q[9] (rad)``, ``pose[3] (m, m, rad)``) and the names the diagram
+    gives its elements (``y[3] {x, y, theta}``)."""
+    try:
+        units = checked_units(spec.port_units(port), width, port)
+    except ValueError:
+        units = None
+    text = f"{port}[{width}]"
+    if units:
+        text += f" ({units})" if isinstance(units, str) else f" ({', '.join(u or '?' for u in units)})"
+    if port in spec.labels:
+        text += " {" + ", ".join(spec.labels[port]) + "}"
+    return text
 
 
 def subsystem_parts(sub) -> list[str]:
