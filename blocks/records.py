@@ -199,7 +199,8 @@ class DiagramRecord:
             "outputs": [jsonable([p.name, list(p.signals)]) for p in self.outputs],
             "references": [jsonable([r.name, block(r.stand_in)]) for r in self.references],
             "log": [jsonable([r.signal, r.decimate, r.every]) for r in self.logs],
-            "annotations": [jsonable([a.signal, a.units, a.elements]) for a in self.annotations],
         }
+        if self.annotations:
+            record["annotations"] = [jsonable([a.signal, a.units, a.elements]) for a in self.annotations]
         return json.dumps(record, sort_keys=True, default=str)
 

@@ -35,8 +35,9 @@
  *                            row logged; last: the event's last advance (how far an
  *                            interrupted run got is how far this one got)
  *                BLK_COPY    [copy, 0, 0, 0]: a row of the copies table
- *   copies     [destination, source, width]: a delayed connection sampling its source, or
- *              an input that holds its default until its source first fires
+ *   copies     [destination, source, width]: a delayed connection sampling its source, an
+ *              input that holds its default until its source first fires, or a run of
+ *              elements of an input that connections by element assemble
  *   programs   [first op, end op, final]: what runs at an event; final: the program that
  *              ends a run at such an event when a block asked for the end (-1: none)
  *   events     [tick, program]: the events of one hyperperiod, by tick (0 <= tick <
