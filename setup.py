@@ -74,9 +74,10 @@ setup(
         Extension(
             "blocks._native",
             sources=[f"{BLOCKS_CSRC}/{name}.c"
-                     for name in ("host", "core", "library", "lib_math", "lib_dynamic", "lib_sources", "fmu", "fmu_me")],
+                     for name in ("host", "core", "library", "lib_math", "lib_dynamic", "lib_sources", "fmu", "fmu_me",
+                                  "fmu_host")],
             depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "lib_common", "fmu",
-                                                             "fmu_me")],
+                                                             "fmu_me", "fmu_calls", "fmu_host")],
             extra_compile_args=CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),
