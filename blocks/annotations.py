@@ -19,6 +19,7 @@ from typing import Any, Callable, Sequence
 from .block import checked_units
 from .build_context import known, suggest
 from .diagram import BlockSpec, Connection
+from .elements import parse_endpoint
 from .units import differs
 
 Report = Callable[[str | None, int | None, str, str], None]
@@ -27,8 +28,6 @@ Report = Callable[[str | None, int | None, str, str], None]
 
 def annotate(levels, specs: dict[str, BlockSpec], failed: set[str], report: Report) -> None:
     """Check every level's annotations and keep what they give on the blocks' specs."""
-    from .wiring import parse_endpoint
-
     for level in levels:
         given: set[tuple[str, str, str]] = set()
         for a in level.builder.annotations:

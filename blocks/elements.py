@@ -1,4 +1,5 @@
-"""Elements of a vector signal, by label, index or slice: the one grammar of connections and plots.
+"""The ends of a wire (``block.port``) and the elements of a vector signal, by label, index
+or slice: the one grammar of connections and plots.
 
 A signal is ``block.port``; some of its elements are written after it in brackets::
 
@@ -15,10 +16,30 @@ A label is matched before an index, so a block whose elements are labelled ``1``
 from __future__ import annotations
 
 import re
-from typing import Sequence
+from typing import Any, Sequence
 
 SIGNAL = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)+)\s*(?:\[(.*)\])?\s*$")
 _SLICE = re.compile(r"^\s*(-?\d+)?\s*:\s*(-?\d+)?\s*(?::\s*(-?\d+)\s*)?$")
+_ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
+_WIRE_END = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
+
+Endpoint = tuple[str, str]
+"""(block path name, port)."""
+
+
+def parse_endpoint(text: Any) -> Endpoint | None:
+    """``("plant", "y")`` from ``"plant.y"``; None if ``text`` is not of that form."""
+    m = _ENDPOINT.match(text) if isinstance(text, str) else None
+    return (m.group(1), m.group(2)) if m else None
+
+
+def parse_wire_end(text: Any) -> tuple[str, str, str | None] | None:
+    """``("plant", "q", "fore.1")`` from ``"plant.q[fore.1]"`` (None for the whole port:
+    ``"plant.q"``); None if ``text`` is neither (an empty selection ``[]`` included)."""
+    m = _WIRE_END.match(text) if isinstance(text, str) else None
+    if m is None or (m.group(3) is not None and not m.group(3).strip()):
+        return None
+    return m.group(1), m.group(2), None if m.group(3) is None else m.group(3).strip()
 
 
 class ElementError(ValueError):

@@ -23,32 +23,11 @@ from .records import PortEntry, Site, WireEntry
 from .diagram import BlockSpec, Composite, Connection, DeclaredReference, DiagramPort, LogEntry
 from .annotations import annotate, check_connected_units
 from .element_wiring import carried, check_assembled, received, resolve
-from .elements import ElementError
+from .elements import ElementError, Endpoint, parse_endpoint, parse_wire_end
 from .scopes import NAME, Level
 from .widths import propagate_widths
 
-_ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
-_WIRE_END = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
 _PATH = re.compile(r"^\s*[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)+\s*$")
-
-Endpoint = tuple[str, str]
-"""(block path name, port)."""
-
-
-def parse_endpoint(text: Any) -> Endpoint | None:
-    """``("plant", "y")`` from ``"plant.y"``; None if ``text`` is not of that form."""
-    m = _ENDPOINT.match(text) if isinstance(text, str) else None
-    return (m.group(1), m.group(2)) if m else None
-
-
-def parse_wire_end(text: Any) -> tuple[str, str, str | None] | None:
-    """``("plant", "q", "fore.1")`` from ``"plant.q[fore.1]"`` (None for the whole port:
-    ``"plant.q"``); None if ``text`` is neither (an empty selection ``[]`` included)."""
-    m = _WIRE_END.match(text) if isinstance(text, str) else None
-    if m is None or (m.group(3) is not None and not m.group(3).strip()):
-        return None
-    return m.group(1), m.group(2), None if m.group(3) is None else m.group(3).strip()
-
 
 @dataclass
 class Ports:
