@@ -251,7 +251,9 @@ class Block:
         a list of one string per element where they differ (``["m", "m", "rad"]`` for a
         pose; ``""`` for an element of unknown unit); None, the default, when the block
         does not know. Plots put it beside the signal's name and run.json keeps it
-        (``units``); it is information for people, not checked against connections."""
+        (``units``), and a connection whose other end declares another unit is a load
+        error (``blocks.annotations``). A diagram may give the ports a block leaves None
+        units of their own (``units: {b.y: rad}``)."""
         return None
 
     def describe(self) -> str:
