@@ -7,6 +7,8 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 """
 
 import importlib
+import sys
+import types
 from typing import Any
 
 _EXPORTS = {
@@ -30,6 +32,20 @@ signal handlers from before anything else) does not import numpy and the rest.""
 _HOME = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = sorted(_HOME)
+
+
+class _Package(types.ModuleType):
+    """The package, whose function ``simulate`` shares its name with its module: importing
+    the module ``blocks.simulate`` sets the package's attribute to the module, which would
+    hide the function; the function stays."""
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, types.ModuleType) and name in _HOME and hasattr(value, name):
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str) -> Any:
