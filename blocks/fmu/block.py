@@ -172,6 +172,15 @@ class FMU(Block):
         self.integration: Integration | None = None
         """How a model-exchange FMU is integrated between the hits, once the block has its period."""
 
+    @classmethod
+    def override_path(cls, parts: list[str]) -> list[str]:
+        """``--set plant.k=2`` sets the FMU variable ``k`` (``start_values.k``) when ``k`` is
+        not a parameter of the block; the rest of the path is the variable's name, dots
+        and all (``--set plant.body.m=2``: the variable ``body.m``)."""
+        if parts[0] in cls.parameters():
+            return parts
+        return ["start_values", ".".join(parts)]
+
     @property
     def fmi_version(self) -> str:
         return self._model.md.fmiVersion
