@@ -408,7 +408,7 @@ class _Reader:
             self.fail(line, f"ssd:Connection {which}Connector {shown(connector)}: element '{element}' declares no "
                       "connector of that name", suggest(connector, names) or f"its connectors: {known(names)}")
             return None
-        wanted = "output" if start == (found.kind == "component") else "input"
+        wanted = "output" if start else "input"
         if c.kind != wanted:
             self.fail(line, f"ssd:Connection {which}s at {element}.{connector} of kind '{c.kind}'; "
                       f"a connection {which}s at an {wanted}")
