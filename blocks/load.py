@@ -14,7 +14,8 @@ from typing import Any, Mapping
 
 from .diagram import Diagram
 from .loader import parse_builder, read_builder
-from .ssp import is_ssp, read_ssp
+from .ssp.package import is_ssp
+from .ssp.reader import read_ssp
 
 
 def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,

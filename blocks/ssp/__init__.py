@@ -10,5 +10,6 @@ files), ``xml`` (namespaces, safe parsing), ``parameters`` (bindings, ``.ssv``, 
 
 from .package import SSD_NAME, is_ssp
 from .reader import read_ssp
+from .writer import export_ssp
 
-__all__ = ["SSD_NAME", "is_ssp", "read_ssp"]
+__all__ = ["SSD_NAME", "export_ssp", "is_ssp", "read_ssp"]

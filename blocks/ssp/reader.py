@@ -83,7 +83,8 @@ def read_ssp(path: str | Path, trust: bool = False, step: Any = None) -> Diagram
     try:
         package = open_package(path)
     except PackageError as exc:
-        raise DiagramError([Issue(str(path), None, str(exc), "an SSP is a zip archive (.ssp) or a folder with "
+        message = str(exc).removeprefix(f"{path}: ")
+        raise DiagramError([Issue(str(path), None, message, "an SSP is a zip archive (.ssp) or a folder with "
                                   "SystemStructure.ssd")]) from None
     return _Reader(package, trust, step).read()
 
