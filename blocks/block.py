@@ -164,7 +164,8 @@ class Block:
         self.period = period
 
     def set_width(self, width: int) -> None:
-        """Give every port declared with width ``None`` the inferred ``width``."""
+        """Give every port declared with width ``None`` the inferred ``width``; a block whose
+        parameters cannot work at that width raises ValueError, a load error at its line."""
         self.inputs = {p: (width if w is None else w) for p, w in self.inputs.items()}
         self.outputs = {p: (width if w is None else w) for p, w in self.outputs.items()}
 

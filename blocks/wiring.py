@@ -287,7 +287,13 @@ class Wiring:
                                    "with a known width is connected to it",
                                    "connect it to a block with fixed widths or give it a width parameter")
                     continue
-                spec.block.set_width(inferred[name])
+                try:
+                    spec.block.set_width(inferred[name])
+                except ValueError as e:
+                    self.ctx.error(spec.file or self.top.file, spec.line,
+                                   f"block '{name}' ({spec.type_name}) cannot take the width {inferred[name]} of "
+                                   f"what it connects to: {e}", "fix its parameters or give it a width parameter")
+                    self.failed.add(name)
         annotate(self.top.levels(), blocks, self.failed, self.report)
         unresolved = self.resolve_elements()
         for c in self.connections:

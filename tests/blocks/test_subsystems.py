@@ -207,7 +207,7 @@ def test_a_problem_inside_a_subsystem_is_reported_in_its_file_under_the_block_pa
                   .replace("outputs: {u: u.y}", "outputs: {u: u.yy}\nbogus: 1"))
     assert problems(toy) == [
         f"{pi}:13: unknown top-level key 'bogus' (hint: allowed keys: version, name, description, time, blocks, "
-        "connections, inputs, outputs, references, log)",
+        "connections, inputs, outputs, references, log, units, elements)",
         f"{pi}:6: block 'ctrl.prop': period must be positive, got '-10 ms' (hint: write e.g. period: 1 ms; leave it "
         "out to inherit)",
         f"{pi}:12: diagram output 'u': block 'ctrl.u' (Sum) has no output 'yy' (hint: did you mean 'y'?)"]
