@@ -304,6 +304,12 @@ class Block:
         """True when ``__init__`` takes ``**kwargs`` (parameters are then not checked by name)."""
         return _accepts_any(cls.__init__)
 
+    def finish(self, state: Any) -> None:
+        """Called once after a run's last tick (complete, failed or interrupted), before
+        its results are made, with the block's last state: let go of what the state holds
+        for the run (an FMU block terminates its instance here). A BlockError raised here
+        fails a run that was complete, at the time it ended."""
+
     def is_stateful(self) -> bool:
         return self.initial_state() is not None
 

@@ -135,7 +135,9 @@ class DiagramBuilder(DiagramRecord):
         from .assemble import assemble
         from .schedule import build_schedule
 
-        diagram = assemble(self, dict(overrides or {}), dict(origins or {}))
+        from .api_args import overrides_mapping
+
+        diagram = assemble(self, overrides_mapping(overrides), dict(origins or {}))
         build_schedule(diagram, diagram.t_end)
         return diagram
 

@@ -11,8 +11,7 @@ import argparse
 from pathlib import Path
 from typing import Any, Sequence
 
-import yaml
-
+from ..yamlsource import load_yaml_value
 from .program import UsageError
 
 
@@ -44,10 +43,9 @@ def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
         if not eq or "." not in key or not all(key.split(".")):
             raise UsageError(f"--set {item!r}: expected BLOCK.PARAM=VALUE, e.g. --set prop.k=2")
         try:
-            overrides[key] = yaml.safe_load(text) if text.strip() else None
-        except yaml.YAMLError as exc:
-            first = str(exc).splitlines()[0]
-            raise UsageError(f"--set {item!r}: the value is not valid YAML ({first})") from None
+            overrides[key] = load_yaml_value(text, f"--set {key}") if text.strip() else None
+        except ValueError as exc:
+            raise UsageError(str(exc)) from None
         if overrides[key] is None:
             raise UsageError(f"--set {item!r}: no value after '='")
     return overrides

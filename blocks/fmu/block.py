@@ -75,6 +75,13 @@ class FMUState:
         if self._release is not None:
             self._release()
 
+    def finish(self) -> None:
+        """Give the instance back at the end of its run, terminate (and, in a process of
+        its own, freeInstance) included: their failure raises, to fail the run."""
+        if self._release is not None and self._release.alive:
+            self._release.detach()
+            self.model.release(self.instance, report=True)
+
     def __deepcopy__(self, memo):
         raise TypeError("the state of an FMU block is a live FMU instance and cannot be copied")
 
@@ -413,6 +420,10 @@ class FMU(Block):
         inst.broken = True
         interrupt.check()
         return BlockError(f"{self._model.shown}: {what}{inst.log_text()}")
+
+    def finish(self, state: FMUState) -> None:
+        """The run is over: terminate its instance now, so that a crash there fails it."""
+        state.finish()
 
     def close(self) -> None:
         """Free the pooled FMU instances and, once no run holds one, the extracted files."""

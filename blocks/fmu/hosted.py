@@ -14,9 +14,12 @@ that names the FMU, the FMU function it was in (traced by the host), the time, a
 signal, exit code or timeout, with the FMU's last log messages; the run fails there with
 its results so far. A signal that stops the run (Ctrl-C, SIGTERM) while it waits for the
 host is raised as it came; the host, left inside a call, is killed when the instance is
-next touched or freed. Terminate and freeInstance run when a run gives its instance back,
-after its results are complete: a host that dies there is reported on the ``blocks.fmu``
-logger as a warning, and the results stand.
+next touched or freed. Terminate runs when a run gives its instance back at its end
+(``FMU.finish``), before its results are made: a host that dies there fails the run at its
+end time, naming the call. FreeInstance runs when the block frees its pooled instances
+(``close``, or at exit), after every run: a host that dies there is reported on the
+``blocks.fmu`` logger as a warning, as is a terminate for a run's state given back only
+when it is dropped.
 """
 
 from __future__ import annotations
@@ -173,9 +176,11 @@ class HostedInstance:
             self._outputs(last if terminate else t + h, error)
         return terminate, early, last
 
-    def stop(self) -> None:
+    def stop(self, report: bool = False) -> None:
         """End a started run's simulation (terminate); an instance that fails to is broken.
-        Called when a run gives the instance back, after its results are complete."""
+        Called when a run gives the instance back: with ``report`` (at the end of the run,
+        before its results are made) a host that dies there raises its HostFailure, else
+        (a run's state dropped later) it is a warning."""
         if not self.started or self.broken or self.inherited:
             return
         self.started = False
@@ -188,6 +193,9 @@ class HostedInstance:
         try:
             self.broken = bool(self._message(("stop",), "terminating it after its run"))
         except HostFailure as exc:
+            self.broken = True
+            if report:
+                raise
             log.warning("%s (after the run; its results are complete)", exc)
         except KeyboardInterrupt as exc:
             interrupt.note(exc)
@@ -196,7 +204,8 @@ class HostedInstance:
             self.broken = True
 
     def free(self) -> None:
-        """Free the instance (freeInstance, in its host, which then ends) and its channel."""
+        """Free the instance (freeInstance, in its host, which then ends) and its channel;
+        a host that dies there is a warning: the runs are over."""
         if self.freed:
             return
         self.freed = True
