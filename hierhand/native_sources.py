@@ -15,8 +15,8 @@ CSRC = "hierhand/csrc"
 
 CORE = ["hand_params.c", "contact.c", "plant.c"]
 CORE_HEADERS = ["hand.h", "kinematics.h", "dynamics.h", "contact.h"]
-CONTROL = ["reflex.c", "manipulation.c", "suppresser.c"]
-CONTROL_HEADERS = ["control.h", "float_ops.h"]
+CONTROL = ["reflex.c", "manipulation.c", "suppresser.c", "control_params.c", "kernels.c"]
+CONTROL_HEADERS = ["control.h", "float_ops.h", "kernels.h"]
 BINDING = ["python/module.c", "python/py_common.c", "python/py_model.c", "python/py_plant.c", "python/py_control.c",
            "python/py_kernels.c"]
 FMU_COMMON = ["fmu_instance.c"]

@@ -871,17 +871,27 @@ static PyObject *call_kernel(PyObject *module, PyObject *args)
     return result;
 }
 
-/* library(): {name: address} of the library blocks' kernels. */
+/* library(): {name: address} of the library blocks' kernel functions ("gain_output", ...), from
+   the kernel types of library.c. */
 static PyObject *library(PyObject *module, PyObject *unused)
 {
     (void)module;
     (void)unused;
     PyObject *found = PyDict_New();
-    for (const blk_library_entry *e = blk_library; found != NULL && e->name != NULL; e++) {
-        PyObject *address = PyLong_FromVoidPtr((void *)e->function);
-        if (address == NULL || PyDict_SetItemString(found, e->name, address) != 0)
-            Py_CLEAR(found);
-        Py_XDECREF(address);
+    static const char *phases[] = {"output", "update", "advance"};
+    for (const blk_kernel_type *k = blk_library_types; found != NULL && k->name != NULL; k++) {
+        void *functions[] = {(void *)(uintptr_t)k->output, (void *)(uintptr_t)k->update,
+                             (void *)(uintptr_t)k->advance};
+        for (int i = 0; found != NULL && i < 3; i++) {
+            if (functions[i] == NULL)
+                continue;
+            PyObject *address = PyLong_FromVoidPtr(functions[i]);
+            PyObject *name = PyUnicode_FromFormat("%s_%s", k->name, phases[i]);
+            if (address == NULL || name == NULL || PyDict_SetItem(found, name, address) != 0)
+                Py_CLEAR(found);
+            Py_XDECREF(address);
+            Py_XDECREF(name);
+        }
     }
     return found;
 }

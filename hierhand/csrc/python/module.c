@@ -93,7 +93,7 @@ PyMODINIT_FUNC PyInit__native(void)
         PyErr_SetString(PyExc_SystemError, "hierhand._native: method table too small");
         return NULL;
     }
-    if (PyType_Ready(&hh_py_model_type) < 0 || PyType_Ready(&hh_py_scratch_type) < 0)
+    if (PyType_Ready(&hh_py_model_type) < 0 || PyType_Ready(&hh_py_context_type) < 0)
         return NULL;
     PyObject *module = PyModule_Create(&module_def);
     if (module == NULL)
@@ -113,7 +113,7 @@ PyMODINIT_FUNC PyInit__native(void)
         return NULL;
     }
     if (PyModule_AddObjectRef(module, "Model", (PyObject *)&hh_py_model_type) != 0 ||
-        PyModule_AddObjectRef(module, "Scratch", (PyObject *)&hh_py_scratch_type) != 0) {
+        PyModule_AddObjectRef(module, "Context", (PyObject *)&hh_py_context_type) != 0) {
         Py_DECREF(module);
         return NULL;
     }
