@@ -106,6 +106,10 @@ class KernelRecord:
     tunables: tuple[Tunable, ...] = ()
     links: tuple[Link, ...] = ()
     follows: tuple[Follow, ...] = ()
+    builds_state: bool = False
+    """Whether the kind's constructor also makes the block's initial state (so that a
+    parameter the state starts from, or whose value sizes it, follows); else the FMU keeps
+    the state the block's ``initial_state`` gives."""
 
 
 @dataclass(frozen=True)

@@ -83,10 +83,11 @@ def inertia_follows(at: int) -> tuple[Follow, ...]:
 
 def record(kind: str, *parts: Any, tunables: tuple[Tunable, ...] = (), links: tuple[Link, ...] = (),
            follows: tuple[Follow, ...] = ()) -> KernelRecord:
-    """A record of ``kind`` whose values are ``parts`` (numbers and arrays) one after the other."""
+    """A record of ``kind`` whose values are ``parts`` (numbers and arrays) one after the other
+    (every hand kind builds its block's state, kernels.h)."""
     values = np.concatenate([np.asarray(p, dtype=np.float64).ravel() for p in parts])
     values.flags.writeable = False
-    return KernelRecord(kind, values, tunables, links, follows)
+    return KernelRecord(kind, values, tunables, links, follows, builds_state=True)
 
 
 def context_of(rec: KernelRecord) -> Any:

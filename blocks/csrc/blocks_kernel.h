@@ -78,7 +78,10 @@ typedef int (*blk_advance_fn)(const void *ctx, double t, double *state, const do
  * destroy:   frees a built context (NULL: nothing to free beyond construct's malloc, which
  *            free releases).
  * initial:   the initial state of a built context (state_size values), NULL when
- *            construct gives -1. */
+ *            construct gives -1.
+ * failure:   one line saying what a failure code of the kernel's functions means (NULL:
+ *            the program says the code), for the phase ("output", "update", "advance")
+ *            and the time of the hit that failed: the words the block's Python side uses. */
 typedef struct {
     void *ctx;
     long outputs;
@@ -95,6 +98,7 @@ typedef struct blk_kernel_type {
     blk_output_fn output;
     blk_update_fn update;
     blk_advance_fn advance;
+    void (*failure)(const void *ctx, int code, int which, const char *phase, double t, char *message, long size);
 } blk_kernel_type;
 
 #endif

@@ -33,6 +33,7 @@
 
 #include "blocks_kernel.h"
 #include "core.h"
+#include "export_instance.h"
 #include "fmu.h"
 #include "library.h"
 
@@ -926,7 +927,12 @@ PyMODINIT_FUNC PyInit__native(void)
         return NULL;
     Py_INCREF(&run_type);
     if (PyModule_AddObject(module, "Run", (PyObject *)&run_type) != 0 ||
-        PyModule_AddIntConstant(module, "ABI", BLK_KERNEL_ABI) != 0) {
+        PyModule_AddIntConstant(module, "ABI", BLK_KERNEL_ABI) != 0 ||
+        PyModule_AddStringConstant(module, "EXPORT_RESOURCE", BLK_EXPORT_RESOURCE) != 0 ||
+        PyModule_AddObject(module, "EXPORT_FORMAT", Py_BuildValue("(LL)", (long long)BLK_EXPORT_MAGIC,
+                                                                  (long long)BLK_EXPORT_VERSION)) != 0 ||
+        PyModule_AddObject(module, "EXPORT_LOG_CATEGORIES",
+                           Py_BuildValue("(sss)", BLK_LOG_EVENTS, BLK_LOG_WARNING, BLK_LOG_ERROR)) != 0) {
         Py_DECREF(module);
         return NULL;
     }

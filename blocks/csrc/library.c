@@ -391,7 +391,7 @@ CONSTRUCT(first, 2, width_first)
 CONSTRUCT(gain, 3, width_gain)
 CONSTRUCT(lti, LTI_HEADER, width_lti)
 
-#define TYPE(kind, construct, out, upd, adv) {#kind, construct##_construct, free, NULL, out, upd, adv}
+#define TYPE(kind, construct, out, upd, adv) {#kind, construct##_construct, free, NULL, out, upd, adv, NULL}
 #define SIGNAL(kind) TYPE(kind, first, kind##_output, NULL, NULL)
 #define STATEFUL(kind) TYPE(kind, first, kind##_output, kind##_update, NULL)
 #define ADVANCING(kind) TYPE(kind, first, kind##_output, kind##_update, kind##_advance)
@@ -435,5 +435,5 @@ const blk_kernel_type blk_library_types[] = {
     SIGNAL(chirp),
     SIGNAL(from_file),
     ADVANCING(random_number),
-    {NULL, NULL, NULL, NULL, NULL, NULL, NULL},
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
 };

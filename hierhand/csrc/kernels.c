@@ -136,6 +136,52 @@ static int plant_advance(const void *ctx, double t, double *state, const double 
     return code;
 }
 
+/* What a plant failure code means, as HandPlant says it (fingers by number: the names
+   are the hand file's, which the record does not hold). */
+static void plant_failure(const void *ctx, int code, int which, const char *phase, double t, char *message,
+                          long size)
+{
+    (void)ctx;
+    char when[64];
+    snprintf(when, sizeof when, "%s t=%.10g s", strcmp(phase, "output") != 0 ? "in the step at" : "at", t);
+    static const char *axes[] = {"x", "y", "theta"}, *rates[] = {"vx", "vy", "omega"};
+    int finger = (which / 3) % HH_FINGERS + 1;
+    size_t n = (size_t)size;
+    switch (code) {
+    case HH_ERR_PENETRATION:
+        snprintf(message, n,
+                 "contact penetration deeper than the fingertip radius %s: the tip centre of finger %d is inside "
+                 "the object; the contact is too soft for the forces or the step too large",
+                 when, which % HH_FINGERS + 1);
+        break;
+    case HH_ERR_Q:
+        snprintf(message, n, "non-finite value %s: joint angle q[%d] (finger %d joint %d) is not finite", when,
+                 which + 1, finger, which % 3 + 1);
+        break;
+    case HH_ERR_QD:
+        snprintf(message, n, "non-finite value %s: joint velocity qd[%d] (finger %d joint %d) is not finite", when,
+                 which + 1, finger, which % 3 + 1);
+        break;
+    case HH_ERR_OBJ:
+        snprintf(message, n, "non-finite value %s: object pose obj[%d] (%s) is not finite", when, which + 1,
+                 axes[which % 3]);
+        break;
+    case HH_ERR_OBJ_VEL:
+        snprintf(message, n, "non-finite value %s: object velocity obj_vel[%d] (%s) is not finite", when, which + 1,
+                 rates[which % 3]);
+        break;
+    case HH_ERR_TAU:
+        snprintf(message, n, "non-finite input %s: tau[%d] (finger %d joint %d)", when, which + 1, finger,
+                 which % 3 + 1);
+        break;
+    case HH_ERR_F_EXT:
+        snprintf(message, n, "non-finite input %s: f_ext[%d]", when, which + 1);
+        break;
+    default:
+        snprintf(message, n, "the plant failed %s (code %d)", when, code);
+    }
+}
+
 /* -- GraspReflex: inputs q, tip, fn, ft, normal, share; out: tau_g, force, active ------------ */
 
 typedef struct {
@@ -207,6 +253,18 @@ static int reflex_update(const void *ctx, double t, double *state, const double 
     return code;
 }
 
+static void reflex_failure(const void *ctx, int code, int which, const char *phase, double t, char *message,
+                           long size)
+{
+    (void)ctx;
+    (void)which;
+    if (code == HH_REFLEX_COINCIDENT)
+        snprintf(message, (size_t)size, "%s at t=%.10g s: internal forces are undefined: all contact points coincide",
+                 phase, t);
+    else
+        snprintf(message, (size_t)size, "%s at t=%.10g s failed with code %d", phase, t, code);
+}
+
 /* -- ManipulationPD: inputs q, qd, fn, support, normal, obj; out: tau_m, tau_ff, q_ref ------- */
 
 typedef struct {
@@ -272,6 +330,18 @@ static int manip_output(const void *ctx, double t, const double *state, const do
         *which = status - HH_MANIP_UNREACHABLE; /* the finger out of reach */
     }
     return status;
+}
+
+static void manip_failure(const void *ctx, int code, int which, const char *phase, double t, char *message,
+                          long size)
+{
+    (void)ctx;
+    if (code == HH_MANIP_NO_PERIOD)
+        snprintf(message, (size_t)size, "%s at t=%.10g s: its gains are matched to its period, and it has none",
+                 phase, t);
+    else
+        snprintf(message, (size_t)size, "%s at t=%.10g s: a target of finger %d is out of its reach", phase, t,
+                 which + 1);
 }
 
 /* -- Suppresser: inputs tau_g, tau_m, tau_ff; out: tau, tau_g_eff, share ---------------------- */
@@ -356,10 +426,11 @@ static int support_output(const void *ctx, double t, const double *state, const 
 /* -- the table ------------------------------------------------------------------------------ */
 
 const blk_kernel_type hh_kernel_types[] = {
-    {"HandPlant", plant_construct, plant_destroy, plant_initial, plant_output, plant_update, plant_advance},
-    {"GraspReflex", reflex_construct, free, reflex_initial, reflex_output, reflex_update, NULL},
-    {"ManipulationPD", manip_construct, free, NULL, manip_output, NULL, NULL},
-    {"Suppresser", suppress_construct, free, suppress_initial, suppress_output, suppress_update, NULL},
-    {"ObjectSupport", support_construct, free, NULL, support_output, NULL, NULL},
-    {NULL, NULL, NULL, NULL, NULL, NULL, NULL},
+    {"HandPlant", plant_construct, plant_destroy, plant_initial, plant_output, plant_update, plant_advance,
+     plant_failure},
+    {"GraspReflex", reflex_construct, free, reflex_initial, reflex_output, reflex_update, NULL, reflex_failure},
+    {"ManipulationPD", manip_construct, free, NULL, manip_output, NULL, NULL, manip_failure},
+    {"Suppresser", suppress_construct, free, suppress_initial, suppress_output, suppress_update, NULL, NULL},
+    {"ObjectSupport", support_construct, free, NULL, support_output, NULL, NULL, NULL},
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
 };

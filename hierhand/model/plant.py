@@ -267,7 +267,8 @@ class HandPlant(DescribesHandPorts, Block):
         """``Kernel.bind``: the kernel of one run, stepping ``state`` in a context of its own."""
         self._check_state(state)
         ctx = context_of(rec)
-        return Kernel(context=ctx.address, owners=(ctx,), error=self._kernel_error, nogil=True, **_KERNEL_FUNCTIONS)
+        return Kernel(context=ctx.address, owners=(ctx,), error=self._kernel_error, nogil=True, record=rec,
+                      **_KERNEL_FUNCTIONS)
 
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BlockError:
         """The kernel's failure as the Python methods raise it (``t``: the failing step's
