@@ -21,7 +21,7 @@ from typing import Any
 
 from .description import read_description
 from .port_types import KINDS, NOT_PORTS
-from .ports import group_variables, groups, initial_reads, port_name, vectors
+from .ports import direct_reads, group_variables, groups, initial_reads, port_name, vectors
 
 
 CO_SIMULATION = "co_simulation"
@@ -97,6 +97,7 @@ class Model:
         self.outputs = group_variables(outs, "output", shown, major)
         self.not_ports = self._not_ports(md.modelVariables)
         self.initial_reads = initial_reads(md, self.inputs, self.outputs)
+        self.direct_reads = direct_reads(md, self.inputs, self.outputs)
         self.in_groups = groups(self.inputs)
         self.out_groups = groups(self.outputs)
         self.vectors = vectors(md.modelVariables, self.variables)
