@@ -63,6 +63,9 @@ class Tunable:
     slot: int
     description: str = ""
     unit: str | None = None
+    finite: bool = False
+    """The value must be finite, the block's one check of it (the kind's constructor
+    checks the others)."""
 
 
 @dataclass(frozen=True)

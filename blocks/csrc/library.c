@@ -387,7 +387,7 @@ static int flat_construct(const double *record, long n, long header, width_fn wi
         return flat_construct(record, n, header, width, built, message, size);                                \
     }
 
-CONSTRUCT(first, 2, width_first)
+CONSTRUCT(first, 1, width_first)
 CONSTRUCT(gain, 3, width_gain)
 CONSTRUCT(lti, LTI_HEADER, width_lti)
 

@@ -72,7 +72,7 @@ def resource_file(plan: Plan, variables: Variables, token: str, model: str) -> b
     w.counted([v.offsets[0] for v in variables.outputs])
     w.int(len(variables.parameters))
     for p in variables.parameters:
-        w.int(p.block, p.slot)
+        w.int(p.block, p.slot, int(p.finite))
         w.string(p.name)
     w.int(len(variables.follows))
     for f in variables.follows:

@@ -41,7 +41,8 @@ class Variable:
     """Input: the arena offsets it is written to; output: its one offset."""
     block: int = -1
     slot: int = -1
-    """Parameter: its block and record slot."""
+    finite: bool = False
+    """Parameter: its block and record slot, and whether the FMU checks that it is finite."""
     depends: tuple[int, ...] = ()
     initial_depends: tuple[int, ...] = ()
     """Output: the input variables (their positions among the inputs) it depends on, at a
@@ -147,7 +148,8 @@ def _parameters(plan: Plan, v: Variables, index: dict[str, int]) -> None:
             name = tunable.name if alone else f"{eb.name}.{tunable.name}"
             v.parameters.append(Variable(name, v.vr_param + len(v.parameters), "parameter",
                                          tunable.description or f"parameter {tunable.name} of block '{eb.name}'",
-                                         tunable.unit, float(rec.values[tunable.slot]), block=b, slot=tunable.slot))
+                                         tunable.unit, float(rec.values[tunable.slot]), block=b, slot=tunable.slot,
+                                         finite=tunable.finite))
         for rule in rec.follows:
             when = tuple(mine[n] for n in rule.when_set if n in mine)
             if when:

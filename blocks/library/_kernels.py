@@ -60,6 +60,18 @@ def make_kernel(context: np.ndarray, output: str | None = None, update: str | No
     )
 
 
+def tunables(name: str, first: int, shape: tuple[int, ...], description: str) -> tuple[Tunable, ...]:
+    """The elements of a parameter ``name`` (a scalar: ``shape`` (), a vector, a matrix,
+    row-major) at record slots from ``first`` as finite tunables: ``k``, ``k[2]``, ``k[1,2]``."""
+    if not shape:
+        return (Tunable(name, first, description, finite=True),)
+    out = []
+    for i, index in enumerate(np.ndindex(*shape)):
+        label = ",".join(str(j + 1) for j in index)
+        out.append(Tunable(f"{name}[{label}]", first + i, description, finite=True))
+    return tuple(out)
+
+
 def error(code: int, which: int, t: float, phase: str) -> BaseException:
     """The exception of a library kernel's failure code (``Kernel.error``)."""
     if code == NOMEM:
