@@ -34,7 +34,7 @@ typedef struct {
 } ex_input;
 
 typedef struct {
-    int64_t block, slot;
+    int64_t block, slot, finite;
     char *name;
 } ex_param;
 
@@ -314,6 +314,7 @@ static void read_variables(reader *r, blk_export *x)
         ex_param *q = x->params + p;
         q->block = index_in(r, x->n_blocks);
         q->slot = word(r);
+        q->finite = word(r);
         q->name = string(r);
         if (r->ok && (q->slot < 0 || q->slot >= x->blocks[q->block].n_record))
             r->ok = 0;
@@ -521,7 +522,8 @@ static void block_prefix(const blk_instance *inst, int64_t b, char *out, size_t 
         snprintf(out, size, "block '%s' (%s): ", block_name(inst, b), inst->x.blocks[b].kind);
 }
 
-/* The records with the parameters written in, the follow rules and the links applied. */
+/* The records with the parameters written in, the follow rules and the links applied: 0;
+   -1 out of memory; -2 a parameter that must be finite is not (logged). */
 static int write_records(blk_instance *inst, ex_build *b)
 {
     const blk_export *x = &inst->x;
@@ -532,8 +534,13 @@ static int write_records(blk_instance *inst, ex_build *b)
             return -1;
         memcpy(b->records[k], e->record, (size_t)e->n_record * sizeof(double));
     }
-    for (int64_t p = 0; p < x->n_params; p++)
+    for (int64_t p = 0; p < x->n_params; p++) {
+        if (x->params[p].finite && !isfinite(inst->params[p])) {
+            LOG_ERROR(inst, "invalid parameter: %s must be finite, got %g", x->params[p].name, inst->params[p]);
+            return -2;
+        }
         b->records[x->params[p].block][x->params[p].slot] = inst->params[p];
+    }
     for (int64_t f = 0; f < x->n_follows; f++) {
         const ex_follow *g = x->follows + f;
         int when = 0, unless = 0;
@@ -622,9 +629,13 @@ static int build(blk_instance *inst)
     b->states = calloc(n, sizeof *b->states);
     b->state_sizes = calloc(n, sizeof *b->state_sizes);
     b->arena = malloc((size_t)(x->table.header[BLK_H_ARENA] + 1) * sizeof(double));
-    if (b->records == NULL || b->built == NULL || b->kernels == NULL || b->states == NULL || b->state_sizes == NULL ||
-        b->arena == NULL || write_records(inst, b) != 0) {
-        LOG_ERROR(inst, "out of memory for %lld blocks", (long long)x->n_blocks);
+    int written = b->records == NULL || b->built == NULL || b->kernels == NULL || b->states == NULL ||
+                          b->state_sizes == NULL || b->arena == NULL
+                      ? -1
+                      : write_records(inst, b);
+    if (written != 0) {
+        if (written == -1)
+            LOG_ERROR(inst, "out of memory for %lld blocks", (long long)x->n_blocks);
         release_build(inst);
         return -1;
     }
@@ -645,7 +656,7 @@ static int build(blk_instance *inst)
     }
     if (inst->stop_defined && inst->stop_tick < b->run.at.end)
         b->run.at.end = inst->stop_tick;
-    return refresh_outputs(inst);
+    return refresh_outputs(inst) < 0 ? -1 : 0;
 }
 
 /* -- failures ---------------------------------------------------------------------------------- */
@@ -685,7 +696,8 @@ static void describe_failure(blk_instance *inst)
 
 /* The outputs at the run's tick from the inputs now: the outputs-only program of that tick
    (at t = 0 before the first step, between events, or an event's), then the lazy outputs.
-   0, or -1 after logging the failure (the instance then failed). */
+   0; -1 after logging the failure (the instance then failed); 1 in initialization mode,
+   where a failure is a warning (the outputs wait for the inputs). */
 static int refresh_outputs(blk_instance *inst)
 {
     const blk_export *x = &inst->x;
@@ -703,6 +715,17 @@ static int refresh_outputs(blk_instance *inst)
     else
         program = -1;
     if ((program >= 0 && blk_run_outputs(run, program) != 0) || (x->lazy >= 0 && blk_run_outputs(run, x->lazy) != 0)) {
+        if (inst->phase == BLK_INITIALIZATION) {
+            /* the inputs an importer sets in initialization mode may not all be there yet:
+               the outputs wait for them, and are computed again when they change */
+            const blk_outcome *o = &run->outcome;
+            blk_instance_log(inst, BLK_STATUS_WARNING, BLK_LOG_WARNING,
+                             "the outputs at t=0 cannot be computed from the inputs set so far (block '%s' "
+                             "fails with code %d); they are computed again when the inputs change",
+                             block_name(inst, x->table.ops[o->op * BLK_OP_N + BLK_OP_A]), o->code);
+            run->outcome.status = BLK_RUN_COMPLETE;
+            return 1;
+        }
         describe_failure(inst);
         inst->phase = BLK_FAILED;
         return -1;
@@ -755,7 +778,7 @@ blk_status blk_instance_exit_initialization(blk_instance *inst)
 {
     if (inst->phase != BLK_INITIALIZATION)
         return wrong_phase(inst, "exiting initialization mode");
-    if (build(inst) != 0) {
+    if (build(inst) != 0 || (!inst->outputs_fresh && (inst->phase = BLK_STEPPING, refresh_outputs(inst) != 0))) {
         inst->phase = BLK_FAILED;
         return BLK_STATUS_ERROR;
     }
@@ -797,6 +820,7 @@ static int in_range(unsigned int vr, int64_t first, int64_t n)
 blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n, double *values)
 {
     const blk_export *x = &inst->x;
+    blk_status status = BLK_STATUS_OK;
     if (inst->phase == BLK_FAILED)
         return wrong_phase(inst, "getting values");
     for (size_t i = 0; i < n; i++) {
@@ -806,8 +830,11 @@ blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n
             LOG_ERROR(inst, "output %u is calculated: read it after entering initialization mode", vr[i]);
             return BLK_STATUS_ERROR;
         }
-        if (build(inst) != 0 || (!inst->outputs_fresh && refresh_outputs(inst) != 0))
+        int refreshed = build(inst) != 0 ? -1 : inst->outputs_fresh ? 0 : refresh_outputs(inst);
+        if (refreshed < 0)
             return BLK_STATUS_ERROR;
+        if (refreshed > 0)
+            status = BLK_STATUS_WARNING;
         break;
     }
     for (size_t i = 0; i < n; i++) {
@@ -825,7 +852,7 @@ blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n
             return BLK_STATUS_ERROR;
         }
     }
-    return BLK_STATUS_OK;
+    return status;
 }
 
 blk_status blk_instance_set(blk_instance *inst, const unsigned int *vr, size_t n, const double *values)
@@ -908,7 +935,7 @@ blk_status blk_instance_do_step(blk_instance *inst, double current_time, double 
     }
     if (refresh_outputs(inst) != 0)
         return BLK_STATUS_ERROR;
-    if (run->at.tick < target) {
+    if (run->at.tick == run->at.end && run->at.end_program >= 0) {
         *terminated = 1;
         LOG_EVENT(inst, "a block ended the run at t=%.10g s", blk_instance_time(inst));
     }

@@ -62,7 +62,8 @@ typedef enum {
  *   inputs: their count, per input its start value and the arena offsets it is written to
  *   (a count, then the offsets),
  *   outputs: their count, per output its arena offset,
- *   parameters: their count, per parameter its block, its slot and its name (a string),
+ *   parameters: their count, per parameter its block, its slot, whether it must be finite
+ *   and its name (a string),
  *   follow rules: their count, per rule its block, its flag slot, the parameters that set
  *   it (a count, then their indices) and those that prevent it (likewise),
  *   links: their count, per link its block, slot, source block, source slot, length,

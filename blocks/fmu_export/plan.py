@@ -94,9 +94,7 @@ def exported_blocks(diagram: Diagram, table: OpTable) -> tuple[ExportBlock, ...]
         kernel = binding.kernels[b]
         record = None if kernel is None else kernel.record
         if record is None:
-            why = ("its kernel calls back into Python" if kernel is not None
-                   else "it has no compiled kernel" if _kernel_of(spec.block) is None
-                   else "its kernel cannot run it here")
+            why = _why_not(spec.block, kernel)
             issues.append(diagram.issue_at(spec, f"block '{name}' ({spec.type_name}) cannot be exported: {why}",
                                            "an exported FMU runs compiled blocks only (library and application "
                                            "blocks with a C kernel)"))
@@ -109,8 +107,16 @@ def exported_blocks(diagram: Diagram, table: OpTable) -> tuple[ExportBlock, ...]
     return tuple(out)
 
 
-def _kernel_of(block: Any):
+def _why_not(block: Any, kernel: Any) -> str:
+    """Why a block's kernel cannot leave Python."""
+    from ..fmu import FMU
+
+    if isinstance(block, FMU):
+        return "the FMU an FMU block runs is not carried inside an exported FMU"
+    if kernel is not None:
+        return "its kernel calls back into Python"
     try:
-        return block.kernel()
+        made = block.kernel()
     except Exception:  # noqa: BLE001 - a kernel that cannot be made is no kernel
-        return None
+        made = None
+    return "it has no compiled kernel" if made is None else "its kernel cannot run it in this diagram"
