@@ -21,12 +21,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy import extract, read_model_description, simulate_fmu
-from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
-from fmpy.fmi3 import FMU3Slave
 from fmpy.validation import validate_fmu
 
 from hierhand.fmu_export import FmuExportError, default_output_path, export_plant_fmu
 from hierhand.model import Hand, HandPlant
+from tests.blocks.fmu_export.slave import Slave as SteppedSlave
 
 STEP = 1e-3  # communication step: 10 plant steps of 0.1 ms
 N_STEPS = 50  # 50 ms
@@ -84,57 +83,11 @@ def heavy_hand_fixed_inertia() -> dict:
     return hand
 
 
-class Slave:
-    """An FMU instance through fmpy's low-level API, its log messages collected."""
-
-    def __init__(self, path: Path, unzip: Path, name: str = "instance", logging_on: bool = False):
-        self.md = read_model_description(str(path))
-        self.fmi = int(self.md.fmiVersion[0])
-        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
-        self.messages: list[tuple[int, str, str]] = []
-        kwargs = dict(guid=self.md.guid, unzipDirectory=extract(str(path), unzip),
-                      modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName=name)
-        if self.fmi == 2:
-            self.fmu = FMU2Slave(**kwargs)
-            callbacks = fmi2CallbackFunctions()
-            callbacks.logger = self._logger2 = fmi2CallbackLoggerTYPE(self._collect2)
-            self._callbacks = callbacks
-            self.fmu.instantiate(callbacks=callbacks, loggingOn=logging_on)
-            self.fmu.setupExperiment(startTime=0.0)
-        else:
-            self.fmu = FMU3Slave(**kwargs)
-            self.fmu.instantiate(loggingOn=logging_on, logMessage=self._collect3)
-
-    def _collect2(self, env, name, status, category, message):
-        self.messages.append((status, category.decode(), message.decode()))
-
-    def _collect3(self, env, status, category, message):
-        self.messages.append((status, category.decode(), message.decode()))
-
-    def set(self, **values):
-        refs = [self.vr[name.replace("__", ".")] for name in values]
-        (self.fmu.setReal if self.fmi == 2 else self.fmu.setFloat64)(refs, list(values.values()))
-
-    def get(self, names) -> np.ndarray:
-        refs = [self.vr[n] for n in names]
-        return np.array((self.fmu.getReal if self.fmi == 2 else self.fmu.getFloat64)(refs))
-
-    def initialize(self):
-        self.fmu.enterInitializationMode()
-        self.fmu.exitInitializationMode()
+class Slave(SteppedSlave):
+    """An instance of a plant FMU, stepped by STEP unless told otherwise."""
 
     def step(self, t: float, h: float = STEP):
-        self.fmu.doStep(currentCommunicationPoint=t, communicationStepSize=h)
-
-    def errors(self) -> list[str]:
-        return [m for status, category, m in self.messages if status == 3 and category == "logStatusError"]
-
-    def close(self):
-        try:
-            self.fmu.terminate()
-        except Exception:  # noqa: BLE001 - a failed instance may refuse; it is freed all the same
-            pass
-        self.fmu.freeInstance()
+        return super().step(t, h)
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
@@ -361,14 +314,11 @@ def test_get_and_set_state_rewinds_a_run_exactly(fmus, fmi, tmp_path):
         run(50, 5)
         slave.fmu.setFMUState(saved)
         np.testing.assert_array_equal(run(20, 30), first)
-        serialize = slave.fmu.serializeFMUstate if fmi == 2 else slave.fmu.serializeFMUState
-        deserialize = slave.fmu.deSerializeFMUstate if fmi == 2 else slave.fmu.deserializeFMUState
-        restored = deserialize(serialize(saved))
+        restored = slave.serialized_copy(saved)
         slave.fmu.setFMUState(restored)
         np.testing.assert_array_equal(run(20, 30), first)
         assert np.abs(first[-1] - first[0]).max() > 1e-4  # the rewound stretch did move
-        (slave.fmu.freeFMUstate if fmi == 2 else slave.fmu.freeFMUState)(saved)
-        (slave.fmu.freeFMUstate if fmi == 2 else slave.fmu.freeFMUState)(restored)
+        slave.free_states(saved, restored)
     finally:
         slave.close()
 
