@@ -1,6 +1,6 @@
 """Sweep: 256 points of diagrams/regrasp.yaml in this process against a 2-worker LocalCluster.
 
-The grid is suppress.S_b over 16 values times suppress.S_a over 16 values, metric
+The grid is ctrl.suppress.S_b over 16 values times ctrl.suppress.S_a over 16 values, metric
 separation_time, run from empty folders: serially in this process (``--serial``), on a
 new LocalCluster from the start (one single-threaded worker process per core, 2 on the
 reference machine; ``--workers N``), and the default way (no option: the points start at
@@ -53,8 +53,8 @@ TARGET = 1.8
 def grid(points: int) -> dict[str, list[float]]:
     """A square grid of about ``points`` points (256: 16 x 16) over S_b and S_a."""
     side = max(1, round(points ** 0.5))
-    return {"suppress.S_b": [round(0.05 + 0.15 * i / max(1, side - 1), 4) for i in range(side)],
-            "suppress.S_a": [round(50 + 750 * i / max(1, side - 1), 1) for i in range(side)]}
+    return {"ctrl.suppress.S_b": [round(0.01 + 0.09 * i / max(1, side - 1), 4) for i in range(side)],
+            "ctrl.suppress.S_a": [round(50 + 750 * i / max(1, side - 1), 1) for i in range(side)]}
 
 
 @dataclass

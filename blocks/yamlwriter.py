@@ -6,7 +6,9 @@ the file needs no params file), its subsystems as ``{diagram: FILE, params, bind
 entries, its wires, its own ports, references and logged signals. A subsystem read from
 a file is written as an entry naming that file (from the new file's folder); one built
 in Python has no file, so ``save_diagram`` writes it beside the diagram
-(``NAME.SUBSYSTEM.yaml``), and ``dump_diagram`` refuses it. Paths in path parameters (an
+(``NAME.SUBSYSTEM.yaml``), and ``dump_diagram`` refuses it. ``save_diagram`` also writes
+beside the diagram a subsystem whose file is outside the new file's folder, which the
+loader would refuse to read from there unless trusted. Paths in path parameters (an
 FMU's ``path``) are written from the new file's folder.
 """
 
@@ -110,12 +112,11 @@ class _Writer:
         return entry
 
     def subsystem_entry(self, sub: Composite) -> dict:
-        if sub.file is not None:
-            source = self.path(sub.file)
-        elif self.stem is None:
-            raise WriteError(f"subsystem '{sub.path}' was built in Python and has no file; save_diagram() writes "
-                             "it beside the diagram")
-        else:
+        source = self.path(sub.file) if sub.file is not None else None
+        if source is None or (self.stem is not None and not _below(source)):
+            if self.stem is None:
+                raise WriteError(f"subsystem '{sub.path}' was built in Python and has no file; save_diagram() "
+                                 "writes it beside the diagram")
             source = f"{self.stem}.{sub.path}.yaml"
             self.extra[source] = self.text(sub)
         entry: dict[str, Any] = {"diagram": source}
@@ -147,6 +148,12 @@ class _Writer:
             return Path(os.path.relpath(target.absolute(), self.folder.absolute())).as_posix()
         except ValueError:  # another drive
             return str(target.absolute())
+
+
+def _below(relative: str) -> bool:
+    """Whether a path written from the new file's folder stays inside that folder."""
+    path = Path(relative)
+    return not path.is_absolute() and ".." not in path.parts
 
 
 def plain(value: Any, what: str) -> Any:

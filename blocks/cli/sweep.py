@@ -42,7 +42,7 @@ def command(measures_help: str = MEASURES_HELP) -> Command:
                            help="sweep folder: sweep.csv and sweep.json (and runs/ with --keep-results)")
         sweep.add_argument("--grid", action="append", default=[], metavar="BLOCK.PARAM=V1,V2,...",
                            help="grid axis, values read as YAML (repeatable: cartesian product), "
-                                "e.g. --grid suppress.S_b=0.05,0.1,0.2")
+                                "e.g. --grid prop.k=1,2,4")
         sweep.add_argument("--random", action="append", default=[], metavar="BLOCK.PARAM=DIST",
                            help="random axis, DIST uniform(a,b) or normal(mean,std) (repeatable; "
                                 "crossed with --grid if both are given)")
@@ -78,7 +78,7 @@ def plot(sub, program) -> argparse.ArgumentParser:
                                        "other parameters, or their mean when there are many), or a heat "
                                        "map over two parameters (other parameters averaged).")
     splot.add_argument("sweep_dir", type=Path, metavar="DIR", help=f"sweep folder of '{program.name} sweep'")
-    splot.add_argument("--x", required=True, metavar="PARAM", help="parameter on the x axis, e.g. suppress.S_b")
+    splot.add_argument("--x", required=True, metavar="PARAM", help="parameter on the x axis, e.g. prop.k")
     splot.add_argument("--y", metavar="PARAM", help="second parameter: draws a heat map")
     splot.add_argument("--metric", required=True, metavar="NAME", help="metric column to plot")
     splot.add_argument("-o", "--output", type=Path, required=True, metavar="FILE.png", help="PNG file to write")

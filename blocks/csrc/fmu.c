@@ -16,6 +16,12 @@
  * As the Python side does around each step: before it, the interrupt hook is looked at
  * and FMI 2's log proxy re-armed; after doStep, interrupt.check() raises a Ctrl-C that an
  * FMU callback noted (blocks/fmu/interrupt.py).
+ *
+ * An instance hosted in a process of its own (FMU_CHANNEL, blocks/fmu/hosted.py) steps
+ * the same way through its channel instead (hosted_step): the inputs into the channel's
+ * values, one round trip (fmu_host.c), the outputs out of them; the host makes the FMI
+ * calls (fmu_calls.h, shared with this file). Anything but a plain success goes to slow
+ * as FMU_SLOW_HOSTED, with how waiting ended.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -26,19 +32,13 @@
 #include <string.h>
 
 #include "fmu.h"
+#include "fmu_calls.h"
+#include "fmu_host.h"
 #include "fmu_me.h"
 
-/* The FMI functions the step calls (the FMI 2.0 and 3.0 signatures; statuses are ints,
-   ok 0 and warning 1). */
-typedef int (*fmi2_set_fn)(void *, const unsigned int *, size_t, const double *);
-typedef int (*fmi2_get_fn)(void *, const unsigned int *, size_t, double *);
-typedef int (*fmi2_do_step_fn)(void *, double, double, int);
-typedef int (*fmi3_set_fn)(void *, const unsigned int *, size_t, const double *, size_t);
-typedef int (*fmi3_get_fn)(void *, const unsigned int *, size_t, double *, size_t);
-typedef int (*fmi3_do_step_fn)(void *, double, double, bool, bool *, bool *, bool *, double *);
 typedef void (*log_arm_fn)(void *);
 
-#define SLOT(c, i, type) ((type)(intptr_t)(c)[i])
+#define SLOT FMU_SLOT
 
 /* The Python side for what is not the steady step; also where the inputs are for it. */
 static int slow(int64_t *c, long kind, double t, int status, const double *const *inputs)
@@ -81,20 +81,35 @@ static int arm(int64_t *c, double t, const double *const *inputs)
     return 0;
 }
 
-/* One set or get call of a group of Float64 values; first is FMU_SET or FMU_GET, whose
-   slots follow in the order of fmu.h: function, value references, their count, the buffer,
-   the number of values. */
-static int transfer(const int64_t *c, int first, bool fmi3, bool set)
+/* The steady step of an instance hosted in a process of its own (FMU_CHANNEL): the inputs
+   into the channel, one round trip, the outputs out of it. Anything but a plain success
+   (the host's answer is a message, its process ended, the call took too long, a signal
+   handler raised) goes to the Python side, which says what it was. */
+static int hosted_step(int64_t *c, double t, const double *const *inputs)
 {
-    void *component = SLOT(c, FMU_COMPONENT, void *);
-    const unsigned int *vrs = SLOT(c, first + 1, const unsigned int *);
-    size_t nvr = (size_t)c[first + 2], count = (size_t)c[first + 4];
-    double *buf = SLOT(c, first + 3, double *);
-    if (set)
-        return fmi3 ? SLOT(c, first, fmi3_set_fn)(component, vrs, nvr, buf, count)
-                    : SLOT(c, first, fmi2_set_fn)(component, vrs, nvr, buf);
-    return fmi3 ? SLOT(c, first, fmi3_get_fn)(component, vrs, nvr, buf, count)
-                : SLOT(c, first, fmi2_get_fn)(component, vrs, nvr, buf);
+    host_channel *ch = SLOT(c, FMU_CHANNEL, host_channel *);
+    double *v = SLOT(c, FMU_VALUES, double *);
+    double *buf = SLOT(c, FMU_SET_BUF, double *);
+    const int64_t *port = c + FMU_PORTS;
+    for (int64_t i = 0; i < c[FMU_N_IN]; i++, port += 2)
+        memcpy(buf + port[0], inputs[i], (size_t)port[1] * sizeof(double));
+    ch->command = HOST_STEP;
+    ch->t = t;
+    ch->h = v[FMU_V_STEP];
+    blk_host_post(ch);
+    int waited = blk_host_wait(ch, (int)c[FMU_SOCKET], v[FMU_V_TIMEOUT]);
+    if (waited == HOST_RAISED)
+        return BLK_RAISED;
+    if (waited != HOST_ANSWERED || ch->answer != HOST_DONE)
+        return slow(c, FMU_SLOW_HOSTED, t, waited, inputs);
+    v[FMU_V_TIME] = t + v[FMU_V_STEP];
+    const double *got = SLOT(c, FMU_GET_BUF, const double *);
+    double *held = v + FMU_V_HELD;
+    for (int64_t i = 0; i < c[FMU_N_OUT]; i++, port += 2) {
+        memcpy(held, got + port[0], (size_t)port[1] * sizeof(double));
+        held += port[1];
+    }
+    return 0;
 }
 
 static int fmu_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
@@ -105,39 +120,32 @@ static int fmu_update(const void *ctx, double t, double *state, const double *co
     double h = v[FMU_V_STEP];
     if (!c[FMU_READY] || fabs(t - v[FMU_V_TIME]) > 1e-9 * fmax(h, fabs(t)))
         return slow(c, FMU_SLOW_UPDATE, t, 0, inputs);
+    if (c[FMU_CHANNEL])
+        return hosted_step(c, t, inputs);
     int code = arm(c, t, inputs);
     if (code)
         return code;
-    void *component = SLOT(c, FMU_COMPONENT, void *);
-    bool fmi3 = c[FMU_VERSION] == 3;
     const int64_t *port = c + FMU_PORTS;
     int status;
     if (c[FMU_SET]) {
         double *buf = SLOT(c, FMU_SET_BUF, double *);
         for (int64_t i = 0; i < c[FMU_N_IN]; i++, port += 2)
             memcpy(buf + port[0], inputs[i], (size_t)port[1] * sizeof(double));
-        status = transfer(c, FMU_SET, fmi3, true);
+        status = fmu_transfer(c, FMU_SET, true);
         if (status > 1)
             return slow(c, FMU_SLOW_SET, t, status, inputs);
     }
-    if (fmi3) {
-        bool *terminate = SLOT(c, FMU_FLAGS + 1, bool *), *early = SLOT(c, FMU_FLAGS + 2, bool *);
-        status = SLOT(c, FMU_DO_STEP, fmi3_do_step_fn)(component, t, h, true, SLOT(c, FMU_FLAGS, bool *), terminate,
-                                                        early, SLOT(c, FMU_FLAGS + 3, double *));
-        if (status > 1 || *terminate || *early)
-            return slow(c, FMU_SLOW_STEP, t, status, inputs);
-    } else {
-        status = SLOT(c, FMU_DO_STEP, fmi2_do_step_fn)(component, t, h, 1);
-        if (status > 1)
-            return slow(c, FMU_SLOW_STEP, t, status, inputs);
-    }
+    bool plain;
+    status = fmu_do_step(c, t, h, &plain);
+    if (!plain)
+        return slow(c, FMU_SLOW_STEP, t, status, inputs);
     PyObject *checked = PyObject_CallNoArgs(SLOT(c, FMU_CHECK, PyObject *));
     if (checked == NULL)
         return BLK_RAISED;
     Py_DECREF(checked);
     v[FMU_V_TIME] = t + h;
     if (c[FMU_GET]) {
-        status = transfer(c, FMU_GET, fmi3, false);
+        status = fmu_transfer(c, FMU_GET, false);
         if (status > 1)
             return slow(c, FMU_SLOW_GET, t, status, inputs);
         const double *buf = SLOT(c, FMU_GET_BUF, const double *);
@@ -158,10 +166,14 @@ static const named slots[] = {
     {"set_vrs", FMU_SET_VRS}, {"set_nvr", FMU_SET_NVR}, {"set_buf", FMU_SET_BUF}, {"set_count", FMU_SET_COUNT},
     {"do_step", FMU_DO_STEP}, {"get", FMU_GET}, {"get_vrs", FMU_GET_VRS}, {"get_nvr", FMU_GET_NVR},
     {"get_buf", FMU_GET_BUF}, {"get_count", FMU_GET_COUNT}, {"flags", FMU_FLAGS}, {"n_in", FMU_N_IN},
-    {"n_out", FMU_N_OUT}, {"ports", FMU_PORTS}, {NULL, 0}};
-static const named values[] = {{"time", FMU_V_TIME}, {"step", FMU_V_STEP}, {"held", FMU_V_HELD}, {NULL, 0}};
+    {"n_out", FMU_N_OUT}, {"channel", FMU_CHANNEL}, {"socket", FMU_SOCKET}, {"trace", FMU_TRACE},
+    {"trace_set", FMU_TRACE_SET}, {"trace_step", FMU_TRACE_STEP}, {"trace_get", FMU_TRACE_GET},
+    {"ports", FMU_PORTS}, {NULL, 0}};
+static const named values[] = {
+    {"time", FMU_V_TIME}, {"step", FMU_V_STEP}, {"timeout", FMU_V_TIMEOUT}, {"held", FMU_V_HELD}, {NULL, 0}};
 static const named kinds[] = {{"output", FMU_SLOW_OUTPUT}, {"update", FMU_SLOW_UPDATE}, {"arm", FMU_SLOW_ARM},
-                              {"set", FMU_SLOW_SET}, {"step", FMU_SLOW_STEP}, {"get", FMU_SLOW_GET}, {NULL, 0}};
+                              {"set", FMU_SLOW_SET}, {"step", FMU_SLOW_STEP}, {"get", FMU_SLOW_GET},
+                              {"hosted", FMU_SLOW_HOSTED}, {NULL, 0}};
 
 /* {name: value} of a table of names, or NULL with an exception. */
 PyObject *blk_names(const named *table)
@@ -178,7 +190,8 @@ PyObject *blk_names(const named *table)
 
 PyObject *blk_fmu_kernel(void)
 {
-    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
+    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
                          PyLong_FromVoidPtr((void *)fmu_update), "slots", blk_names(slots), "values", blk_names(values),
-                         "kinds", blk_names(kinds), "model_exchange", blk_fmu_me_functions());
+                         "kinds", blk_names(kinds), "model_exchange", blk_fmu_me_functions(), "host",
+                         blk_fmu_host_functions());
 }

@@ -1,5 +1,8 @@
 /* The FMU block's compiled kernel (fmu.c): the layout of its per-run context, for
- * blocks._native, which hands the layout and the functions to blocks/fmu/kernel.py. */
+ * blocks._native, which hands the layout and the functions to blocks/fmu/kernel.py. The
+ * same table describes an FMU instance to the host that runs it in a process of its own
+ * (fmu_host.c), which fills the FMU's slots and FMU_TRACE*; the run's kernel of such an
+ * instance fills FMU_CHANNEL and FMU_SOCKET instead of the FMU's functions. */
 #ifndef BLOCKS_FMU_H
 #define BLOCKS_FMU_H
 
@@ -35,12 +38,18 @@ enum {
     FMU_FLAGS, /* FMI 3 doStep's output arguments: eventHandlingNeeded, terminateSimulation, earlyReturn, */
     FMU_N_IN = FMU_FLAGS + 4, /* lastSuccessfulTime (the instance's own) */
     FMU_N_OUT,
+    FMU_CHANNEL,    /* an instance hosted in a process of its own: its host_channel * (fmu_host.h), else 0; */
+    FMU_SOCKET,     /* the run's end of its socket pair; the set and get buffers are the channel's values */
+    FMU_TRACE,      /* in the host: char *, where each call writes the FMU function it calls (0: no trace), */
+    FMU_TRACE_SET,  /* and the names of the set, doStep and get functions (const char *) */
+    FMU_TRACE_STEP,
+    FMU_TRACE_GET,
     FMU_PORTS /* then [offset in the set buffer, width] per input port in Block.inputs order, and
                  [offset in the get buffer, width] per output port in Block.outputs order */
 };
 
 /* The values array. */
-enum { FMU_V_TIME, FMU_V_STEP, FMU_V_HELD };
+enum { FMU_V_TIME, FMU_V_STEP, FMU_V_TIMEOUT, FMU_V_HELD }; /* FMU_V_TIMEOUT: a hosted call's, in seconds */
 
 /* What slow is asked to do. */
 enum {
@@ -49,12 +58,14 @@ enum {
     FMU_SLOW_ARM,    /* interrupt.arm() */
     FMU_SLOW_SET,    /* setting the inputs returned status */
     FMU_SLOW_STEP,   /* doStep returned status, or asked to terminate, or returned early */
-    FMU_SLOW_GET     /* getting the outputs returned status (the FMU's time is past the step) */
+    FMU_SLOW_GET,    /* getting the outputs returned status (the FMU's time is past the step) */
+    FMU_SLOW_HOSTED  /* a hosted step that was not a plain success: status is how waiting ended (HOST_*) */
 };
 
 /* {"output": address, "update": address, "slots": {name: index}, "values": {...},
-   "kinds": {...}, "model_exchange": {...} (fmu_me.h)}: the kernel's functions and its
-   context's layout, and the model-exchange integration's. */
+   "kinds": {...}, "model_exchange": {...} (fmu_me.h), "host": {...} (fmu_host.h)}: the
+   kernel's functions and its context's layout, the model-exchange integration's and the
+   FMU host's. */
 PyObject *blk_fmu_kernel(void);
 
 /* A name and its value, in the tables of names that describe a context's layout. */

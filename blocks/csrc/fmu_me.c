@@ -12,8 +12,9 @@
  * Their context is one FMU instance's int64 table (ME_* slots of fmu_me.h), made and
  * filled by blocks/fmu/solvers.py: the FMU's component and functions, the buffers. A call
  * that returns worse than a warning is recorded there (which call, its status, the time)
- * for the Python side's message. Called through ctypes, without the GIL; nothing here
- * touches Python.
+ * for the Python side's message; where the table has ME_TRACE (the FMU host, fmu_host.c),
+ * each call first writes the name of the FMU function it calls there. Called through
+ * ctypes, without the GIL; nothing here touches Python.
  */
 #include <math.h>
 #include <stdbool.h>
@@ -32,6 +33,13 @@ typedef double *(*array_fn)(void *);
 #define SLOT(c, i, type) ((type)(intptr_t)(c)[i])
 #define MAX_BISECTIONS 200
 
+/* Name the FMU function of the call about to be made, where calls are traced. */
+static void trace(const int64_t *c, int call)
+{
+    if (c[ME_TRACE])
+        strcpy(SLOT(c, ME_TRACE, char *), SLOT(c, ME_TRACE_NAMES, const char *const *)[call]);
+}
+
 /* Record the failed call and its status at time t; ME_CALL_FAILED. */
 static int failed(int64_t *c, int call, int status, double t)
 {
@@ -45,10 +53,12 @@ static int failed(int64_t *c, int call, int status, double t)
 static int place(int64_t *c, double t, double *x)
 {
     void *component = SLOT(c, ME_COMPONENT, void *);
+    trace(c, ME_CALL_SET_TIME);
     int status = SLOT(c, ME_SET_TIME, set_time_fn)(component, t);
     if (status > 1)
         return failed(c, ME_CALL_SET_TIME, status, t);
     if (c[ME_NX] > 0) {
+        trace(c, ME_CALL_SET_STATES);
         status = SLOT(c, ME_SET_STATES, states_fn)(component, x, (size_t)c[ME_NX]);
         if (status > 1)
             return failed(c, ME_CALL_SET_STATES, status, t);
@@ -58,6 +68,7 @@ static int place(int64_t *c, double t, double *x)
 
 static int call(int64_t *c, int slot, int which, double *out, size_t n, double t)
 {
+    trace(c, which);
     int status = SLOT(c, slot, states_fn)(SLOT(c, ME_COMPONENT, void *), out, n);
     return status > 1 ? failed(c, which, status, t) : 0;
 }
@@ -81,6 +92,7 @@ static int completed(int64_t *c, double t)
     void *component = SLOT(c, ME_COMPONENT, void *);
     int status;
     bool enter, terminate;
+    trace(c, ME_CALL_COMPLETED);
     if (c[ME_VERSION] == 3) {
         status = SLOT(c, ME_COMPLETED, fmi3_completed_fn)(component, true, &enter, &terminate);
     } else {
@@ -193,6 +205,7 @@ int blk_me_rhs(double t, void *y, void *ydot, void *user_data)
         dx[0] = 0.0;
         return 0;
     }
+    trace(c, ME_CALL_GET_DERIVATIVES);
     int status = SLOT(c, ME_GET_DERIVATIVES, states_fn)(SLOT(c, ME_COMPONENT, void *), dx, (size_t)c[ME_NX]);
     if (status > 1) {
         failed(c, ME_CALL_GET_DERIVATIVES, status, t);
@@ -215,7 +228,8 @@ static const named slots[] = {
     {"set_states", ME_SET_STATES}, {"get_derivatives", ME_GET_DERIVATIVES}, {"get_indicators", ME_GET_INDICATORS},
     {"completed", ME_COMPLETED}, {"array", ME_ARRAY}, {"nx", ME_NX}, {"nz", ME_NZ}, {"values", ME_VALUES},
     {"x", ME_X}, {"dx", ME_DX}, {"x_start", ME_X_START}, {"z", ME_Z}, {"z_new", ME_Z_NEW}, {"failed", ME_FAILED},
-    {"failed_status", ME_FAILED_STATUS}, {"size", ME_TABLE_SIZE}, {NULL, 0}};
+    {"failed_status", ME_FAILED_STATUS}, {"trace", ME_TRACE}, {"trace_names", ME_TRACE_NAMES},
+    {"size", ME_TABLE_SIZE}, {NULL, 0}};
 static const named values[] = {
     {"reached", ME_V_REACHED}, {"failed_time", ME_V_FAILED_TIME}, {"locate", ME_V_LOCATE}, {"size", ME_V_SIZE},
     {NULL, 0}};

@@ -25,6 +25,8 @@ enum {
     ME_Z_NEW,           /* double *: the event indicators at its end (nz) */
     ME_FAILED,          /* out: which call failed (ME_CALL_*), 0 for none */
     ME_FAILED_STATUS,   /* out: the status it returned */
+    ME_TRACE,           /* in the FMU host: char *, where each call first writes the FMU function it calls, */
+    ME_TRACE_NAMES,     /* and const char **, their names by ME_CALL_* (0: no trace) */
     ME_TABLE_SIZE
 };
 

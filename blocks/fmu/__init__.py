@@ -81,6 +81,16 @@ modelDescription.xml (``description.read_description``): ``hierhand validate`` a
 never run an FMU's code. The archive is extracted and the binary loaded when a run first
 needs an instance, at the block's first ``output`` or ``update``.
 
+Isolation. Each instance runs in a process of its own (``isolation: process``, the default
+except for the FMUs this project exports, recognised by their ``generationTool``), so that
+a crash, an ``exit()`` or a hang in the FMU's code fails the run instead of ending it: the
+host process (``host``) is forked by one launcher per process (``launcher``) and answers
+the block through a channel (``channel``: shared memory, one round trip per steady step,
+and messages for the rest), which ``hosted.HostedInstance`` drives with the surface of an
+in-process instance; the block and its kernel use either the same way. A call that does
+not return within ``call_timeout`` kills the host. ``isolation: none`` runs the instance in
+the run's process, the fastest.
+
 State. The FMU instance is external mutable state: ``initial_state()`` hands each run its
 own ``FMUState``, which takes an instance from the block's pool (reset), or instantiates
 one if every pooled one is in use, at the run's first call. When the run's state is
@@ -89,12 +99,15 @@ instances are freed when the block goes away, at process exit, or by ``FMU.close
 instance that failed is freed, never reused. The state cannot be copied or checkpointed
 (FMU get/set state is not used).
 
-Errors. Problems with the file, its modelDescription, the parameters and a period the FMU
-cannot step are raised at load time (ValueError, which the diagram loader reports as
+Errors. Problems with the file (missing, not a regular file, unreadable), its
+modelDescription (steps out of range, arrays too large), the parameters and a period the
+FMU cannot step are raised at load time (ValueError, which the diagram loader reports as
 ``file:line: block 'x' (FMU): ...``). A binary that does not load or instantiate, a
 failing ``doStep`` or model-exchange call, and a failing solver raise ``BlockError``
 naming the FMU, the function, the time and the status, with the FMU's recent log
-messages; the executor keeps the results up to that point. Ctrl-C inside an FMU call or
+messages; so does an isolated FMU whose process ended inside a call (the signal or exit
+code) or that did not return in time (``hosted.HostFailure``). The executor keeps the
+results up to that point. Ctrl-C inside an FMU call or
 the integration is a KeyboardInterrupt, never an FMU failure (see ``interrupt``).
 
 Modules, one concept each:
@@ -110,7 +123,12 @@ Modules, one concept each:
 - ``exchange``: a model-exchange instance's step (integration, events, event iteration);
 - ``solvers``: the integration settings, CVode and Euler over the C loops of blocks/csrc/fmu_me.c;
 - ``sundials``: the SUNDIALS (CVode) functions of fmpy's libraries, declared for ``solvers``;
-- ``kernel``: the compiled steady step (blocks/csrc/fmu.c) of a co-simulation FMU with Float64 ports only;
+- ``kernel``: the compiled steady step (blocks/csrc/fmu.c) of a co-simulation FMU with Float64 ports only
+  (in this process, or through the channel of an isolated instance);
+- ``hosted``: an instance in a process of its own, as the run sees it; ``host``: that process;
+  ``channel``: the shared memory and messages between them (blocks/csrc/fmu_host.c);
+  ``launcher``: the process that forks the hosts, as the run sees it; ``forkserver``: that process;
+- ``native``: the compiled functions of blocks._native the FMU modules use;
 - ``log_messages``: the FMUs' log messages and the FMI 2 logger proxy;
 - ``interrupt``: Ctrl-C inside FMU calls;
 - ``description``: reading a modelDescription without running code (``hierhand fmu info``);

@@ -21,11 +21,13 @@ beyond its declared size is cut off), so forged headers do not get more through.
 Files are created exclusively (``O_EXCL``), without the archive's permission bits,
 inside a fresh destination folder, and every resolved path is checked to lie inside it.
 ``read_member`` reads one member (an FMU's modelDescription.xml) into memory without
-writing anything to disk.
+writing anything to disk. Only regular files are opened as archives (``open_regular``): a
+FIFO would block the reader forever and a device such as ``/dev/zero`` never ends.
 """
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import os
 import shutil
@@ -122,15 +124,40 @@ def _central_directory_size(fp) -> int | None:
     return int.from_bytes(record[40:48], "little")
 
 
-def open_archive(archive: str | os.PathLike, limits: Limits = LIMITS) -> zipfile.ZipFile:
-    """``zipfile.ZipFile(archive)``, after checking that its member list is not too large
-    to read (zipfile reads all of it into memory first)."""
-    with open(archive, "rb") as fp:
+class NotARegularFile(OSError):
+    """A path that names a folder, FIFO, device or socket where a file is read."""
+
+
+def open_regular(path: str | os.PathLike):
+    """The regular file ``path`` opened for binary reading. Opening does not wait for a
+    FIFO's writer, and only a regular file is returned: anything else raises
+    ``NotARegularFile``; a file that cannot be opened raises the OSError of ``os.open``."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
+    try:
+        kind = stat.S_IFMT(os.fstat(fd).st_mode)
+        if kind != stat.S_IFREG:
+            what = {stat.S_IFDIR: "a folder", stat.S_IFIFO: "a FIFO (named pipe)", stat.S_IFCHR: "a device",
+                    stat.S_IFBLK: "a device", stat.S_IFSOCK: "a socket"}.get(kind, "not a regular file")
+            raise NotARegularFile(f"it is {what}, not a regular file")
+        os.set_blocking(fd, True)
+        return os.fdopen(fd, "rb")
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+@contextlib.contextmanager
+def open_archive(archive: str | os.PathLike, limits: Limits = LIMITS):
+    """``zipfile.ZipFile`` of the regular file ``archive`` (``open_regular``), after checking
+    that its member list is not too large to read (zipfile reads all of it into memory first)."""
+    with open_regular(archive) as fp:
         cd_size = _central_directory_size(fp)
-    if cd_size is not None and cd_size > limits.members * _CD_BYTES_PER_MEMBER:
-        raise ArchiveError(f"{_describe(archive)}: its member list takes {cd_size} bytes, more than "
-                           f"{limits.members} members can need (the limit is {limits.members} members)")
-    return zipfile.ZipFile(archive)
+        if cd_size is not None and cd_size > limits.members * _CD_BYTES_PER_MEMBER:
+            raise ArchiveError(f"{_describe(archive)}: its member list takes {cd_size} bytes, more than "
+                               f"{limits.members} members can need (the limit is {limits.members} members)")
+        fp.seek(0)
+        with zipfile.ZipFile(fp) as zf:
+            yield zf
 
 
 def check_members(zf: zipfile.ZipFile, archive: str | os.PathLike = "<archive>",

@@ -28,10 +28,11 @@ from ..block import Block, BlockError, EndRun, Signal
 from ..kernel import Kernel
 from ..timebase import format_duration
 from . import interrupt
+from .description import FMUNotFound, open_fmu_file
 from .instance import Instance
 from .kernel import fmu_kernel
 from .log_messages import status_name
-from .model import INTERFACES, float_or_none
+from .model import INTERFACES, ISOLATIONS, float_or_none, isolation_choice
 from .pool import PooledModel
 from .solvers import DEFAULT_TOLERANCE, CallFailed, Integration, SolverError, integration, solver_choice
 from .start_values import assignments, input_starts, start_of
@@ -112,25 +113,35 @@ class FMU(Block):
         so a loop through it is evaluated in order as one through native blocks is (an
         exported controller); false (the default): the outputs of the previous step, no
         feedthrough
+    isolation : str
+        'process': each instance runs in a process of its own, so that a crash, an exit()
+        or a hang in the FMU fails the run (with its results so far) instead of ending it;
+        'none': in the run's process, the fastest. Default: 'none' for FMUs exported by
+        this project's 'fmu export', 'process' for all others
+    call_timeout : duration
+        'isolation: process' only: how long one call into the FMU (a step, initialisation,
+        ...) may take before the FMU counts as hung and the run fails; default 10 min
     """
     time_varying = True
     path_params = ("path",)
 
     def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
                  tolerance: float | None = None, interface: str | None = None, solver: str | None = None,
-                 substep: Any = None, feedthrough: bool = False):
+                 substep: Any = None, feedthrough: bool = False, isolation: str | None = None,
+                 call_timeout: Any = None):
         if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
             raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
         file = Path(path).expanduser()
         resolved = (file if file.is_absolute() else Path.cwd() / file).absolute()
         shown = f"FMU '{path}'"
-        if not resolved.exists():
+        try:
+            with open_fmu_file(resolved, shown) as fp:
+                is_zip = zipfile.is_zipfile(fp)
+        except FMUNotFound:
             raise ValueError(f"FMU file not found: looked at {resolved} (in a diagram, a relative path "
                              "is resolved against the diagram's folder; from Python, against the "
-                             "current directory)")
-        if resolved.is_dir():
-            raise ValueError(f"{shown} is a folder; give the path of the .fmu file")
-        if not zipfile.is_zipfile(resolved):
+                             "current directory)") from None
+        if not is_zip:
             raise ValueError(f"{shown} is not an FMU: not a zip archive")
         if start_values is None:
             start_values = {}
@@ -153,6 +164,7 @@ class FMU(Block):
                      if model.md.modelExchange is not None else "it has no model-exchange interface")
             raise ValueError(f"parameter '{given}' is for model-exchange FMUs; {shown} runs as co-simulation, "
                              f"with its own solver ({other})")
+        model.isolation, model.timeout = isolation_choice(model, isolation, call_timeout)
         self._assignments = assignments(model, start_values)
         self.tolerance = tolerance if tolerance is not None else model.default_tolerance
         if model.exchange and self.tolerance is None:
@@ -186,6 +198,11 @@ class FMU(Block):
         """The interface the block runs: 'co-simulation' or 'model exchange'."""
         return self._model.interface
 
+    @property
+    def isolation(self) -> str:
+        """Where the block's instances run: 'process' (each in a process of its own) or 'none'."""
+        return self._model.isolation
+
     def describe(self) -> str:
         model, given = self._model, len(self._assignments)
         notes = [f"{given} start value{'s' if given != 1 else ''} set"] if given else []
@@ -197,7 +214,8 @@ class FMU(Block):
                          f"indicator{'s' if indicators != 1 else ''}")
         elif model.fixed_step is not None:
             notes.append(f"fixed internal step {format_duration(model.fixed_step)}, informative")
-        return f"FMI {self.fmi_version} {model.interface} {model.shown}" + (f" ({'; '.join(notes)})" if notes else "")
+        return (f"FMI {self.fmi_version} {model.interface} {model.shown}" + (f" ({'; '.join(notes)})" if notes else "")
+                + f", runs {ISOLATIONS[model.isolation]}")
 
     def parameter_values(self) -> dict[str, Any]:
         """Every parameter variable (causality ``parameter``) with the value a run starts
@@ -259,9 +277,15 @@ class FMU(Block):
         model = self._model
         if period is None:
             period = model.default_step
+            if period is None and model.default_step_problem:
+                raise ValueError(f"an FMU block needs a period, the interval between its hits, and {model.shown} "
+                                 f"has no usable default: {model.default_step_problem}; add e.g. 'period: 1 ms'")
             if period is None:
                 raise ValueError("an FMU block needs a period, the interval between its hits (the FMU "
                                  "declares no default step size: add e.g. 'period: 1 ms')")
+        if model.exchange and self._solver == "euler" and self._substep is None and model.default_step_problem:
+            raise ValueError(f"'solver: euler' takes its sub-step from the FMU's default step, and {model.shown} "
+                             f"has no usable one: {model.default_step_problem}; add e.g. 'substep: 1 ms'")
         if model.exchange:
             self.integration = integration(self._solver, self._substep, model.default_step, self.tolerance, period)
             model.integration = self.integration

@@ -17,7 +17,7 @@ import math
 from collections.abc import Mapping
 
 from ..block import Signal
-from .instance import FMI2Instance, FMI3Instance, Instance, call_failed
+from .instance import FMI2Instance, FMI3Instance, Instance, call_failed, function_address
 
 
 class CoSimulation(Instance):
@@ -44,7 +44,7 @@ class CoSimulation(Instance):
 
     def do_step_address(self) -> int:
         """The C address of the FMU's doStep."""
-        return ctypes.cast(self._do_step, ctypes.c_void_p).value
+        return function_address(self._do_step)
 
 
 class CoSimulation2(CoSimulation, FMI2Instance):

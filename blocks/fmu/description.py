@@ -5,12 +5,16 @@
 extracted to disk and no binary is loaded. The FMU block reads its FMU this way when a
 diagram is loaded (``hierhand validate`` and ``graph`` never run an FMU's code) and
 extracts and loads the binary only when a run starts; ``hierhand fmu info`` prints
-``describe_fmu``.
+``describe_fmu``. ``open_fmu_file`` opens an FMU file and says what is wrong with a path
+that is not one (missing, a folder, a FIFO or device, unreadable); ``step_of`` reads a step
+attribute within the limits of a duration.
 """
 
 from __future__ import annotations
 
+import errno
 import io
+import math
 import zipfile
 from dataclasses import dataclass
 from fractions import Fraction
@@ -18,13 +22,69 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree
 
-from .archive import ArchiveError, read_member
+from ..timebase import DurationError, parse_duration
+from .archive import ArchiveError, NotARegularFile, open_regular, read_member
 
 MODEL_DESCRIPTION = "modelDescription.xml"
+SHOWN_TEXT = 40
+"""How many characters of an attribute's text messages quote (a 5000-digit step is shown cut)."""
 
 
 class FMUInfoError(ValueError):
     """An FMU that cannot be read; the message names it."""
+
+
+class FMUNotFound(FMUInfoError):
+    """No file at an FMU's path."""
+
+
+def open_fmu_file(path: str | Path, shown: str):
+    """The FMU file ``path`` opened for binary reading (``shown`` names it in messages).
+    FMUNotFound if nothing is there; FMUInfoError if it is a folder, a FIFO, a device or a
+    socket (none of them is opened: a FIFO would wait for a writer, ``/dev/zero`` never
+    ends) or cannot be read (permissions), each saying so."""
+    try:
+        return open_regular(path)
+    except FileNotFoundError:
+        raise FMUNotFound(f"FMU file not found: looked at {path}") from None
+    except NotARegularFile as exc:
+        if "folder" in str(exc):
+            raise FMUInfoError(f"{shown} is a folder; give the path of the .fmu file") from None
+        raise FMUInfoError(f"{shown} cannot be read as an FMU: {exc}; give the path of the .fmu file") from None
+    except PermissionError:
+        raise FMUInfoError(f"{shown} cannot be read: permission denied (check the permissions of the file "
+                           "and of its folders)") from None
+    except OSError as exc:
+        if exc.errno == errno.ENOTDIR:
+            raise FMUNotFound(f"FMU file not found: looked at {path} (a part of the path is a file, "
+                              "not a folder)") from None
+        raise FMUInfoError(f"{shown} cannot be read: {exc.strerror or exc}") from None
+    except ValueError:  # a NUL character in the path
+        raise FMUInfoError(f"{shown} cannot be read: the path contains a NUL character") from None
+
+
+def shown_text(text: Any) -> str:
+    """An attribute's text for a message: cut to SHOWN_TEXT characters."""
+    text = str(text).strip()
+    return text if len(text) <= SHOWN_TEXT else text[:SHOWN_TEXT] + "..."
+
+
+def step_of(text: Any) -> Fraction:
+    """A step attribute of a modelDescription (``stepSize``, ``fixedInternalStepSize``: an
+    xs:double) as an exact duration: the decimal of the double it is, in the range of
+    every duration (1e-12 s to 1e9 s, ``timebase.parse_duration``). ValueError says why
+    not ("not a number", "out of range ..."), to follow the attribute's name and text. The exact decimal of the text itself could hold thousands of digits (or 1e999999999,
+    whose Fraction would take forever), and a schedule of such a step would not end."""
+    try:
+        value = float(str(text).strip())
+    except ValueError:
+        raise ValueError("not a number") from None
+    if not math.isfinite(value) or value <= 0:
+        raise ValueError("not a positive finite number of seconds")
+    try:
+        return parse_duration(value)
+    except DurationError:
+        raise ValueError("out of range (1e-12 s to 1e9 s)") from None
 
 
 @dataclass
@@ -41,9 +101,19 @@ class FMUDescription:
         return sorted({f.split("/")[1] for f in self.files if f.startswith("binaries/") and f.count("/") >= 2})
 
     def fixed_step(self) -> Fraction | None:
-        """The FMU's fixed internal step, if it declares one: FMI 3 ``fixedInternalStepSize``
-        of ``<CoSimulation>``; FMI 2 has no such attribute, so there the same attribute is
-        read from a ``<CoSimulation>`` element in any tool's ``<VendorAnnotations>``."""
+        """The FMU's fixed internal step, if it declares a usable one (``fixed_step_text``
+        read by ``step_of``; None for one out of range)."""
+        text = self.fixed_step_text()
+        try:
+            return step_of(text) if text is not None else None
+        except ValueError:
+            return None
+
+    def fixed_step_text(self) -> str | None:
+        """The text of the fixed internal step, if the FMU gives one: FMI 3
+        ``fixedInternalStepSize`` of ``<CoSimulation>``; FMI 2 has no such attribute, so
+        there the same attribute is read from a ``<CoSimulation>`` element in any tool's
+        ``<VendorAnnotations>``."""
         cs = self.md.coSimulation
         value = getattr(cs, "fixedInternalStepSize", None) if cs is not None else None
         if value is None and self.md.fmiVersion == "2.0":
@@ -53,11 +123,7 @@ class FMUDescription:
                 return None
             for element in root.iterfind("VendorAnnotations/Tool/CoSimulation"):
                 value = element.get("fixedInternalStepSize") or value
-        try:
-            step = Fraction(str(value).strip()) if value is not None else None
-        except (ValueError, ZeroDivisionError):
-            return None
-        return step if step is not None and step > 0 else None
+        return None if value is None else str(value)
 
 
 def variable_unit(v: Any) -> str | None:
@@ -103,9 +169,9 @@ def read_description(path: str | Path, shown: str, validate: bool = True) -> FMU
 def describe_fmu(path: str | Path) -> str:
     """Text listing an FMU's FMI version, interfaces, default experiment and variables."""
     path = Path(path)
-    if not path.is_file():
-        raise FMUInfoError(f"{path}: FMU file not found")
-    description = read_description(path, f"FMU '{path}'", validate=False)
+    shown = f"FMU '{path}'"
+    open_fmu_file(path, shown).close()
+    description = read_description(path, shown, validate=False)
     md = description.md
     lines = [f"{path}", f"  model: {md.modelName}  (FMI {md.fmiVersion}, generated by "
                         f"{md.generationTool or 'unknown tool'})"]
@@ -117,9 +183,11 @@ def describe_fmu(path: str | Path) -> str:
     lines.append("  interfaces: " + (", ".join(f"{n} (model identifier {i.modelIdentifier})"
                                                for n, i in interfaces) or "none"))
     lines.append(f"  platforms: {', '.join(description.platforms()) or 'none (no binaries)'}")
-    step = description.fixed_step()
+    step, text = description.fixed_step(), description.fixed_step_text()
     if step is not None:
         lines.append(f"  fixed internal step: {float(step):g} s (informative)")
+    elif text is not None:
+        lines.append(f"  fixed internal step: {_step_text(text)}")
     cs = md.coSimulation
     if cs is not None and not cs.canHandleVariableCommunicationStepSize:
         lines.append("  communication step: fixed (canHandleVariableCommunicationStepSize is false)")
@@ -129,9 +197,9 @@ def describe_fmu(path: str | Path) -> str:
                      f"{md.numberOfEventIndicators} event indicators; {completed} completedIntegratorStep")
     de = md.defaultExperiment
     if de is not None:
-        parts = [f"{k} {getattr(de, a)}" for k, a in (("start", "startTime"), ("stop", "stopTime"),
-                                                      ("step", "stepSize"), ("tolerance", "tolerance"))
-                 if getattr(de, a, None) is not None]
+        parts = [f"{k} {_step_text(value) if k == 'step' else shown_text(value)}"
+                 for k, value in (("start", de.startTime), ("stop", de.stopTime), ("step", de.stepSize),
+                                  ("tolerance", de.tolerance)) if value is not None]
         lines.append(f"  default experiment: {', '.join(parts) or '-'}")
     else:
         lines.append("  default experiment: none")
@@ -139,8 +207,17 @@ def describe_fmu(path: str | Path) -> str:
     width = max((len(v.name) for v in md.modelVariables), default=4)
     lines.append(f"    {'name':<{width}}  {'causality':<15} {'variability':<12} {'type':<8} start")
     for v in md.modelVariables:
-        start = "" if v.start is None else str(v.start)
+        start = "" if v.start is None else shown_text(v.start)
         unit = f" {variable_unit(v)}" if variable_unit(v) else ""
         lines.append(f"    {v.name:<{width}}  {v.causality or '':<15} {v.variability or '':<12} "
                      f"{v.type:<8} {start}{unit}")
     return "\n".join(lines)
+
+
+def _step_text(text: Any) -> str:
+    """A step attribute as ``fmu info`` shows it: its text, or why ``step_of`` refuses it."""
+    try:
+        step_of(text)
+    except ValueError as exc:
+        return f"{shown_text(text)} (not usable: {exc})"
+    return shown_text(text)

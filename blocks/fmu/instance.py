@@ -28,7 +28,7 @@ import functools
 import itertools
 import os
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -36,7 +36,7 @@ import numpy as np
 
 from ..block import BlockError, Signal
 from . import interrupt
-from .log_messages import ERROR_LOG_LINES, LOG_LINES, fmi2_buffers, fmi2_logger, log, record
+from .log_messages import LOG_LINES, fmi2_buffers, fmi2_logger, log, log_text, record
 from .model import import_fmpy
 from .port_types import EXACT_INTEGERS, KINDS, PortKind, float64_holds
 from .ports import Group
@@ -67,6 +67,13 @@ class Binary:
     completed_step: bool = False
     """Model exchange: the numbers of continuous states and event indicators, and whether
     the FMU needs completedIntegratorStep."""
+    in_ports: list[tuple[str, int]] = field(default_factory=list)
+    out_ports: list[tuple[str, int]] = field(default_factory=list)
+    """The block's input and output ports (name, width), in the block's order."""
+    isolation: str = "none"
+    """Where instances run: 'none' (in this process) or 'process' (a process of their own)."""
+    timeout: float = 0.0
+    """Isolation 'process': how long one call into the FMU may take, in seconds."""
 
 
 @dataclass
@@ -88,6 +95,14 @@ class Transfer:
     vrs: Any
 
 
+def function_address(function: Any) -> int:
+    """The C address of one of the FMU's functions (``slave._functions``), also of one the
+    FMU host traces (``host.Traced``, which keeps the function as ``traced``)."""
+    import ctypes
+
+    return ctypes.cast(getattr(function, "traced", function), ctypes.c_void_p).value
+
+
 def call_failed(function: str, status: int) -> Exception:
     """The exception for an FMI call that returned ``status`` (worse than warning): fmpy's,
     as its own wrappers raise it."""
@@ -101,6 +116,8 @@ class Instance:
 
     value_counts = False
     """Whether the get and set functions also take the number of values (FMI 3)."""
+    usable = True
+    """Whether a pooled instance can serve another run (always, for one in this process's memory)."""
 
     def __init__(self, model: Binary):
         fmpy = import_fmpy()
@@ -178,16 +195,13 @@ class Instance:
             args = (self.component, vrs, len(g.vrs), buf) + ((g.count,) if self.value_counts else ())
             call = functools.partial(self.slave._functions[function], *args)
             check = not g.kind.is_float if verb == "Set" else g.kind.exceeds_float64
-            address = ctypes.cast(self.slave._functions[function], ctypes.c_void_p).value
+            address = function_address(self.slave._functions[function])
             out.append(Transfer(function, call, np.frombuffer(buf, dtype=g.kind.dtype), g.slices, g.kind, check,
                                 address, vrs))
         return out
 
     def log_text(self) -> str:
-        if not self.messages:
-            return " (the FMU logged no messages)"
-        lines = list(self.messages)[-ERROR_LOG_LINES:]
-        return "; FMU log: " + " | ".join(lines)
+        return log_text(list(self.messages))
 
     # -- the life cycle -------------------------------------------------------------------
 

@@ -17,6 +17,12 @@ initialising it with the inputs of that moment), a step the Python update would 
 a call that returned worse than a warning, a doStep that asks to terminate or returned
 early. So messages, EndRun and Ctrl-C are the Python methods' own, and the values that
 reach the FMU and come back are the same, to the last bit.
+
+An instance in a process of its own (``hosted.HostedInstance``) has the same kernel: its
+table holds the instance's channel instead of the FMU's functions (``attach_hosted``), the
+C step writes the inputs into the channel and reads the outputs from it, and a step that
+was not a plain success (or whose host ended or timed out, or a signal that came while
+it waited) is handed to ``hosted`` with how the waiting ended.
 """
 
 from __future__ import annotations
@@ -31,19 +37,10 @@ from ..block import EndRun
 from ..compiled import failure
 from ..kernel import END_RUN, Kernel, address
 from . import interrupt
+from .native import native
+from .hosted import HostedInstance
 from .instance import Instance, call_failed
 from .log_messages import fmi2_logger_arming
-
-
-@functools.cache
-def native() -> dict[str, Any] | None:
-    """The C functions and context layout (``fmu_kernel()`` of blocks._native); None
-    when the extension is not built."""
-    try:
-        from .. import _native
-    except ImportError:
-        return None
-    return _native.fmu_kernel()
 
 
 def fmu_kernel(block: Any) -> Kernel | None:
@@ -59,7 +56,7 @@ def fmu_kernel(block: Any) -> Kernel | None:
 
 
 HANDLERS = {"output": "output", "update": "update", "arm": "arm", "set": "set_failed", "step": "stepped",
-            "get": "get_failed"}
+            "get": "get_failed", "hosted": "hosted"}
 """The method of ``KernelRun`` for each kind of ``slow`` call of fmu.c."""
 
 
@@ -146,9 +143,13 @@ class KernelRun:
         ready = started and inst is not None and inst is self.instance and not inst.broken and state.ended is None
         self.set(started=started, ready=ready)
 
-    def attach(self, inst: Instance) -> None:
-        """Put the instance's component, set / doStep / get functions and buffers in the table."""
+    def attach(self, inst: Instance | HostedInstance) -> None:
+        """Put the instance's component, set / doStep / get functions and buffers in the table
+        (for an instance in a process of its own: its channel, whose values are the buffers)."""
         self.instance = inst
+        if isinstance(inst, HostedInstance):
+            self.attach_hosted(inst)
+            return
         self.set(version=inst.model.major, component=inst.component, do_step=inst.do_step_address())
         ports = self.slots["ports"]
         for verb, transfers, names in (("set", inst.writes, self.block.inputs), ("get", inst.reads, self.block.outputs)):
@@ -166,6 +167,21 @@ class KernelRun:
                 self.table[self.slots["flags"] + i] = ctypes.addressof(flag)
         else:
             self.set(**dict(zip(("log_arm", "log_arg"), fmi2_logger_arming())))
+
+    def attach_hosted(self, inst: HostedInstance) -> None:
+        """The channel of a hosted instance in the table: the C step writes the inputs into
+        its values and reads the outputs from them, one round trip a step."""
+        region = inst.region
+        self.set(channel=region.address, socket=inst.sock.fileno(), set_buf=region.inputs_address,
+                 get_buf=region.outputs_address)
+        self.values[self.at["timeout"]] = inst.timeout
+        ports = self.slots["ports"]
+        for names in (inst.model.in_ports, inst.model.out_ports):
+            first = 0
+            for _, width in names:
+                self.table[ports:ports + 2] = (first, width)
+                ports += 2
+                first += width
 
     def inputs(self) -> dict[str, np.ndarray]:
         """The values of the inputs the C call was given (copies)."""
@@ -208,6 +224,15 @@ class KernelRun:
 
     def after_step(self, t: float, status: int) -> None:
         self.block.stepped(t, self.state, self.instance, self.instance.outcome(status, t, self.block._step))
+
+    def hosted(self, t: float, waited: int) -> int:
+        """A hosted step that was not a plain success (``waited``: how waiting for it ended):
+        the rest of the step as the block's update does it."""
+        return self.ending(self.block.step_calls, self.instance, t, self.after_hosted, t, waited)
+
+    def after_hosted(self, t: float, waited: int) -> None:
+        inst, block = self.instance, self.block
+        block.stepped(t, self.state, inst, inst.finish_step(waited, t, block._step))
 
     def ending(self, call: Any, *args: Any) -> int:
         """``call(*args)``; 1 when it raised EndRun (kept for the error factory), else 0."""

@@ -39,6 +39,13 @@ instance's message buffer and who it is, for the log."""
 _fmi2_proxy: tuple | None = None
 
 
+def log_text(lines: list[str]) -> str:
+    """An instance's recent log messages (oldest first) as a failure's message ends with them."""
+    if not lines:
+        return " (the FMU logged no messages)"
+    return "; FMU log: " + " | ".join(lines[-ERROR_LOG_LINES:])
+
+
 def status_name(status: object) -> str:
     """An FMI status code by its name (``'error'``), or the code itself as text."""
     return _STATUS[status] if isinstance(status, int) and 0 <= status < len(_STATUS) else str(status)

@@ -15,13 +15,16 @@ indicators). Problems are ValueErrors, which the diagram loader reports as
 from __future__ import annotations
 
 import math
+import sys
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from .description import read_description
+from ..limits import MAX_PORT_WIDTH
+from ..timebase import parse_duration
+from .description import read_description, shown_text, step_of
 from .port_types import KINDS, NOT_PORTS
-from .ports import direct_reads, group_variables, groups, initial_reads, port_name, vectors
+from .ports import direct_reads, group_variables, groups, initial_reads, port_name, variable_width, vectors
 
 
 CO_SIMULATION = "co_simulation"
@@ -29,6 +32,23 @@ MODEL_EXCHANGE = "model_exchange"
 INTERFACES = {CO_SIMULATION: "co-simulation", MODEL_EXCHANGE: "model exchange"}
 """The interfaces the block runs, by the name a diagram's ``interface`` parameter gives them,
 in words."""
+
+ISOLATIONS = {"process": "in a process of its own", "none": "in the run's process"}
+"""Where the block's FMU instances run, by the name a diagram's ``isolation`` parameter gives it."""
+
+IN_PROCESS_TOOLS = ("hierhand", "blocks")
+"""The generation tools (the first word of the modelDescription's ``generationTool``) whose
+FMUs run in the run's process unless the diagram says otherwise: this project's own exports
+(``fmu export``: ``blocks`` names the diagram exports, ``hierhand`` the earlier plant
+ones), whose binary is the C core the native blocks run. Every other FMU runs in a
+process of its own by default, so that its crash or hang cannot take the run with it. (A modelDescription can claim any tool: this is a choice of speed, not of trust.)"""
+
+PROCESS_ISOLATION = sys.platform.startswith("linux")
+"""Whether FMUs can run in processes of their own here (the channel needs Linux)."""
+
+DEFAULT_CALL_TIMEOUT = Fraction(600)
+"""How long one call into an FMU in a process of its own may take by default (10 min):
+far beyond any one step of a real FMU, so that only one that hangs reaches it."""
 
 
 def import_fmpy():
@@ -81,12 +101,21 @@ class Model:
         """The fixed internal step a co-simulation FMU declares (informative, not enforced)."""
         self.can_vary_step = bool(md.coSimulation.canHandleVariableCommunicationStepSize) \
             if md.coSimulation is not None else True
+        self._check_sizes(md)
         self.states = md.numberOfContinuousStates if self.exchange else 0
         self.indicators = md.numberOfEventIndicators if self.exchange else 0
         self.completed_step = bool(md.modelExchange.needsCompletedIntegratorStep) if self.exchange else False
         self.guid = md.guid or ""
         de = md.defaultExperiment
-        self.default_step = fraction_or_none(de.stepSize if de else None)
+        self.default_step: Fraction | None = None
+        """The DefaultExperiment's stepSize, if the FMU gives a usable one."""
+        self.default_step_problem: str | None = None
+        """Why the FMU's stepSize is not usable (out of range, not a number), if it is not."""
+        if de is not None and de.stepSize is not None:
+            try:
+                self.default_step = step_of(de.stepSize)
+            except ValueError as exc:
+                self.default_step_problem = f"its DefaultExperiment stepSize '{shown_text(de.stepSize)}' is {exc}"
         self.default_tolerance = float_or_none(de.tolerance if de else None)
         self.variables = {v.name: v for v in md.modelVariables}
         kinds = KINDS[major]
@@ -101,6 +130,13 @@ class Model:
         self.in_groups = groups(self.inputs)
         self.out_groups = groups(self.outputs)
         self.vectors = vectors(md.modelVariables, self.variables)
+
+    @property
+    def default_isolation(self) -> str:
+        """Where the FMU runs unless the diagram says: 'none' for the tools of
+        IN_PROCESS_TOOLS (and where processes of their own are not available), else 'process'."""
+        tool = (self.md.generationTool or "").split()
+        return "none" if not PROCESS_ISOLATION or (tool and tool[0] in IN_PROCESS_TOOLS) else "process"
 
     @property
     def interface(self) -> str:
@@ -124,6 +160,21 @@ class Model:
                              "model-exchange FMUs, not scheduled execution")
         raise ValueError(f"{self.shown} has no {INTERFACES[asked]} interface (it provides only "
                          f"{INTERFACES[offered[0]]}); drop 'interface: {asked}' to run it as {INTERFACES[offered[0]]}")
+
+    def _check_sizes(self, md: Any) -> None:
+        """ValueError for an array variable, or a number of continuous states or event
+        indicators, beyond MAX_PORT_WIDTH values: each is allocated (and an array's elements
+        labelled) per run, so 10^9 of them would exhaust memory rather than fail."""
+        for v in md.modelVariables:
+            width = variable_width(v)
+            if width > MAX_PORT_WIDTH:
+                raise ValueError(f"variable '{v.name}' of {self.shown} is an array of {width} elements, more "
+                                 f"than the limit of {MAX_PORT_WIDTH} the FMU block takes")
+        for what, count in (("continuous states", md.numberOfContinuousStates),
+                            ("event indicators", md.numberOfEventIndicators)):
+            if not 0 <= count <= MAX_PORT_WIDTH:
+                raise ValueError(f"{self.shown} declares {count} {what}, more than the limit of {MAX_PORT_WIDTH} "
+                                 "the FMU block takes")
 
     def _not_ports(self, variables: list) -> dict[str, str]:
         """Why each variable that is not a port is not one, by the port name it would have."""
@@ -150,13 +201,34 @@ class Model:
         return why
 
 
-def fraction_or_none(text: Any) -> Fraction | None:
-    """A positive Fraction read from ``text``, or None."""
+def isolation_choice(model: Model, isolation: Any, call_timeout: Any) -> tuple[str, float]:
+    """The ``isolation`` and ``call_timeout`` parameters checked (ValueError naming the
+    value): where the instances run (default: ``model.default_isolation``), and the timeout
+    of one call there in seconds."""
+    if isolation is None:
+        isolation = model.default_isolation
+    elif isolation not in ISOLATIONS:
+        raise ValueError(f"parameter 'isolation' must be one of {', '.join(ISOLATIONS)}, got {isolation!r}")
+    elif isolation == "process" and not PROCESS_ISOLATION:
+        raise ValueError("parameter 'isolation: process' needs Linux; use 'isolation: none' here")
+    if call_timeout is None:
+        return isolation, float(DEFAULT_CALL_TIMEOUT)
+    if isolation != "process":
+        raise ValueError("parameter 'call_timeout' is for FMUs that run in a process of their own "
+                         f"('isolation: process'); {model.shown} runs in the run's process, where a call "
+                         "cannot be timed out")
+    return isolation, float(duration_parameter("call_timeout", call_timeout, "30 s"))
+
+
+def duration_parameter(name: str, value: Any, example: str) -> Fraction:
+    """A block parameter that is a positive duration (ValueError naming it, with an example)."""
     try:
-        value = Fraction(str(text).strip())
-    except (TypeError, ValueError, ZeroDivisionError):
-        return None
-    return value if value > 0 else None
+        duration = parse_duration(value)
+    except ValueError as exc:
+        raise ValueError(f"parameter '{name}' must be a duration such as '{example}': {exc}") from None
+    if duration <= 0:
+        raise ValueError(f"parameter '{name}' must be positive, got {value!r}")
+    return duration
 
 
 def float_or_none(text: Any) -> float | None:

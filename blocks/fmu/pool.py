@@ -4,8 +4,12 @@ Instantiating an FMU (loading its binary, allocating its memory) costs far more 
 resetting one, and an FMU may allow only one instance per process, so a block keeps the
 instances its runs gave back and hands them to the next runs. ``PooledModel`` is the
 block's ``Model`` with that pool: a run takes an idle instance (reset when it starts) or a
-new one, extracting the archive the first time a run needs one; giving it back terminates
-the FMU's simulation and pools the instance, or frees it if it failed. Closing the block,
+new one (in this process, or for ``isolation: process`` in a process of its own,
+``hosted``), extracting the archive the first time a run needs one; giving it back
+terminates the FMU's simulation and pools the instance, or frees it if it failed. A
+process forked from this one drops the isolated instances it inherited (their hosts
+belong to the parent) and makes its own, and an isolated instance whose process ended
+while it was idle is dropped too. Closing the block,
 or its going away, frees the idle instances and, once no run holds one, the extracted
 files.
 """
@@ -24,6 +28,7 @@ from .archive import ArchiveError, extract_archive
 from .description import MODEL_DESCRIPTION
 from .cosimulation import CoSimulation2, CoSimulation3
 from .exchange import ModelExchange2, ModelExchange3
+from .hosted import HostedInstance
 from .instance import Binary, Instance
 from .model import Model
 
@@ -49,17 +54,25 @@ class PooledModel(Model):
         self.integration = None
         """How the block integrates a model-exchange FMU (``solvers.Integration``), set when
         the block is bound to its period."""
+        self.isolation = "none"
+        self.timeout = 0.0
+        """Where the block's instances run ('none': here, 'process': each in a process of its
+        own) and how long one call may take there (seconds), set by the block."""
         super().__init__(path, shown, interface)
 
     def acquire(self) -> Instance:
         with self.lock:
             if self.closed:
                 raise BlockError(f"{self.shown}: the FMU block was closed")
+            unusable = [inst for inst in self.idle if not inst.usable]
+            self.idle[:] = [inst for inst in self.idle if inst not in unusable]
             inst = self.idle.pop() if self.idle else None
-            if inst is None and self.once_per_process and self.live:
+            if inst is None and self.once_per_process and self.live and self.isolation == "none":
                 raise BlockError(f"{self.shown} can be instantiated only once per process, and its "
                                  "instance is in use by another run")
             self.live += 1
+        for gone in unusable:  # copies of another process's hosted instances, or ones whose host ended
+            gone.free()
         if inst is None:
             try:
                 inst = new_instance(self._extracted())
@@ -87,7 +100,10 @@ class PooledModel(Model):
                 self.dir = folder
                 self.binary = Binary(self.shown, self.major, self.identifier, self.guid, folder,
                                      folder / self.library, self.in_groups, self.out_groups, self.exchange,
-                                     self.integration, self.states, self.indicators, self.completed_step)
+                                     self.integration, self.states, self.indicators, self.completed_step,
+                                     [(p.name, p.width) for p in self.inputs.values()],
+                                     [(p.name, p.width) for p in self.outputs.values()], self.isolation,
+                                     self.timeout)
         return self.binary
 
     def release(self, inst: Instance) -> None:
@@ -112,12 +128,19 @@ class PooledModel(Model):
             self._cleanup()
 
 
-def new_instance(model: Binary) -> Instance:
-    """An instance of the FMU ``model`` for its interface and FMI version (BlockError if
-    its binary does not load or instantiate)."""
+def instance_class(model: Binary) -> type[Instance]:
+    """The class of an instance of the FMU ``model`` in this process, for its interface and FMI version."""
     kinds = {(False, 2): CoSimulation2, (False, 3): CoSimulation3, (True, 2): ModelExchange2,
              (True, 3): ModelExchange3}
-    return kinds[model.exchange, model.major](model)
+    return kinds[model.exchange, model.major]
+
+
+def new_instance(model: Binary) -> Instance | HostedInstance:
+    """An instance of the FMU ``model``: in this process, or (isolation 'process') in a
+    process of its own (BlockError if its binary does not load or instantiate)."""
+    if model.isolation == "process":
+        return HostedInstance(model)
+    return instance_class(model)(model)
 
 
 def _remove_model(idle: list, directories: list[str]) -> None:

@@ -34,8 +34,11 @@ from typing import Any
 import numpy as np
 
 from ..kernel import address
-from ..timebase import format_duration, parse_duration
+from ..timebase import format_duration
 from . import interrupt
+from .native import native
+from .instance import function_address
+from .model import duration_parameter
 from .sundials import CV_NORMAL, CV_ROOT_RETURN
 
 SOLVERS = ("cvode", "euler")
@@ -86,13 +89,7 @@ def solver_choice(solver: Any, substep: Any) -> tuple[str, Fraction | None]:
     if solver != "euler":
         raise ValueError("parameter 'substep' is the fixed step of 'solver: euler'; CVode chooses its own "
                          "steps (drop 'substep', or add 'solver: euler')")
-    try:
-        step = parse_duration(substep)
-    except ValueError as exc:
-        raise ValueError(f"parameter 'substep' must be a duration such as '1 ms': {exc}") from None
-    if step <= 0:
-        raise ValueError(f"parameter 'substep' must be positive, got {substep!r}")
-    return solver, step
+    return solver, duration_parameter("substep", substep, "1 ms")
 
 
 def integration(solver: str, substep: Fraction | None, default_step: Fraction | None, tolerance: float,
@@ -118,8 +115,6 @@ def integration(solver: str, substep: Fraction | None, default_step: Fraction | 
 @functools.cache
 def layout() -> dict[str, Any]:
     """The C functions and the table's layout (fmu_me.h), from blocks._native."""
-    from .kernel import native
-
     found = native()
     if found is None:
         raise SolverError("model exchange needs the compiled extension blocks._native, which is not built "
@@ -174,7 +169,7 @@ class ContinuousCalls:
         self._flag_refs = tuple(ctypes.byref(f) for f in self._flags)
 
     def _address(self, name: str) -> int:
-        return ctypes.cast(self.functions[name], ctypes.c_void_p).value
+        return function_address(self.functions[name])
 
     def check(self, name: str, status: int, t: float) -> None:
         if status > 1:

@@ -38,7 +38,7 @@ def check_key(key: str, option: str) -> str:
     """``key`` stripped, if it has the ``block.param`` form; else a SweepError naming ``option``."""
     key = key.strip()
     if not _KEY.match(key):
-        raise SweepError(f"{option}: {key!r} is not BLOCK.PARAM, e.g. suppress.S_b")
+        raise SweepError(f"{option}: {key!r} is not BLOCK.PARAM, e.g. prop.k")
     return key
 
 

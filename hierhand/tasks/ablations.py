@@ -1,8 +1,9 @@
 """What the project adds to the paper's controller, each addition switched off alone.
 
 ``ABLATIONS`` lists every mechanism of the shipped task diagrams that the paper does not
-have, with the ``--set`` values that switch it off (per task; the same for all where the
-task has the block) and why it is there. ``reproduce`` runs each at the shipped point and
+have, with the ``--set`` values that switch it off, keyed by the role of the block
+(``reflex.margin``: ``ctrl.reflex.margin`` in the task diagrams, see ``TaskBlocks.resolve``;
+per task, the same for all where the task has the block) and why it is there. ``reproduce`` runs each at the shipped point and
 tables the tasks' outcomes (``report.md``); ``benchmarks/robustness.py --ablations`` runs
 them over the spread.
 """

@@ -22,11 +22,11 @@ def _pyplot():
     return plt
 
 
-def _ratio_axes(ax, results: Results, fingers, b: TaskBlocks, title: str, styles=("-", "-")) -> None:
-    t, ratio = results[f"{b.plant}.ratio"]
+def _ratio_axes(ax, results: Results, fingers, title: str, styles=("-", "-")) -> None:
+    t, ratio = results[f"{TaskBlocks.of_run(results).plant}.ratio"]
     for f, style in zip(fingers, styles):
         ax.plot(t, ratio[:, f], style, lw=1.2, label=FINGER_NAMES[f])
-    safety = safety_ratio_of(results, b)
+    safety = safety_ratio_of(results)
     ax.axhline(safety, color="k", ls="--", lw=0.8, label=f"safety ratio {safety:g}")
     ax.set_ylim(0, 1.05)
     ax.set_ylabel("|f_t| / f_n")
@@ -35,11 +35,12 @@ def _ratio_axes(ax, results: Results, fingers, b: TaskBlocks, title: str, styles
     ax.legend(loc="upper right", fontsize="small")
 
 
-def _torque_axes(ax, results: Results, joint: int, b: TaskBlocks, title: str) -> None:
-    t_g, tau_g = results[f"{b.reflex}.tau_g"]
-    t_m, tau_m = results[f"{b.manipulation}.tau_m"]
-    applied = f"{b.suppresser}.tau_g_eff"
-    suppressing = results.info.get("parameters", {}).get(b.suppresser, {}).get("enabled", True) is not False
+def _torque_axes(ax, results: Results, joint: int, title: str) -> None:
+    b = TaskBlocks.of_run(results)
+    t_g, tau_g = results[b.signal("reflex", "tau_g")]
+    t_m, tau_m = results[b.signal("manip", "tau_m")]
+    applied = b.signal("suppress", "tau_g_eff")
+    suppressing = results.info.get("parameters", {}).get(b.suppress, {}).get("enabled", True) is not False
     if applied in results and suppressing:
         ax.plot(t_g, tau_g[:, joint], lw=0.8, ls="--", color="C0", label="grasp torque from the reflex")
         t_a, tau_a = results[applied]
@@ -70,7 +71,7 @@ def _save(fig, path: Path) -> Path:
     return path
 
 
-def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBlocks = TaskBlocks()) -> list[Path]:
+def draw_figures(runs: dict[str, Results], summary: dict, out: Path) -> list[Path]:
     """fig09.png ... fig14.png in ``out`` from the runs 'grasp', 'manipulate', 'regrasp' and
     'regrasp_unsuppressed'."""
     plt = _pyplot()
@@ -79,22 +80,22 @@ def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBloc
     g = summary["grasp"]
 
     fig, ax = plt.subplots(figsize=(8, 3.6))
-    _ratio_axes(ax, runs["grasp"], (THUMB, FORE), b, "Fig. 9: friction ratio, grasp under disturbance")
+    _ratio_axes(ax, runs["grasp"], (THUMB, FORE), "Fig. 9: friction ratio, grasp under disturbance")
     _mark(ax, g["disturbance_time_s"], " disturbance")
     written.append(_save(fig, out / "fig09.png"))
 
     fig, ax = plt.subplots(figsize=(8, 3.6))
-    _torque_axes(ax, runs["grasp"], fore_joint1, b, "Fig. 10: forefinger joint 1, grasp under disturbance")
+    _torque_axes(ax, runs["grasp"], fore_joint1, "Fig. 10: forefinger joint 1, grasp under disturbance")
     _mark(ax, g["disturbance_time_s"], " disturbance")
     written.append(_save(fig, out / "fig10.png"))
 
     m = summary["manipulation"]
     fig, ax = plt.subplots(figsize=(8, 3.6))
-    _ratio_axes(ax, runs["manipulate"], (THUMB, FORE), b, "Fig. 11: friction ratio, manipulation")
+    _ratio_axes(ax, runs["manipulate"], (THUMB, FORE), "Fig. 11: friction ratio, manipulation")
     written.append(_save(fig, out / "fig11.png"))
 
     fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
-    t, obj = runs["manipulate"][f"{b.plant}.obj"]
+    t, obj = runs["manipulate"][f"{TaskBlocks.of_run(runs['manipulate']).plant}.obj"]
     target = m["target_pose"]
     for j, label in enumerate(("x", "y")):
         axes[0].plot(t, 1000 * obj[:, j], lw=1.2, label=f"object {label}")
@@ -114,28 +115,29 @@ def draw_figures(runs: dict[str, Results], summary: dict, out: Path, b: TaskBloc
     fig, axes = plt.subplots(2, 1, figsize=(8, 5.5), sharex=True)
     for ax, key, label in ((axes[0], "regrasp", "with suppresser"),
                            (axes[1], "regrasp_unsuppressed", "without suppresser")):
-        _ratio_axes(ax, runs[key], (FORE,), b, f"Fig. 13 ({label}): forefinger friction ratio, re-grasp")
+        _ratio_axes(ax, runs[key], (FORE,), f"Fig. 13 ({label}): forefinger friction ratio, re-grasp")
         run_key = "suppressed" if key == "regrasp" else "unsuppressed"
         _mark(ax, r[run_key]["middle_contact_time_s"], " middle touches")
         _mark(ax, r[run_key]["fore_separation_time_s"], " forefinger leaves")
     written.append(_save(fig, out / "fig13.png"))
 
-    written.append(_fig14(runs, r, out, b, fore_joint1))
+    written.append(_fig14(runs, r, out, fore_joint1))
     return written
 
 
-def _fig14(runs: dict[str, Results], r: dict, out: Path, b: TaskBlocks, joint: int) -> Path:
+def _fig14(runs: dict[str, Results], r: dict, out: Path, joint: int) -> Path:
     """Fig. 14: the forefinger's grasp torque before and after the suppresser, its |tau_m|
     against S_b and the suppresser's factor while it withdraws; below, the same run without
     the suppresser."""
     plt = _pyplot()
     s = r["suppressed"]
     run = runs["regrasp"]
-    t, tau_g = run[f"{b.reflex}.tau_g"]
-    _, applied = run[f"{b.suppresser}.tau_g_eff"]
-    tau_m = np.abs(run.held(f"{b.manipulation}.tau_m", t)[:, joint])
+    b = TaskBlocks.of_run(run)
+    t, tau_g = run[b.signal("reflex", "tau_g")]
+    _, applied = run[b.signal("suppress", "tau_g_eff")]
+    tau_m = np.abs(run.held(b.signal("manip", "tau_m"), t)[:, joint])
     factor = np.divide(applied[:, joint], tau_g[:, joint], out=np.full(t.size, np.nan), where=tau_g[:, joint] != 0)
-    s_b = float(np.mean(run.info["parameters"][b.suppresser]["S_b"]))
+    s_b = float(np.mean(run.info["parameters"][b.suppress]["S_b"]))
     start = s["withdrawal_start_s"] - 0.05
     end = (s["fore_separation_time_s"] or s["withdrawal_end_s"]) + 0.05
     shown = (t >= start) & (t <= end)
@@ -158,7 +160,7 @@ def _fig14(runs: dict[str, Results], r: dict, out: Path, b: TaskBlocks, joint: i
         _mark(ax, s["withdrawal_start_s"], " withdrawal starts")
         _mark(ax, s["fore_factor_leaves_s"], " factor < 0.9", height=0.86)
         _mark(ax, s["fore_separation_time_s"], " forefinger leaves", height=0.74)
-    _torque_axes(axes[2], runs["regrasp_unsuppressed"], joint, b,
+    _torque_axes(axes[2], runs["regrasp_unsuppressed"], joint,
                  "Fig. 14, below: the same joint, re-grasp without suppresser")
     axes[2].legend(loc="upper left", bbox_to_anchor=(1.0, 1.0), fontsize="small")
     _mark(axes[2], r["unsuppressed"]["withdrawal_start_s"], " withdrawal starts")

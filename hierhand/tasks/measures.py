@@ -1,7 +1,7 @@
 """The hand tasks' scalar measures, registered for sweeps under ``blocks.measures``.
 
-Each is one number of a task summary (``summaries``), computed with the task diagrams'
-block names (plant, reflex, manip, suppress), in the framework's measure contract
+Each is one number of a task summary (``summaries``), on the diagram's hand plant (found
+by ``TaskBlocks``, whatever its name), in the framework's measure contract
 (``blocks.sweep.measures``): ``measure(results, diagram, *args) -> float | None`` with a
 ``check(diagram, *args)`` that refuses a diagram which does not log what it reads.
 
@@ -23,20 +23,24 @@ from .summaries import TaskBlocks, grasp_summary, object_dropped as dropped, reg
 DISTURBANCE_BLOCK = "push"
 """The block whose ``time`` parameter is the disturbance time when a metric gives none."""
 
-_PLANT = TaskBlocks().plant
-CONTACT_SIGNALS = (f"{_PLANT}.contact", f"{_PLANT}.obj")
-"""What every hand measure reads: the contact flags and the object pose."""
-RATIO_SIGNALS = (*CONTACT_SIGNALS, f"{_PLANT}.ratio")
+CONTACT_PORTS = ("contact", "obj")
+"""What every hand measure reads of the plant: the contact flags and the object pose."""
+RATIO_PORTS = (*CONTACT_PORTS, "ratio")
+
+
+def _require_plant_signals(diagram, ports: tuple[str, ...]) -> None:
+    plant = TaskBlocks.of_diagram(diagram).plant
+    require_logged(diagram, [f"{plant}.{port}" for port in ports])
 
 
 def _check_contact(diagram) -> None:
-    require_logged(diagram, CONTACT_SIGNALS)
+    _require_plant_signals(diagram, CONTACT_PORTS)
 
 
 def _check_ratio(measure: str):
     """The check of a ratio measure: the signals, and a disturbance time from somewhere."""
     def check(diagram, disturbance_time: float | None = None) -> None:
-        require_logged(diagram, RATIO_SIGNALS)
+        _require_plant_signals(diagram, RATIO_PORTS)
         if disturbance_time is None:
             push = diagram.blocks.get(DISTURBANCE_BLOCK)
             if push is None or "time" not in push.params:

@@ -245,6 +245,10 @@ addition below does there, is measured by `python benchmarks/robustness.py --abl
 {DEPARTURES}
 ## Each addition switched off alone (the shipped point)
 
+The parameters are named by block as in `diagrams/controller.yaml` (`reflex`, `manip`,
+`suppress`); in a task diagram the controller is the subsystem `ctrl`, so `reflex.margin`
+is `--set ctrl.reflex.margin=0` there, and `plant` and `support` are the task's own blocks.
+
 {ablation_table(summary["ablations"])}
 
 At the shipped point several additions change nothing: they are there for the spread

@@ -16,6 +16,7 @@ from typing import Callable
 import blocks
 from blocks import Results
 
+from ..model import load_hand
 from .ablations import shipped_outcomes
 from .figures import draw_figures
 from .report import report_markdown
@@ -62,26 +63,29 @@ def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda 
     return runs
 
 
-def summarize(runs: dict[str, Results], b: TaskBlocks = TaskBlocks()) -> dict:
+def summarize(runs: dict[str, Results]) -> dict:
     """summary.json's content from the four runs."""
+    roles = {task: TaskBlocks.of_run(results) for task, results in runs.items()}
     grasp_params = runs["grasp"].info["parameters"]
     manipulate_params = runs["manipulate"].info["parameters"]
     push = float(grasp_params["push"]["time"])
-    regrasp = {key: regrasp_summary(runs[task], withdrawal(runs[task].info["parameters"], b), b)
+    regrasp = {key: regrasp_summary(runs[task], withdrawal(runs[task].info["parameters"], roles[task]))
                for key, task in (("suppressed", "regrasp"), ("unsuppressed", "regrasp_unsuppressed"))}
     for case in regrasp.values():
         case["succeeded"] = regrasp_succeeded(case)
-    grasp = grasp_summary(runs["grasp"], push, b, handover_time=handover_time(grasp_params))
-    grasp.update(reaction_times(runs["grasp"], push, b=b))
-    grasp.update(reaction_times(runs["grasp"], push, b=b, part=0.01, label="first_moves"))
-    manipulation = manipulation_summary(runs["manipulate"], manipulate_params[b.manipulation]["trajectories"],
-                                        run_hand(manipulate_params, b).object_pose0, b)
-    settle = min(w["waypoints"][0][0] for w in manipulate_params[b.manipulation]["trajectories"].values())
+    handover = handover_time(grasp_params, roles["grasp"])
+    grasp = grasp_summary(runs["grasp"], push, handover_time=handover)
+    grasp.update(reaction_times(runs["grasp"], push))
+    grasp.update(reaction_times(runs["grasp"], push, part=0.01, label="first_moves"))
+    trajectories = manipulate_params[roles["manipulate"].block("manip")]["trajectories"]
+    manipulation = manipulation_summary(runs["manipulate"], trajectories,
+                                        load_hand(manipulate_params[roles["manipulate"].plant]).object_pose0)
+    settle = min(w["waypoints"][0][0] for w in trajectories.values())
     middle = regrasp["suppressed"]["middle_contact_time_s"]
     names = {THUMB: "thumb", FORE: "forefinger", MIDDLE: "middle finger"}
 
     def excursions(results: Results, since: float, fingers, until: float = float("inf")) -> dict:
-        return {names[f]: v for f, v in ratio_excursions(results, since, fingers, b, until).items()}
+        return {names[f]: v for f, v in ratio_excursions(results, since, fingers, until=until).items()}
 
     return {
         "grasp": grasp,
@@ -89,22 +93,13 @@ def summarize(runs: dict[str, Results], b: TaskBlocks = TaskBlocks()) -> dict:
         "regrasp": regrasp,
         "ratio_excursions": {
             "grasp after the hand-over, before the push": excursions(
-                runs["grasp"], handover_time(grasp_params) + SETTLED, (THUMB, FORE), push),
+                runs["grasp"], handover + SETTLED, (THUMB, FORE), push),
             "grasp after the push": excursions(runs["grasp"], push, (THUMB, FORE)),
             "manipulation from its first waypoint": excursions(runs["manipulate"], settle, (THUMB, FORE)),
             "re-grasp, the holding fingers after the middle finger's first touch": excursions(
                 runs["regrasp"], (middle or 0.0) + SETTLED, (THUMB, MIDDLE)),
         },
     }
-
-
-def run_hand(parameters: dict, b: TaskBlocks = TaskBlocks()):
-    """The hand of a task run, from its run.json parameters: the hand of the plant that
-    the manipulation controller refers to (``hand: plant``), whose parameters are the
-    hand file's sections."""
-    from ..model import load_hand
-
-    return load_hand(parameters[parameters[b.manipulation]["hand"]])
 
 
 def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[str], None] = lambda s: None) -> dict:

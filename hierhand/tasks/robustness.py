@@ -20,7 +20,7 @@ from blocks import Results
 
 from ..control.inverse_kinematics import UnreachableError
 from ..model import load_hand
-from .summaries import (POSITION_TOLERANCE, grasp_summary, grasp_succeeded, handover_time, manipulation_summary,
+from .summaries import (POSITION_TOLERANCE, TaskBlocks, grasp_summary, grasp_succeeded, handover_time, manipulation_summary,
                         manipulation_succeeded, regrasp_events, regrasp_succeeded, regrasp_summary, withdrawal)
 from .variations import Variation, carry
 
@@ -28,17 +28,18 @@ UNREACHABLE = "unreachable"
 
 
 def grasp_outcome(results: Results) -> str:
-    summary = grasp_summary(results, float(results.info["parameters"]["push"]["time"]),
-                            handover_time=handover_time(results.info["parameters"]))
+    parameters = results.info["parameters"]
+    summary = grasp_summary(results, float(parameters["push"]["time"]),
+                            handover_time=handover_time(parameters, TaskBlocks.of_run(results)))
     if summary["object_dropped"]:
         return "dropped"
     return "" if grasp_succeeded(summary) else "ratio above the safety ratio at the end"
 
 
 def manipulation_outcome(results: Results) -> str:
-    parameters = results.info["parameters"]
-    summary = manipulation_summary(results, parameters["manip"]["trajectories"],
-                                   load_hand(parameters["plant"]).object_pose0)
+    parameters, b = results.info["parameters"], TaskBlocks.of_run(results)
+    summary = manipulation_summary(results, parameters[b.block("manip")]["trajectories"],
+                                   load_hand(parameters[b.plant]).object_pose0, b)
     if summary["object_dropped"]:
         return "dropped"
     if summary["position_error_m"] > POSITION_TOLERANCE:
@@ -50,7 +51,7 @@ def manipulation_outcome(results: Results) -> str:
 
 
 def regrasp_outcome(results: Results) -> str:
-    summary = regrasp_summary(results, withdrawal(results.info["parameters"]))
+    summary = regrasp_summary(results, withdrawal(results.info["parameters"], TaskBlocks.of_run(results)))
     if summary["object_dropped"]:
         return "dropped"
     if summary["middle_contact_time_s"] is None:
@@ -89,24 +90,37 @@ TASKS = (
 def judge(variation: Variation, diagrams: Path, extra: Mapping[str, Mapping[str, Any]] | None = None,
           tasks: tuple[Task, ...] = TASKS) -> dict[str, str]:
     """Each task's outcome on the variation; ``extra``: more ``--set`` values per task name
-    (an ablation), applied after the variation's."""
+    (an ablation), written by role (``reflex.margin``, see ``TaskBlocks.resolve``) and
+    applied after the variation's."""
     outcomes = {}
     for task in tasks:
         path = diagrams / f"{task.name}.yaml"
+        diagram = blocks.load_diagram(path)
+        b = TaskBlocks.of_diagram(diagram)
         try:
-            overrides = carry(blocks.load_diagram(path).parameters(), variation, task.moves_object)
+            overrides = carry(diagram.parameters(), variation, task.moves_object, b)
         except UnreachableError:
             outcomes[task.name] = UNREACHABLE
             continue
-        overrides.update((extra or {}).get(task.name, {}))
+        overrides.update(by_name(b, (extra or {}).get(task.name, {})))
         outcomes[task.name] = _outcome(task, path, overrides)
     return outcomes
 
 
 def run_shipped(diagrams: Path, extra: Mapping[str, Mapping[str, Any]], tasks: tuple[Task, ...] = TASKS) -> dict[str, str]:
-    """Each task's outcome at the shipped point, with ``extra`` ``--set`` values per task name."""
-    return {task.name: _outcome(task, diagrams / f"{task.name}.yaml", dict(extra.get(task.name, {})))
-            for task in tasks}
+    """Each task's outcome at the shipped point, with ``extra`` ``--set`` values per task name
+    (written by role, as for ``judge``)."""
+    outcomes = {}
+    for task in tasks:
+        path = diagrams / f"{task.name}.yaml"
+        b = TaskBlocks.of_diagram(blocks.load_diagram(path))
+        outcomes[task.name] = _outcome(task, path, by_name(b, extra.get(task.name, {})))
+    return outcomes
+
+
+def by_name(b: TaskBlocks, values: Mapping[str, Any]) -> dict[str, Any]:
+    """``--set`` values written by role, keyed as the diagram names its blocks."""
+    return {b.resolve(key): value for key, value in values.items()}
 
 
 def _outcome(task: Task, path: Path, overrides: dict[str, Any]) -> str:

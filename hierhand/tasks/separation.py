@@ -22,18 +22,19 @@ S_B_SCALES = (0.8, 1.0, 1.2)
 """Factors on the suppresser's S_b."""
 
 
-def separation_relation(diagram: Path, b: TaskBlocks = TaskBlocks()) -> list[dict]:
+def separation_relation(diagram: Path) -> list[dict]:
     """One row per run of the re-grasp ``diagram``: the withdrawal start, S_b, and when the
     forefinger separated (None if it did not)."""
-    base = blocks.load_diagram(diagram).parameters()
-    fore = base[b.manipulation]["trajectories"]["fore"]
-    s_b = base[b.suppresser]["S_b"]
+    loaded = blocks.load_diagram(diagram)
+    b, base = TaskBlocks.of_diagram(loaded), loaded.parameters()
+    fore = base[b.block("manip")]["trajectories"]["fore"]
+    s_b = base[b.block("suppress")]["S_b"]
     rows = []
     for shift in SHIFTS:
         for scale in S_B_SCALES:
             moved = copy.deepcopy(fore)
             moved["waypoints"] = [[w[0] + shift, *w[1:]] for w in fore["waypoints"]]
-            overrides = {f"{b.manipulation}.trajectories.fore": moved, f"{b.suppresser}.S_b": s_b * scale}
+            overrides = {b.resolve("manip.trajectories.fore"): moved, b.resolve("suppress.S_b"): s_b * scale}
             results = blocks.simulate(blocks.load_diagram(diagram, overrides=overrides))
             rows.append({"withdrawal_start_s": moved["waypoints"][0][0], "S_b": s_b * scale,
                          "fore_separation_time_s": regrasp_events(results, b)["fore_separation_time_s"]})

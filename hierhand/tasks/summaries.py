@@ -1,14 +1,16 @@
 """Summaries of the paper's tasks: the numbers each task is judged by, from a run's Results.
 
-Every function takes the Results of a shipped task diagram and the names of its plant,
-reflex and controller blocks, so the same numbers serve the reproduction, the tests and,
-as the scalar measures of ``measures``, sweeps.
+Every function takes the Results of a task diagram and, optionally, its blocks by role
+(``TaskBlocks``; by default found in the run's block types), so the same numbers serve the
+reproduction, the tests and, as the scalar measures of ``measures``, sweeps of any diagram
+that has the blocks a number needs.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, Mapping
 
 import numpy as np
 
@@ -27,32 +29,97 @@ over the last milliseconds and the reflex drops the finger, so its torque there 
 about suppression."""
 
 
+ROLES = {"reflex": "GraspReflex", "manip": "ManipulationPD", "suppress": "Suppresser", "support": "ObjectSupport"}
+"""The blocks a task diagram may have besides its plant, by role, and the type of each."""
+PLANTS = ("HandPlant", "FMU")
+"""What a task's plant is: the hand plant, or an FMU exported from it."""
+
+
 @dataclass(frozen=True)
 class TaskBlocks:
-    """Names of the blocks a task diagram uses."""
+    """The blocks of a task diagram by role, found by their types (``of``): the plant and at
+    most one each of ``ROLES``. The names are the diagram's own: ``plant`` and, inside the
+    shipped controller subsystem, ``ctrl.reflex``, ``ctrl.manip`` and ``ctrl.suppress``."""
 
-    plant: str = "plant"
-    reflex: str = "reflex"
-    manipulation: str = "manip"
-    suppresser: str = "suppress"
+    plant: str
+    reflex: str | None = None
+    manip: str | None = None
+    suppress: str | None = None
+    support: str | None = None
+
+    @classmethod
+    def of(cls, block_types: Mapping[str, str], parameters: Mapping[str, Any]) -> "TaskBlocks":
+        """The roles of a diagram's blocks (``block_types``: name -> type, as run.json keeps
+        them). The plant is the block the controllers' ``hand`` names, else the one
+        HandPlant. ValueError when a role has two blocks or there is no plant."""
+        found: dict[str, str | None] = {}
+        for role, kind in ROLES.items():
+            names = [name for name, t in block_types.items() if t == kind]
+            if len(names) > 1:
+                raise ValueError(f"a task diagram has at most one {kind}; this one has {len(names)} "
+                                 f"({', '.join(names)})")
+            found[role] = names[0] if names else None
+        hands = sorted({parameters.get(name, {}).get("hand") for name in found.values() if name is not None} - {None})
+        plants = [name for name, t in block_types.items() if t == "HandPlant"]
+        if len(hands) > 1:
+            raise ValueError(f"the task's controllers model different hands: their 'hand' names {', '.join(hands)}")
+        if hands and block_types.get(hands[0]) in PLANTS:
+            plant = hands[0]
+        elif not hands and len(plants) == 1:
+            plant = plants[0]
+        elif len(plants) > 1:
+            raise ValueError(f"the diagram has {len(plants)} HandPlants ({', '.join(plants)}) and no controller "
+                             "whose 'hand' says which one is the task's")
+        else:
+            raise ValueError("a hand task needs its plant: a HandPlant block, or the exported plant FMU that "
+                             "its controllers' 'hand' names; this diagram has none")
+        return cls(plant=plant, **found)
+
+    @classmethod
+    def of_run(cls, results: Results) -> "TaskBlocks":
+        """The roles of the blocks of the diagram a run came from (its run.json)."""
+        return cls.of(results.info.get("block_types", {}), results.info.get("parameters", {}))
+
+    @classmethod
+    def of_diagram(cls, diagram) -> "TaskBlocks":
+        """The roles of a loaded diagram's blocks."""
+        return cls.of({name: spec.type_name for name, spec in diagram.blocks.items()}, diagram.parameters())
+
+    def block(self, role: str) -> str:
+        """The name of the block in ``role``; ValueError if the diagram has none."""
+        name = self.plant if role == "plant" else getattr(self, role)
+        if name is None:
+            raise ValueError(f"the task needs a {ROLES[role]} block; the diagram has none")
+        return name
+
+    def signal(self, role: str, port: str) -> str:
+        """The name of a role's output signal, e.g. ``signal("reflex", "tau_g")``."""
+        return f"{self.block(role)}.{port}"
+
+    def resolve(self, key: str) -> str:
+        """A ``--set`` key written by role (``reflex.margin``) as the diagram names it."""
+        role, _, rest = key.partition(".")
+        return f"{self.block(role)}.{rest}"
 
 
-def handover_time(parameters: dict) -> float | None:
-    """When the support lets the object go (the ``support`` block's ``until``, or ``time``
-    for a Step), or None for a diagram without one."""
-    support = parameters.get("support", {})
-    value = support.get("until", support.get("time"))
+def handover_time(parameters: Mapping[str, Any], b: TaskBlocks) -> float | None:
+    """When the support lets the object go (the support's ``until``), or None for a
+    diagram without one."""
+    if b.support is None:
+        return None
+    value = parameters.get(b.support, {}).get("until")
     return None if value is None else float(value)
 
 
-def withdrawal(parameters: dict, b: TaskBlocks = TaskBlocks()) -> tuple[float, float]:
+def withdrawal(parameters: Mapping[str, Any], b: TaskBlocks) -> tuple[float, float]:
     """(start, end) of the forefinger's trajectory in a re-grasp diagram."""
-    waypoints = parameters[b.manipulation]["trajectories"]["fore"]["waypoints"]
+    waypoints = parameters[b.block("manip")]["trajectories"]["fore"]["waypoints"]
     return float(waypoints[0][0]), float(waypoints[-1][0])
 
 
-def safety_ratio_of(results: Results, b: TaskBlocks = TaskBlocks()) -> float:
+def safety_ratio_of(results: Results, b: TaskBlocks | None = None) -> float:
     """The safety ratio the run's reflex kept to (its parameter, or the paper's 0.6)."""
+    b = b or TaskBlocks.of_run(results)
     return float(results.info.get("parameters", {}).get(b.reflex, {}).get("safety_ratio", SAFETY_RATIO))
 
 
@@ -63,8 +130,9 @@ def _signal(results: Results, name: str) -> tuple[np.ndarray, np.ndarray]:
         raise ValueError(f"the task needs the logged signal {exc}") from None
 
 
-def object_dropped(results: Results, b: TaskBlocks = TaskBlocks()) -> bool:
+def object_dropped(results: Results, b: TaskBlocks | None = None) -> bool:
     """Dropped: fewer than two fingers touch it at the end, or it fell by DROP_DISTANCE."""
+    b = b or TaskBlocks.of_run(results)
     _, contact = _signal(results, f"{b.plant}.contact")
     _, obj = _signal(results, f"{b.plant}.obj")
     return bool(contact[-1].sum() < 2 or obj[0, 1] - obj[-1, 1] > DROP_DISTANCE)
@@ -76,13 +144,14 @@ def first_time(t: np.ndarray, condition: np.ndarray, after: float = -math.inf) -
     return float(t[hits[0]]) if hits.size else None
 
 
-def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks = TaskBlocks(),
+def grasp_summary(results: Results, disturbance_time: float, b: TaskBlocks | None = None,
                   fingers: tuple[int, ...] = (THUMB, FORE), steady_window: float = 0.2,
                   handover_time: float | None = None) -> dict:
     """Peak |f_t|/f_n after the disturbance, when it is back under the run's safety ratio
     for good, its maximum over the last ``steady_window`` seconds, how far the object moved,
     and the peak while the fingers close (before ``handover_time``, when the support lets
     the object go; None without one)."""
+    b = b or TaskBlocks.of_run(results)
     safety = safety_ratio_of(results, b)
     t, ratio = _signal(results, f"{b.plant}.ratio")
     worst = ratio[:, list(fingers)].max(axis=1)
@@ -123,9 +192,10 @@ def rigid_target(start_tips: np.ndarray, end_tips: np.ndarray, start_pose: np.nd
 
 
 def manipulation_summary(results: Results, trajectories: dict, initial_pose: np.ndarray,
-                         b: TaskBlocks = TaskBlocks(), fingers: tuple[str, str] = ("thumb", "fore")) -> dict:
+                         b: TaskBlocks | None = None, fingers: tuple[str, str] = ("thumb", "fore")) -> dict:
     """Target pose implied by the two fingertip trajectories, the pose reached, the errors,
     and the largest |f_t|/f_n once the grasp has settled (from the first waypoint on)."""
+    b = b or TaskBlocks.of_run(results)
     first = [np.asarray(trajectories[f]["waypoints"][0], dtype=float) for f in fingers]
     last = [np.asarray(trajectories[f]["waypoints"][-1], dtype=float) for f in fingers]
     target = rigid_target(np.array([w[1:3] for w in first]), np.array([w[1:3] for w in last]),
@@ -145,9 +215,10 @@ def manipulation_summary(results: Results, trajectories: dict, initial_pose: np.
     }
 
 
-def regrasp_events(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
+def regrasp_events(results: Results, b: TaskBlocks | None = None) -> dict:
     """When the middle finger first touches the object, when the forefinger then lets go,
     whether it stays off, and whether the object was dropped (from the contact flags)."""
+    b = b or TaskBlocks.of_run(results)
     t, contact = _signal(results, f"{b.plant}.contact")
     middle = first_time(t, contact[:, MIDDLE] > 0)
     separation = first_time(t, contact[:, FORE] == 0, after=middle) if middle is not None else None
@@ -159,17 +230,18 @@ def regrasp_events(results: Results, b: TaskBlocks = TaskBlocks()) -> dict:
     }
 
 
-def holding_kept(results: Results, since: float | None, b: TaskBlocks = TaskBlocks(),
+def holding_kept(results: Results, since: float | None, b: TaskBlocks | None = None,
                  quantile: float | None = None) -> float | None:
     """The smallest share of its grasp torque that any joint of the holding fingers (thumb
     and middle) kept through the suppresser from ``since`` on (or that ``quantile`` of the
     shares, e.g. 0.01: what they kept 99 % of the time), over the samples where that joint's
     grasp torque is at least a tenth of the largest among those joints; None without such
     samples."""
+    b = b or TaskBlocks.of_run(results)
     if since is None:
         return None
-    t, tau_g = _signal(results, f"{b.reflex}.tau_g")
-    _, applied = _signal(results, f"{b.suppresser}.tau_g_eff")
+    t, tau_g = _signal(results, b.signal("reflex", "tau_g"))
+    _, applied = _signal(results, b.signal("suppress", "tau_g_eff"))
     joints = [*range(3 * THUMB, 3 * THUMB + 3), *range(3 * MIDDLE, 3 * MIDDLE + 3)]
     g, a = tau_g[t >= since][:, joints], applied[t >= since][:, joints]
     large = np.abs(g) >= 0.1 * np.abs(g).max() if g.size and np.abs(g).max() > 0 else np.zeros(g.shape, bool)
@@ -183,7 +255,7 @@ FACTOR_LEAVES = 0.9
 """The suppression factor below which the sigmoid counts as acting (Fig. 14)."""
 
 
-def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBlocks = TaskBlocks(),
+def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBlocks | None = None,
                     joint: int = 3 * FORE) -> dict:
     """``regrasp_events``, ``holding_kept`` from the middle finger's first contact, the
     paper's Fig. 14 on the forefinger's ``joint`` (its MP joint by default) while it
@@ -194,11 +266,12 @@ def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBl
     grows), the suppresser's factor (applied over reflex torque) there, and when the factor
     first fell below FACTOR_LEAVES. ``withdrawal`` is the forefinger trajectory's (start,
     end) time."""
+    b = b or TaskBlocks.of_run(results)
     events = regrasp_events(results, b)
-    t_g, tau_g_eff = _signal(results, f"{b.suppresser}.tau_g_eff")
-    _, tau_g = _signal(results, f"{b.reflex}.tau_g")
-    _signal(results, f"{b.manipulation}.tau_m")  # a clear error if it was not logged
-    held_m = np.abs(results.held(f"{b.manipulation}.tau_m", t_g)[:, joint])
+    t_g, tau_g_eff = _signal(results, b.signal("suppress", "tau_g_eff"))
+    _, tau_g = _signal(results, b.signal("reflex", "tau_g"))
+    _signal(results, b.signal("manip", "tau_m"))  # a clear error if it was not logged
+    held_m = np.abs(results.held(b.signal("manip", "tau_m"), t_g)[:, joint])
     separation = events["fore_separation_time_s"]
     end = separation - CONTACT_FADE if separation is not None else math.inf
     window = (t_g >= withdrawal[0]) & (t_g < end)
@@ -228,10 +301,11 @@ def regrasp_summary(results: Results, withdrawal: tuple[float, float], b: TaskBl
 
 
 def sliding_before_separation(results: Results, start: float, separation: float | None,
-                              b: TaskBlocks = TaskBlocks()) -> dict:
+                              b: TaskBlocks | None = None) -> dict:
     """How the forefinger's contact went between the start of its withdrawal and its
     separation: its largest |f_t|/f_n, and how long it was above the safety ratio and at
     the sliding limit (mu_d, where the contact law clips a sliding contact)."""
+    b = b or TaskBlocks.of_run(results)
     t, ratio = _signal(results, f"{b.plant}.ratio")
     window = (t >= start) & (t < (separation if separation is not None else math.inf))
     fore = ratio[window, FORE]
@@ -244,10 +318,11 @@ def sliding_before_separation(results: Results, start: float, separation: float 
     }
 
 
-def ratio_excursions(results: Results, since: float, fingers: tuple[int, ...], b: TaskBlocks = TaskBlocks(),
+def ratio_excursions(results: Results, since: float, fingers: tuple[int, ...], b: TaskBlocks | None = None,
                      until: float = math.inf) -> dict[int, dict]:
     """Per finger, over [since, until): its largest |f_t|/f_n while in contact and how long
     it was above the run's safety ratio."""
+    b = b or TaskBlocks.of_run(results)
     t, ratio = _signal(results, f"{b.plant}.ratio")
     window = (t >= since) & (t < until)
     step = float(np.median(np.diff(t))) if t.size > 1 else 0.0
@@ -257,15 +332,16 @@ def ratio_excursions(results: Results, since: float, fingers: tuple[int, ...], b
 
 
 def reaction_times(results: Results, since: float, fingers: tuple[int, ...] = (THUMB, FORE),
-                   b: TaskBlocks = TaskBlocks(), window: float = 0.2, part: float = 0.1,
+                   b: TaskBlocks | None = None, window: float = 0.2, part: float = 0.1,
                    label: str = "reacts") -> dict:
     """When the grasp torque (the reflex's) and the manipulation torque (the PD's) first
     react to a disturbance at ``since`` (the paper's Fig. 10): per torque, the first time
     after ``since`` at which some joint of the ``fingers`` has moved from its value just
     before by ``part`` of its largest move within ``window`` (keys
     ``grasp_torque_<label>_s``, ``manipulation_torque_<label>_s``); None where it does not move."""
+    b = b or TaskBlocks.of_run(results)
     out = {}
-    for key, signal in (("grasp", f"{b.reflex}.tau_g"), ("manipulation", f"{b.manipulation}.tau_m")):
+    for key, signal in (("grasp", b.signal("reflex", "tau_g")), ("manipulation", b.signal("manip", "tau_m"))):
         t, tau = _signal(results, signal)
         joints = [j for f in fingers for j in range(3 * f, 3 * f + 3)]
         before = tau[max(int(np.searchsorted(t, since)) - 1, 0), joints]

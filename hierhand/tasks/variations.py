@@ -16,12 +16,16 @@ reach raises ``UnreachableError``; such a point is left out of the task's rate.
 from __future__ import annotations
 
 import copy
+import inspect
 import math
 from dataclasses import asdict, dataclass
 from typing import Any, Mapping
 
 import numpy as np
 
+from ..control.grasp_reflex import GraspReflex
+from ..control.manipulation_pd import ManipulationPD
+from ..control.suppresser import Suppresser
 from ..control.inverse_kinematics import finger_ik_near
 from ..model import Hand, load_hand
 from .summaries import TaskBlocks, rigid_target
@@ -138,8 +142,7 @@ class FaceMap:
         return self.c1 + moved
 
 
-def carry(parameters: Mapping[str, Any], v: Variation, moves_object: bool = False,
-          b: TaskBlocks = TaskBlocks()) -> dict[str, Any]:
+def carry(parameters: Mapping[str, Any], v: Variation, moves_object: bool, b: TaskBlocks) -> dict[str, Any]:
     """The ``--set`` values that put a task diagram (its ``parameters``) on the variation:
     the plant's hand, the gains, the start poses and waypoints carried (``FaceMap``), the
     push where the diagram has one (block ``push``). ``UnreachableError`` (naming the
@@ -153,15 +156,15 @@ def carry(parameters: Mapping[str, Any], v: Variation, moves_object: bool = Fals
     for f, finger in enumerate(sections["fingers"]):
         finger["q0"] = [float(x) for x in q0[3 * f:3 * f + 3]]
     new = load_hand(sections)
-    manip, suppress, reflex = parameters[b.manipulation], parameters[b.suppresser], parameters[b.reflex]
+    manip, suppress, reflex = (parameters[b.block(role)] for role in ("manip", "suppress", "reflex"))
     overrides: dict[str, Any] = {
         **{f"{b.plant}.{section}": sections[section] for section in ("fingers", "object", "contact")},
-        f"{b.reflex}.ki": _number(reflex.get("ki", 50.0)) * v.ki,
-        f"{b.reflex}.safety_ratio": v.safety_ratio,
-        f"{b.manipulation}.kp": _scaled(manip.get("kp", 3.0), v.kp),
-        f"{b.manipulation}.kd": _scaled(manip.get("kd", 0.04), v.kd),
-        f"{b.suppresser}.S_a": _scaled(suppress.get("S_a", 100.0), v.S_a),
-        f"{b.suppresser}.S_b": _scaled(suppress.get("S_b", 0.03), v.S_b),
+        b.resolve("reflex.ki"): _number(_given(reflex, GraspReflex, "ki")) * v.ki,
+        b.resolve("reflex.safety_ratio"): v.safety_ratio,
+        b.resolve("manip.kp"): _scaled(_given(manip, ManipulationPD, "kp"), v.kp),
+        b.resolve("manip.kd"): _scaled(_given(manip, ManipulationPD, "kd"), v.kd),
+        b.resolve("suppress.S_a"): _scaled(_given(suppress, Suppresser, "S_a"), v.S_a),
+        b.resolve("suppress.S_b"): _scaled(_given(suppress, Suppresser, "S_b"), v.S_b),
     }
     trajectories = copy.deepcopy(dict(manip.get("trajectories") or {}))
     if moves_object:
@@ -174,7 +177,7 @@ def carry(parameters: Mapping[str, Any], v: Variation, moves_object: bool = Fals
         for w in spec["waypoints"]:
             _ik(new, f, w[1:4], q0[3 * f:3 * f + 3])
     if trajectories:
-        overrides[f"{b.manipulation}.trajectories"] = trajectories
+        overrides[b.resolve("manip.trajectories")] = trajectories
     if "push" in parameters:
         after = list(parameters["push"].get("after", [0.0, 0.0, 0.0]))
         overrides["push.after"] = [v.push[0], v.push[1], *after[2:]]
@@ -203,6 +206,13 @@ def _carry_motion(trajectories: dict, old: Hand, new: Hand, carried: FaceMap) ->
 
 def _ik(hand: Hand, finger: int, pose, near) -> np.ndarray:
     return finger_ik_near(hand, finger, [float(x) for x in pose], near)
+
+
+def _given(parameters: Mapping[str, Any], block_type: type, name: str) -> Any:
+    """A block's parameter as the diagram gives it, else the block type's default."""
+    if name in parameters:
+        return parameters[name]
+    return inspect.signature(block_type).parameters[name].default
 
 
 def _number(value: Any) -> float:

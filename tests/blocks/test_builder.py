@@ -193,6 +193,9 @@ def test_every_shipped_diagram_saved_elsewhere_loads_to_the_same_diagram(tmp_pat
         d = load_diagram(path)
         again = load_diagram(save_diagram(d, tmp_path / path.name))
         assert structure(again) == structure(d), path.name
+    # a subsystem file the new folder cannot reach is written beside the diagram
+    assert load_diagram(tmp_path / "regrasp.ctrl.yaml").inputs.keys() == load_diagram(ROOT / "diagrams" /
+                                                                                     "controller.yaml").inputs.keys()
 
 
 def test_a_path_parameter_is_written_from_the_new_file(tmp_path):

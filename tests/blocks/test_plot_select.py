@@ -13,7 +13,7 @@ from blocks.plot_select import SelectionError, select, split_signals
 def results() -> Results:
     t = np.arange(4.0)
     signals = {"plant.q": (t, np.arange(24.0).reshape(4, 6)), "ref.y": (t, np.ones((4, 1))),
-               "fmu.y": (t, np.zeros((4, 2)))}
+               "fmu.y": (t, np.zeros((4, 2))), "ctrl.inner.pi.y": (t, np.zeros((4, 2)))}
     info = {"element_labels": {"plant.q": ["thumb.1", "thumb.2", "fore.1", "fore.2", "1,1", "3"],
                                "fmu.y": ["1", "2"]}}
     return Results(signals, info)
@@ -35,6 +35,7 @@ def test_a_signal_is_every_element_with_its_labels():
     ("plant.q[1,1]", (4,)),  # a label with a comma is a label
     ("plant.q[3]", (5,)),  # a label wins over an index
     ("fmu.y[1]", (0,)),  # the FMU's y[1] is its first element
+    ("ctrl.inner.pi.y[1]", (1,)),  # a signal of a block inside nested subsystems
 ])
 def test_elements_by_label_index_and_slice(text, picked):
     (trace,) = select(results(), text)
@@ -47,7 +48,7 @@ def test_commas_outside_brackets_overlay_signals():
 
 
 @pytest.mark.parametrize("text, word", [
-    ("nope.y", "signal 'nope.y' was not logged; logged signals: plant.q, ref.y, fmu.y"),
+    ("nope.y", "signal 'nope.y' was not logged; logged signals: plant.q, ref.y, fmu.y, ctrl.inner.pi.y"),
     ("plant.q[fore.9]", "has no element 'fore.9'; its elements: thumb.1, thumb.2"),
     ("plant.q[6]", "index 6 is out of range"), ("plant.q[4:2]", "selects no element"),
     ("plant.q[::0]", "step must not be 0"), ("plant", "is not a signal"), ("ref.y,", "'' is not a signal"),

@@ -94,13 +94,13 @@ def test_every_block_of_the_regrasp_diagram_has_a_kernel(diagram):
                             "GraspReflex.update", "ManipulationPD.output", "Suppresser.output", "Suppresser.update",
                             "ObjectSupport.output"}
     assert all(isinstance(a, int) and a != 0 for a in kernels.values())
-    plant, reflex = b["plant"].kernel(), b["reflex"].kernel()
+    plant, reflex = b["plant"].kernel(), b["ctrl.reflex"].kernel()
     assert plant.output and plant.update and plant.advance and plant.bind and plant.nogil
     assert _run_kernel(b["plant"]).context and _run_kernel(b["plant"]).nogil
     assert reflex.output and reflex.update and not reflex.advance and reflex.nogil
-    suppress = b["suppress"].kernel()  # the shipped suppresser low-passes: it has a state
+    suppress = b["ctrl.suppress"].kernel()  # the shipped suppresser low-passes: it has a state
     assert suppress.output and suppress.update and not suppress.advance and suppress.nogil
-    for name in ("manip", "support"):
+    for name in ("ctrl.manip", "support"):
         k = b[name].kernel()
         assert k.output and not k.update and not k.advance and k.context and k.nogil
 
@@ -115,7 +115,7 @@ def test_blocks_not_bound_have_no_kernel():
 
 def test_kernels_equal_the_python_methods_along_a_regrasp(diagram):
     b = _blocks(diagram)
-    plant, reflex, manip, suppress, support = (b[n] for n in ("plant", "reflex", "manip", "suppress", "support"))
+    plant, reflex, manip, suppress, support = (b[n] for n in ("plant", "ctrl.reflex", "ctrl.manip", "ctrl.suppress", "support"))
     dt_plant, dt_reflex = float(plant.period), float(reflex.period)
     steps = round(dt_reflex / dt_plant)  # plant steps per reflex hit
     per_manip = round(float(manip.period) / dt_reflex)
@@ -165,7 +165,7 @@ def test_the_support_switches_off_at_until_in_both(diagram):
 def test_the_suppresser_takes_any_torques(diagram):
     from hierhand.control.suppresser import Suppresser
 
-    filtered = _blocks(diagram)["suppress"]
+    filtered = _blocks(diagram)["ctrl.suppress"]
     static = Suppresser(S_a=filtered.S_a, S_b=filtered.S_b, mode=filtered.mode)
     rng = np.random.default_rng(5)
     state = rng.normal(scale=0.05, size=9)
@@ -248,7 +248,7 @@ def test_a_bad_state_fails_in_the_output_as_in_python(diagram):
 
 
 def test_coincident_contacts_fail_the_reflex_as_in_python(diagram):
-    reflex = _blocks(diagram)["reflex"]
+    reflex = _blocks(diagram)["ctrl.reflex"]
     kernel = reflex.kernel()
     state = reflex.initial_state()
     # tip centres placed so that the contact points (centre plus radius along the normal) coincide
@@ -275,7 +275,7 @@ def test_coincident_contacts_fail_the_reflex_as_in_python(diagram):
 
 def test_an_unreachable_target_fails_the_manipulation_as_in_python():
     d = blocks.load_diagram(REGRASP)
-    manip = d.blocks["manip"].block
+    manip = d.blocks["ctrl.manip"].block
     # the middle finger's targets a metre away, in the packed waypoints (which the kernel's
     # record copies) and in the trajectory the Python path names the error from
     manip._waypoints[2, :, 1] += 1.0

@@ -1,6 +1,7 @@
 """Corpus cases for FMUs: code that must not run, archives that must not be unpacked,
-files that are not where they are said to be, settings that would only fail once a run
-has started, and Ctrl-C inside an FMU.
+files that are not where they are said to be (or not files), steps and arrays too large
+or small to be, settings that would only fail once a run has started, Ctrl-C inside an
+FMU, and FMUs that crash, call exit() or hang (which run in processes of their own).
 
 Most cases need no compiler: loading a diagram never loads an FMU's binary, so their
 FMUs carry a few bytes in its place. The cases that run an FMU use the test FMUs of
@@ -13,6 +14,8 @@ from __future__ import annotations
 import atexit
 import functools
 import json
+import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -27,17 +30,34 @@ NOT_A_LIBRARY = b"not a shared library: a diagram's validation never loads it"
 
 
 @functools.cache
-def _libraries() -> tuple[bytes, bytes, Path] | None:
-    """The marker library, the library that sends itself SIGINT inside doStep (and then
-    returns 'fatal'), and the folder the marker library leaves its traces in; None without
-    a compiler."""
-    if fmu_build.build_error():
-        return None
+def _scratch() -> Path:
+    """A folder for what a case cannot carry as a file (a FIFO), removed at exit."""
     root = Path(tempfile.mkdtemp(prefix="hostile-fmu-"))
     atexit.register(shutil.rmtree, root, True)
+    return root
+
+
+@functools.cache
+def _libraries() -> tuple[bytes, bytes, Path, bytes, bytes] | None:
+    """The marker library, the library that sends itself SIGINT inside doStep (and then
+    returns 'fatal'), the folder the marker library leaves its traces in, the misbehaving
+    first-order library (``sources/misbehave.h``) and the plain one; None without a compiler."""
+    if fmu_build.build_error():
+        return None
+    root = _scratch()
     (root / "markers").mkdir()
     marker = fmu_build.marker_library(root, root / "markers")
-    return marker, fmu_build.interrupting_library(root, 4), root / "markers"
+    return (marker, fmu_build.interrupting_library(root, 4), root / "markers",
+            fmu_build.misbehaving_library(root, "cs2"),
+            fmu_build.compile_library(root / f"plain{fmu_build.EXT}", "first_order_fmi2.c", "fmi2_unsupported.c"))
+
+
+@functools.cache
+def _fifo() -> str:
+    """The path of a FIFO named like an FMU (a reader opening it would wait for a writer)."""
+    path = _scratch() / "plant.fmu"
+    os.mkfifo(path)
+    return str(path)
 
 
 def fmu(library: bytes = NOT_A_LIBRARY, xml: str = XML, identifier: str = "FirstOrder",
@@ -63,26 +83,51 @@ def ran(identifier: str, expected: set[str]):
 
 
 def saved_as(status: str):
-    """A ``check``: the run's results were saved in ``out`` with this status."""
+    """A ``check``: the run's results were saved in ``out`` with a status that begins so."""
     def check(folder: Path, proc: subprocess.CompletedProcess) -> None:
         info = json.loads((folder / "out" / "run.json").read_text())
-        assert info["status"] == status, info["status"]
+        assert info["status"].startswith(status), info["status"]
         assert (folder / "out" / "signals.npz").is_file()
     return check
 
 
-def diagram(path: str = "plant.fmu", period: str = "0.1 s") -> str:
+def diagram(path: str = "plant.fmu", period: str = "0.1 s", params: str = "") -> str:
     """A diagram driving the first-order FMU ``path`` with a step."""
     return f"""\
 name: fmu-case
 time: {{t_end: 0.5 s}}
 blocks:
   src: {{type: Step, period: 0.1 s, params: {{time: 0.2}}}}
-  plant: {{type: FMU, period: {period}, params: {{path: {path}}}}}
+  plant: {{type: FMU, period: {period}, params: {{path: {path}{', ' + params if params else ''}}}}}
 connections:
   - src.y -> plant.u
 log: [plant.y]
 """
+
+
+def prints(text: str):
+    """A ``check``: the command printed ``text`` on stdout."""
+    def check(folder: Path, proc: subprocess.CompletedProcess) -> None:
+        assert text in proc.stdout, proc.stdout
+    return check
+
+
+def with_step(step: str) -> str:
+    """The first-order modelDescription with the DefaultExperiment stepSize ``step``."""
+    return XML.replace('stepSize="0.1"', f'stepSize="{step}"')
+
+
+XML3 = (fmu_build.SOURCES / "first_order_fmi3.xml").read_text()
+BILLION = re.sub(r'(<Float64 name="z".*?<Dimension start=)"2"', r'\1"1000000000"', XML3, flags=re.S)
+assert BILLION != XML3
+
+
+def fmu3(xml: str) -> bytes:
+    """An FMI 3 FMU archive of ``xml`` with a few bytes as its binary."""
+    import fmpy
+
+    return fmu_build.zip_bytes({"modelDescription.xml": xml,
+                                f"binaries/{fmpy.platform_tuple}/FirstOrder3{fmu_build.EXT}": NOT_A_LIBRARY})
 
 
 FIXED_STEP = XML.replace('canHandleVariableCommunicationStepSize="true"', 'canHandleVariableCommunicationStepSize="false"')
@@ -115,15 +160,46 @@ CASES = [
          files={"plant.fmu": "just text"}),
     Case("fmu-info-reads-a-binary-it-never-loads", ("fmu", "info", "plant.fmu"), 0, "",
          files={"plant.fmu": fmu()}),
+    Case("fmu-path-naming-a-fifo-is-refused-unopened", ("validate", "d.yaml"), 2,
+         r"d\.yaml:5: block 'plant' \(FMU\): FMU '.*plant\.fmu' cannot be read as an FMU: it is a FIFO \(named "
+         r"pipe\), not a regular file", files={"d.yaml": diagram(_fifo())}, timeout=30),
+    Case("fmu-info-of-a-fifo-is-refused-unopened", ("fmu", "info", _fifo()), 2,
+         r"^hierhand: error: FMU '.*' cannot be read as an FMU: it is a FIFO", timeout=30),
+    Case("fmu-path-naming-dev-zero-is-refused-unread", ("validate", "d.yaml"), 2,
+         r"d\.yaml:5: block 'plant' \(FMU\): FMU '/dev/zero' cannot be read as an FMU: it is a device, not a "
+         r"regular file", files={"d.yaml": diagram("/dev/zero")}, timeout=30),
+    Case("fmu-default-step-1e-308-is-out-of-range", ("validate", "d.yaml"), 2,
+         r"d\.yaml:5: block 'plant' \(FMU\): an FMU block needs a period, .* its DefaultExperiment stepSize "
+         r"'1e-308' is out of range \(1e-12 s to 1e9 s\)",
+         files={"d.yaml": diagram().replace("period: 0.1 s, params: {path", "params: {path"),
+                "plant.fmu": fmu(xml=with_step("1e-308"))}, timeout=30),
+    Case("fmu-default-step-1e308-is-out-of-range", ("run", "d.yaml", "-o", "out"), 2,
+         r"d\.yaml:5: block 'plant' \(FMU\): .*stepSize '1e308' is out of range",
+         files={"d.yaml": diagram().replace("period: 0.1 s, params: {path", "params: {path"),
+                "plant.fmu": fmu(xml=with_step("1e308"))}, absent=("out",), timeout=30),
+    Case("fmu-default-step-of-a-billion-digits-exponent-is-not-a-number-of-seconds", ("validate", "d.yaml"), 2,
+         r"stepSize '1e999999999' is not a positive finite number of seconds",
+         files={"d.yaml": diagram().replace("period: 0.1 s, params: {path", "params: {path"),
+                "plant.fmu": fmu(xml=with_step("1e999999999"))}, timeout=30),
+    Case("fmu-info-shows-an-unusable-step-as-such", ("fmu", "info", "plant.fmu"), 0, "",
+         files={"plant.fmu": fmu(xml=with_step("1e-308"))}, timeout=30,
+         check=prints("step 1e-308 (not usable: out of range (1e-12 s to 1e9 s))")),
+    Case("fmu-fmi3-array-of-a-billion-elements-is-refused", ("validate", "d.yaml"), 2,
+         r"d\.yaml:5: block 'plant' \(FMU\): variable 'z' of FMU 'plant\.fmu' is an array of 1000000000 "
+         r"elements, more than the limit of 1000000",
+         files={"d.yaml": diagram(), "plant.fmu": fmu3(BILLION)}, timeout=30),
 ]
+
 
 
 def _running_cases() -> list[Case]:
     """validate, graph and fmu info read the FMU without running its code; run runs it;
-    Ctrl-C inside the FMU's doStep stops the run as interrupted (exit 130), results saved."""
+    Ctrl-C inside the FMU's doStep (in the run's process) stops the run as interrupted
+    (exit 130), results saved; an FMU that crashes, calls exit() or hangs (in a process of
+    its own, the default for FMUs of other tools) fails the run (exit 1), results saved."""
     if _libraries() is None:
         return []
-    marker, interrupting, _ = _libraries()
+    marker, interrupting, _, misbehaving, plain = _libraries()
     cases = []
     for name, argv in (("validate", ("validate", "d.yaml")), ("graph", ("graph", "d.yaml")),
                        ("graph-dot", ("graph", "d.yaml", "-o", "g.dot")), ("info", ("fmu", "info", "plant.fmu"))):
@@ -135,8 +211,43 @@ def _running_cases() -> list[Case]:
                       files={"d.yaml": diagram(), "plant.fmu": fmu(marker, identifier="Traced_run")},
                       check=ran("Traced_run", {"loaded", "instantiated"})))
     cases.append(Case("fmu-ctrl-c-in-do-step-is-an-interrupt", ("run", "d.yaml", "-o", "out", "-q"), 130,
-                      r"interrupted at t=0\.2 s by SIGINT", files={"d.yaml": diagram(), "plant.fmu": fmu(interrupting)},
+                      r"interrupted at t=0\.2 s by SIGINT",
+                      files={"d.yaml": diagram(params="isolation: none"), "plant.fmu": fmu(interrupting)},
                       check=saved_as("interrupted at t=0.2 s by SIGINT")))
+    run = ("run", "d.yaml", "-o", "out", "-q")
+    failed = r"hierhand: d\.yaml: failed at t={t} s: block 'plant' \(FMU\) {phase}: FMU 'plant\.fmu' "
+    for name, instructions, t, phase, message in (
+            ("segfault-in-do-step", "fmi2DoStep segv 0.2", "0.2", "update",
+             r"crashed in fmi2DoStep \(the step from t=0\.2 s to 0\.3 s\): SIGSEGV \(a segmentation fault"),
+            ("exit-0-in-do-step", "fmi2DoStep exit0 0.2", "0.2", "update",
+             r"called exit\(0\) in fmi2DoStep \(the step from t=0\.2 s to 0\.3 s\), which ended the process"),
+            ("abort-in-instantiate", "fmi2Instantiate abort", "0", "output",
+             r"crashed in fmi2Instantiate \(instantiating it\): SIGABRT \(an abort"),
+            ("stack-overflow-in-exit-initialization", "fmi2ExitInitializationMode overflow", "0", "output",
+             r"crashed in fmi2ExitInitializationMode \(initialising it at t=0 s\): SIGSEGV")):
+        cases.append(Case(f"fmu-{name}-fails-the-run-with-its-results", run, 1,
+                          failed.format(t=re.escape(t), phase=phase) + message,
+                          files={"d.yaml": diagram(), "plant.fmu": fmu(misbehaving, **{
+                              "resources__misbehave.txt": instructions})},
+                          check=saved_as(f"failed at t={t} s: block 'plant' (FMU)")))
+    cases.append(Case("fmu-hang-in-do-step-fails-the-run-after-its-call-timeout", run, 1,
+                      failed.format(t="0\\.3", phase="update")[:-1] + r": fmi2DoStep \(the step from t=0\.3 s to 0\.4 s\) "
+                      r"did not return within 1 s, so the FMU was stopped .*\(hint: if the FMU needs longer for one "
+                      r"call, raise the block's 'call_timeout'",
+                      files={"d.yaml": diagram(params="call_timeout: 1 s"),
+                             "plant.fmu": fmu(misbehaving, **{"resources__misbehave.txt": "fmi2DoStep hang 0.3"})},
+                      check=saved_as("failed at t=0.3 s: block 'plant' (FMU)")))
+    cases.append(Case("fmu-truncated-binary-is-a-bus-error-that-fails-the-run", run, 1,
+                      failed.format(t="0", phase="output") + r"crashed in loading its binary \(instantiating it\): "
+                      r"SIGBUS \(a bus error: e\.g\. a truncated or changed binary file\)",
+                      files={"d.yaml": diagram(), "plant.fmu": fmu(plain[:len(plain) // 2])},
+                      check=saved_as("failed at t=0 s: block 'plant' (FMU)")))
+    cases.append(Case("fmu-crash-in-terminate-leaves-the-run-complete-and-says-so", run, 0,
+                      r"FMU 'plant\.fmu' crashed in fmi2Terminate \(terminating it after its run\): SIGSEGV .*"
+                      r"\(after the run; its results are complete\)",
+                      files={"d.yaml": diagram(), "plant.fmu": fmu(misbehaving, **{
+                          "resources__misbehave.txt": "fmi2Terminate segv"})},
+                      check=saved_as("complete")))
     return cases
 
 

@@ -134,3 +134,32 @@ def me_fmu(build: Path, model: str, fmi: int, defines: dict[str, str] | None = N
     files = {"modelDescription.xml": (SOURCES / f"{model}_fmi{fmi}.xml").read_text(),
              f"binaries/{platform}/{identifier}{EXT}": library}
     return zip_files(build / f"{name or identifier}.fmu", files)
+
+
+MISBEHAVING = {
+    "cs2": (("first_order_fmi2.c", "fmi2_unsupported.c"), "first_order_fmi2.xml", "FirstOrder", 2),
+    "cs3": (("first_order_fmi3.c", "fmi3_unsupported.c"), "first_order_fmi3.xml", "FirstOrder3", 3),
+    "me2": (("linear.c", "me_fmi2.c", "fmi2_unsupported.c"), "linear_fmi2.xml", "Linear2", 2),
+}
+"""The test FMUs that can misbehave (``sources/misbehave.h``): FMI 2 and FMI 3 co-simulation
+(the first-order FMUs) and FMI 2 model exchange (the linear oscillator)."""
+
+
+def misbehaving_library(build: Path, kind: str) -> bytes:
+    """The library of the misbehaving test FMU ``kind`` (a key of MISBEHAVING), built in ``build``."""
+    sources, _, identifier, _ = MISBEHAVING[kind]
+    return compile_library(build / f"misbehaving_{identifier}{EXT}", *sources, "misbehave.c",
+                           defines={"MISBEHAVE": "1"})
+
+
+def misbehaving_fmu(path: Path, kind: str, library: bytes, instructions: str = "") -> Path:
+    """The misbehaving test FMU ``kind`` with ``library`` as its binary, at ``path``; it does
+    what ``instructions`` say (a line of ``sources/misbehave.h``: "fmi2DoStep segv 0.3"),
+    nothing unusual without them."""
+    _, xml, identifier, fmi = MISBEHAVING[kind]
+    platform = fmpy.platform if fmi == 2 else fmpy.platform_tuple
+    files: dict[str, bytes | str] = {"modelDescription.xml": (SOURCES / xml).read_text(),
+                                     f"binaries/{platform}/{identifier}{EXT}": library}
+    if instructions:
+        files["resources/misbehave.txt"] = instructions + "\n"
+    return zip_files(path, files)

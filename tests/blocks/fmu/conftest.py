@@ -10,11 +10,13 @@ import pytest
 fmpy = pytest.importorskip("fmpy")
 
 from .build import (  # noqa: E402
+    MISBEHAVING,
     SOURCES,
     build_error,
     compile_library,
     interrupting_library,
     marker_library,
+    misbehaving_library,
     zip_files,
 )
 
@@ -71,3 +73,13 @@ def fmus(tmp_path_factory) -> Fmus:
     interrupting = {status: interrupting_library(build, status) for status in (0, 4)}
     return Fmus(tmp_path_factory.mktemp("fmus"), lib2, lib3, marker_library(build, markers), markers,
                 interrupting)
+
+
+@pytest.fixture(scope="session")
+def misbehaving(tmp_path_factory) -> dict[str, bytes]:
+    """The libraries of the misbehaving test FMUs (``sources/misbehave.h``), by kind."""
+    why = build_error()
+    if why:
+        pytest.skip(why)
+    build = tmp_path_factory.mktemp("misbehaving")
+    return {kind: misbehaving_library(build, kind) for kind in MISBEHAVING}

@@ -12,6 +12,8 @@ from __future__ import annotations
 from fractions import Fraction
 
 import gc
+import os
+import re
 import shutil
 from pathlib import Path
 
@@ -20,6 +22,7 @@ import pytest
 
 import blocks
 from blocks import DiagramError, SimulationError, load_diagram, loads_diagram, simulate
+from blocks.fmu import FMU
 
 fmpy = pytest.importorskip("fmpy")
 
@@ -27,13 +30,13 @@ from .build import compile_library, fmi2_files, zip_files  # noqa: E402
 
 
 def diagram(path: Path, period: str = "0.1 s", start_values: str = "{}", source: str | None = None,
-            extra: str = "", t_end: str = "1 s", log: str = "[f.y, f.z]"):
+            extra: str = "", t_end: str = "1 s", log: str = "[f.y, f.z]", params: str = ""):
     src = source or "{type: Step, period: 0.1 s, params: {time: 0.3, before: 1.0, after: 2.0}}"
     return loads_diagram(f"""
 time: {{t_end: {t_end}}}
 blocks:
   src: {src}
-  f: {{type: FMU, period: {period}, params: {{path: '{path}', start_values: {start_values}}}}}
+  f: {{type: FMU, period: {period}, params: {{path: '{path}', start_values: {start_values}{', ' + params if params else ''}}}}}
 {extra}
 connections:
   - src.y -> f.u
@@ -278,9 +281,10 @@ def test_dostep_discard_is_a_failure(fmus):
 def test_ctrl_c_during_a_step_is_an_interrupt_not_an_fmu_failure(fmus, tmp_path, status):
     """SIGINT arrives inside doStep, which then logs (the KeyboardInterrupt is raised in the
     log callback, where ctypes loses it) and returns ok, or 'fatal' as an FMU whose memory
-    callback was broken would. Either way the run stops as interrupted, results kept."""
+    callback was broken would. Either way the run stops as interrupted, results kept. (In the
+    run's process: the SIGINT is the FMU's own process's.)"""
     path = zip_files(tmp_path / "interrupting.fmu", fmi2_files(fmus.interrupting[status]))
-    d = diagram(path, log="[f.y]")
+    d = diagram(path, log="[f.y]", params="isolation: none")
     try:
         results = simulate(d)
     except KeyboardInterrupt:  # pragma: no cover - would otherwise stop the whole test session
@@ -336,7 +340,7 @@ def test_a_fixed_internal_step_is_shown_and_not_enforced(fmus, version):
     path = fmus.with_fixed_step(version, "0.04", f"fixed{version}.fmu")
     d = diagram(path, period="0.1 s")
     assert d.blocks["f"].block.describe() == (f"FMI {version}.0 co-simulation FMU '{path}' "
-                                              "(fixed internal step 40 ms, informative)")
+                                              "(fixed internal step 40 ms, informative), runs in a process of its own")
     results = simulate(d)
     assert results.complete and len(results["f.y"][0]) == 11
 
@@ -452,3 +456,26 @@ def test_unsafe_archive_is_refused_by_the_block(fmus, tmp_path):
     msg = load_error(lambda: diagram(evil))
     assert "unsafe FMU archive" in msg and "'../evil.txt'" in msg
     assert not (tmp_path.parent / "evil.txt").exists()
+
+
+def test_sizes_beyond_what_a_run_can_allocate_are_load_errors(fmus):
+    """An FMI 3 array, the states and the event indicators are allocated per run: 10^9 of
+    them are refused when the block is made, not a MemoryError when it runs."""
+    many = fmus.make("indicators.fmu", fmus.xml2.replace('numberOfEventIndicators="0"',
+                                                          'numberOfEventIndicators="4000000000"'))
+    with pytest.raises(ValueError, match=r"declares 4000000000 event indicators, more than the limit of 1000000"):
+        FMU(many)
+    big = fmus.make("array.fmu", re.sub(r'(<Float64 name="z".*?<Dimension start=)"2"', r'\1"1000000000"',
+                                        fmus.xml3, flags=re.S), version=3)
+    with pytest.raises(ValueError, match=r"variable 'z' of FMU '.*' is an array of 1000000000 elements"):
+        FMU(big)
+
+
+def test_an_fmu_path_that_is_not_a_regular_file_is_refused_unopened(tmp_path):
+    os.mkfifo(tmp_path / "pipe.fmu")
+    with pytest.raises(ValueError, match=r"it is a FIFO \(named pipe\), not a regular file"):
+        FMU(tmp_path / "pipe.fmu")
+    with pytest.raises(ValueError, match=r"FMU '/dev/zero' cannot be read as an FMU: it is a device"):
+        FMU("/dev/zero")
+    with pytest.raises(ValueError, match=r"is a folder; give the path of the .fmu file"):
+        FMU(tmp_path)

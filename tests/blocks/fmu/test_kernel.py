@@ -67,12 +67,12 @@ def first_order(fmus) -> dict[int, Path]:
 
 
 def diagram(path: Path, start_values: str = "{}", extra: str = "", wires: str = "", offset: str = "",
-            t_end: str = "1 s", log: str = "[f.y, f.z, src.y]"):
+            t_end: str = "1 s", log: str = "[f.y, f.z, src.y]", params: str = ""):
     return loads_diagram(f"""
 time: {{t_end: {t_end}}}
 blocks:
   src: {{type: Ramp, period: 0.05 s, params: {{slope: 3.0, start: 0.1}}}}
-  f: {{type: FMU, period: 0.1 s{offset}, params: {{path: '{path}', start_values: {start_values}}}}}
+  f: {{type: FMU, period: 0.1 s{offset}, params: {{path: '{path}', start_values: {start_values}{', ' + params if params else ''}}}}}
 {extra}
 connections:
   - src.y -> f.u
@@ -118,11 +118,18 @@ def test_python_blocks_around_the_compiled_fmu(fmus, monkeypatch):
     assert counts == {"output": 1}
 
 
+def handed(kind: str, isolation: str) -> str:
+    """The kind of slow call that hands a step which was not a plain success to Python: the
+    FMU call's own in the run's process, 'hosted' for an FMU in a process of its own."""
+    return kind if isolation == "none" else "hosted"
+
+
+@pytest.mark.parametrize("isolation", ["none", "process"])
 @pytest.mark.parametrize("version", [2, 3])
-def test_a_failing_step_inside_a_fused_stretch_fails_as_in_python(first_order, monkeypatch, version):
+def test_a_failing_step_inside_a_fused_stretch_fails_as_in_python(first_order, monkeypatch, version, isolation):
     """doStep fails at t = 0.3 s (u = 0.6 exceeds the threshold), inside a C call that runs
     the events at 0.3 and 0.35 s: same status, same samples up to there."""
-    d = diagram(first_order[version], start_values="{threshold: 0.55}")
+    d = diagram(first_order[version], start_values="{threshold: 0.55}", params=f"isolation: {isolation}")
     reference = python(monkeypatch, d)
     counts = slow_calls(monkeypatch)
     compiled = simulate(d)
@@ -130,7 +137,7 @@ def test_a_failing_step_inside_a_fused_stretch_fails_as_in_python(first_order, m
     assert f"fmi{version}DoStep at t=0.3 s (step 0.1 s) returned status 'error'" in compiled.status
     assert "exceeds the threshold" in compiled.status                 # the FMU's log line
     assert_same(compiled, reference)
-    assert counts == {"output": 1, "step": 1}
+    assert counts == {"output": 1, handed("step", isolation): 1}
     assert simulate(d).status == compiled.status                      # the broken instance was not pooled
 
 
@@ -149,8 +156,9 @@ log: [f.y]
     assert_same(compiled, reference)
 
 
+@pytest.mark.parametrize("isolation", ["none", "process"])
 @pytest.mark.parametrize("which, failing", [("set", "fmi2SetReal"), ("get", "fmi2GetReal")])
-def test_a_failing_set_or_get_through_the_kernel_fails_as_in_python(tmp_path, monkeypatch, which, failing):
+def test_a_failing_set_or_get_through_the_kernel_fails_as_in_python(tmp_path, monkeypatch, which, failing, isolation):
     """The FMU refuses to take u (to give y) from t = 0.3 s: inside a fused C call, the
     same status, FMU log line and samples as through the Python methods."""
     why = build_error()
@@ -159,7 +167,7 @@ def test_a_failing_set_or_get_through_the_kernel_fails_as_in_python(tmp_path, mo
     library = compile_library(tmp_path / f"fail_{which}{fmpy.sharedLibraryExtension}", "first_order_fmi2.c",
                               "fmi2_unsupported.c", defines={f"FAIL_{which.upper()}_AT": "0.3"})
     path = zip_files(tmp_path / f"fail_{which}.fmu", fmi2_files(library))
-    d = diagram(path)
+    d = diagram(path, params=f"isolation: {isolation}")
     reference = python(monkeypatch, d)
     counts = slow_calls(monkeypatch)
     compiled = simulate(d)
@@ -168,7 +176,7 @@ def test_a_failing_set_or_get_through_the_kernel_fails_as_in_python(tmp_path, mo
     assert f"{failing} returned status 'error'" in compiled.status
     assert f"cannot {which} " in compiled.status                          # the FMU's log line
     assert_same(compiled, reference)
-    assert counts == {"output": 1, which: 1}
+    assert counts == {"output": 1, handed(which, isolation): 1}
     assert simulate(d).status == compiled.status                          # the broken instance was not pooled
 
 
@@ -214,15 +222,18 @@ def terminating(tmp_path_factory) -> dict[int, Path]:
     return out
 
 
+@pytest.mark.parametrize("isolation", ["none", "process"])
 @pytest.mark.parametrize("fmi", [2, 3])
 @pytest.mark.parametrize("stop_at, end", [(0.25, 0.3), (0.3, 0.3)])
-def test_termination_through_the_kernel_ends_the_run_as_in_python(terminating, monkeypatch, fmi, stop_at, end):
+def test_termination_through_the_kernel_ends_the_run_as_in_python(terminating, monkeypatch, fmi, stop_at, end,
+                                                                   isolation):
     """The request comes back from a step inside a fused C call (a 0.05 s clock fires in
     between); the run ends at the FMU's next hit, every block logged up to there."""
     d = loads_diagram(f"""
 time: {{t_end: 1 s}}
 blocks:
-  fmu: {{type: FMU, period: 0.1 s, params: {{path: '{terminating[fmi]}', start_values: {{stop_at: {stop_at}}}}}}}
+  fmu: {{type: FMU, period: 0.1 s, params: {{path: '{terminating[fmi]}', start_values: {{stop_at: {stop_at}}},
+                                            isolation: {isolation}}}}}
   clock: {{type: Ramp, period: 0.05 s, params: {{slope: 1}}}}
 connections: [clock.y -> fmu.{"r_in" if fmi == 2 else "f_in"}]
 log: all
@@ -236,16 +247,17 @@ log: all
     assert compiled.ended_by["time"] == pytest.approx(end)
     assert "requested to terminate the simulation" in compiled.ended_by["reason"]
     assert_same(compiled, reference)
-    assert counts == {"output": 1, "step": 1}
+    assert counts == {"output": 1, handed("step", isolation): 1}
 
 
 @pytest.mark.parametrize("status", [0, 4], ids=["ok", "fatal"])
 def test_ctrl_c_inside_a_compiled_step_is_the_runs_interrupt(fmus, monkeypatch, tmp_path, status):
     """SIGINT inside doStep at t = 0.2 s, within a fused C call: the interrupt the FMU's
     log callback noted is raised after the step (ok) or by the failure (fatal), and the
-    run stops as interrupted with the results so far, as in Python."""
+    run stops as interrupted with the results so far, as in Python. (In the run's process:
+    the SIGINT is the FMU's own process's.)"""
     path = zip_files(tmp_path / "interrupting.fmu", fmi2_files(fmus.interrupting[status]))
-    d = diagram(path, log="[f.y, src.y]")
+    d = diagram(path, log="[f.y, src.y]", params="isolation: none")
     try:
         reference = python(monkeypatch, d)
         counts = slow_calls(monkeypatch)

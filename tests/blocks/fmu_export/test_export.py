@@ -124,11 +124,12 @@ def toy_with(what: str, ctrl: str) -> str:
     return TOP.replace("name: toy-composed", f"name: toy-{what}").replace("{diagram: lib/pi.yaml}", ctrl)
 
 
-@pytest.mark.parametrize("fmi", [2, 3])
-def test_a_subsystem_leaves_with_its_inputs_and_outputs_and_feeds_through_as_native(tmp_path, fmi):
+@pytest.mark.parametrize("fmi,isolation", [(2, "none"), (3, "process")])
+def test_a_subsystem_leaves_with_its_inputs_and_outputs_and_feeds_through_as_native(tmp_path, fmi, isolation):
     """The toy's controller (inputs: and outputs:) as an FMU: its output depends on its
     input (the 10 ms gain), which the ModelStructure says; the toy with the FMU read with
-    feedthrough is the toy with the subsystem, to the last bit."""
+    feedthrough, in the run's process or in one of its own, is the toy with the subsystem,
+    to the last bit."""
     (tmp_path / "pi.yaml").write_text(PI)
     pi = blocks.load_diagram(tmp_path / "pi.yaml")
     path = export_fmu(pi, tmp_path / f"pi{fmi}.fmu", fmi)
@@ -137,7 +138,7 @@ def test_a_subsystem_leaves_with_its_inputs_and_outputs_and_feeds_through_as_nat
     assert [(u.variable.name, [d.name for d in u.dependencies]) for u in md.outputs] == [("u", ["e"])]
     (tmp_path / "composed.yaml").write_text(toy_with("composed", "{diagram: pi.yaml}"))
     (tmp_path / "fmu.yaml").write_text(toy_with(
-        "fmu", f'{{type: FMU, period: 1 ms, params: {{path: "{path}", feedthrough: true}}}}'))
+        "fmu", f'{{type: FMU, period: 1 ms, params: {{path: "{path}", feedthrough: true, isolation: {isolation}}}}}'))
     composed = blocks.simulate(blocks.load_diagram(tmp_path / "composed.yaml"))
     via_fmu = blocks.simulate(blocks.load_diagram(tmp_path / "fmu.yaml"))
     assert via_fmu.complete

@@ -172,11 +172,13 @@ def plant_fmu(tmp_path_factory) -> Path:
 
 
 def _copy_fmu_project(root: Path, fmu: Path) -> Path:
-    """The shipped FMU diagram in ``root/diagrams``, its FMU at ``../fmu/`` as it expects."""
+    """The shipped FMU diagram in ``root/diagrams`` with the subsystem it includes, its FMU at
+    ``../fmu/`` as it expects."""
     (root / "diagrams").mkdir(parents=True)
     (root / "fmu").mkdir()
     shutil.copy(fmu, root / "fmu" / "HandPlant_fmi2.fmu")
     shutil.copy(ROOT / "diagrams" / "regrasp_fmu.yaml", root / "diagrams")
+    shutil.copy(ROOT / "diagrams" / "controller.yaml", root / "diagrams")
     return root / "diagrams" / "regrasp_fmu.yaml"
 
 

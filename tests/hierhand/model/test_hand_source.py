@@ -50,7 +50,7 @@ def without(path: Path, parameter: str, out: Path) -> Path:
 
 def test_every_block_of_a_diagram_models_the_plants_hand_after_overrides():
     d = blocks.load_diagram(REGRASP, overrides=HEAVY)
-    plant, reflex, manip, support = (d.blocks[n].block for n in ("plant", "reflex", "manip", "support"))
+    plant, reflex, manip, support = (d.blocks[n].block for n in ("plant", "ctrl.reflex", "ctrl.manip", "support"))
     hand = plant.hand
     assert reflex.hand is hand and manip.hand is hand and support.hand is hand
     assert hand.params.object.mass == 0.36
@@ -84,7 +84,7 @@ def test_every_block_of_a_diagram_models_the_plants_hand_after_overrides():
 def test_the_diagrams_record_the_plants_name_and_the_overridden_hand():
     d = blocks.load_diagram(REGRASP, overrides=HEAVY)
     params = d.parameters()
-    assert params["reflex"]["hand"] == params["manip"]["hand"] == params["support"]["hand"] == "plant"
+    assert params["ctrl.reflex"]["hand"] == params["ctrl.manip"]["hand"] == params["support"]["hand"] == "plant"
     assert params["plant"]["object"] == {"mass": 0.36}
     assert params["plant"]["fingers"][1]["links"][0]["length"] == 0.041
     assert params["plant"]["fingers"][2] == default_hand_dict()["fingers"][2]
@@ -94,9 +94,9 @@ def test_the_diagrams_record_the_plants_name_and_the_overridden_hand():
 def test_every_shipped_diagram_gives_its_hand_once(name):
     d = blocks.load_diagram(ROOT / "diagrams" / f"{name}.yaml")
     refs = {str(r) for r in d.references()}
-    assert refs == {"reflex.hand -> plant", "manip.hand -> plant", "support.hand -> plant"}
+    assert refs == {"ctrl.reflex.hand -> plant", "ctrl.manip.hand -> plant", "support.hand -> plant"}
     assert d.blocks["support"].type_name == "ObjectSupport"
-    assert set(d.parameters()["reflex"]) & {"gravity", "fingers", "object", "contact"} == set()
+    assert set(d.parameters()["ctrl.reflex"]) & {"gravity", "fingers", "object", "contact"} == set()
 
 
 def test_a_bad_index_into_the_fingers_is_one_line_naming_the_set():
@@ -109,9 +109,9 @@ def test_a_bad_index_into_the_fingers_is_one_line_naming_the_set():
 
 def test_a_hand_reference_to_another_kind_of_block_names_it():
     with pytest.raises(DiagramError) as info:
-        blocks.load_diagram(ROOT / "diagrams" / "grasp.yaml", overrides={"reflex.hand": "push"})
+        blocks.load_diagram(ROOT / "diagrams" / "grasp.yaml", overrides={"support.hand": "push"})
     (issue,) = info.value.issues
-    assert issue.message == ("block 'reflex' (GraspReflex): parameter 'hand': block 'push' is a Step; "
+    assert issue.message == ("block 'support' (ObjectSupport): parameter 'hand': block 'push' is a Step; "
                              "expected a HandPlant or an FMU exported by 'hierhand fmu export'")
 
 
@@ -167,8 +167,8 @@ def test_hand_of_anything_else_says_what_it_got(source, message):
 def test_the_fmu_diagram_models_the_fmus_hand(fmu):
     d = blocks.load_diagram(ROOT / "diagrams" / "regrasp_fmu.yaml",
                             overrides={"plant.path": str(fmu), "plant.start_values": {"object.mass": 0.36}})
-    hand = d.blocks["reflex"].block.hand
-    assert d.blocks["manip"].block.hand is hand and d.blocks["support"].block.hand is hand
+    hand = d.blocks["ctrl.reflex"].block.hand
+    assert d.blocks["ctrl.manip"].block.hand is hand and d.blocks["support"].block.hand is hand
     assert hand.params.object.mass == 0.36
     np.testing.assert_array_equal(d.blocks["support"].block.force, [0.0, 0.36 * 9.81, 0.0])
 
@@ -185,13 +185,14 @@ def validate(path: Path, cwd: Path) -> str:
 
 def test_validate_shows_where_the_hand_comes_from_and_who_uses_it(tmp_path):
     out = validate(REGRASP, tmp_path)
-    assert "references:\n  reflex.hand -> plant\n  manip.hand -> plant\n  support.hand -> plant\n" in out
-    assert ("  plant: hand: the built-in default hand; referenced by reflex.hand, manip.hand, support.hand\n"
+    assert "references:\n  ctrl.reflex.hand -> plant\n  ctrl.manip.hand -> plant\n  support.hand -> plant\n" in out
+    assert ("  plant: hand: the built-in default hand; referenced by ctrl.reflex.hand, ctrl.manip.hand, support.hand\n"
             in out)
     (tmp_path / "heavy.yaml").write_text("object: {mass: 0.36}\n")
     text = REGRASP.read_text().replace("plant:    {type: HandPlant, period: 0.1 ms}",
                                        "plant:    {type: HandPlant, period: 0.1 ms, params_file: heavy.yaml}")
     (tmp_path / "regrasp.yaml").write_text(text)
+    (tmp_path / "controller.yaml").write_text((REGRASP.parent / "controller.yaml").read_text())
     out = validate(tmp_path / "regrasp.yaml", tmp_path)
     assert (f"  plant: params_file {tmp_path / 'heavy.yaml'}; hand: object from the diagram, the rest from the "
-            "built-in default hand; referenced by reflex.hand, manip.hand, support.hand\n") in out
+            "built-in default hand; referenced by ctrl.reflex.hand, ctrl.manip.hand, support.hand\n") in out

@@ -51,9 +51,9 @@ def test_a_run_records_the_units_of_its_signals(tmp_path):
     r.save(tmp_path)
     again = blocks.Results.load(tmp_path)
     assert again.unit("plant.q") == "rad" and again.element_labels("plant.q") == JOINTS
-    assert again.unit("reflex.tau_g") == "N m" and again.unit("reflex.force") == "N"
+    assert again.unit("ctrl.reflex.tau_g") == "N m" and again.unit("ctrl.reflex.force") == "N"
     assert again.units("plant.obj") == ["m", "m", "rad"]
-    assert again.unit("suppress.share") == "1"
+    assert again.unit("ctrl.suppress.share") == "1"
 
 
 def test_hierhand_blocks_lists_units_beside_the_ports(tmp_path):

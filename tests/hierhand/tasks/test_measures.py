@@ -80,13 +80,18 @@ def test_object_dropped_on_hand_made_results():
     t = np.array([0.0, 1.0])
     contact = np.array([[1.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
     obj = np.array([[0.0, 0.1, 0.0], [0.0, 0.1, 0.0]])
-    r = Results({"plant.contact": (t, contact), "plant.obj": (t, obj)}, {"status": "complete"})
+    r = Results({"plant.contact": (t, contact), "plant.obj": (t, obj)},
+                {"status": "complete", "block_types": {"plant": "HandPlant"}})
     assert parse_metric("d=object_dropped").evaluate(r, None) == 1.0
 
 
 def test_a_hand_measure_on_a_diagram_without_the_plant_signals_is_refused():
-    with pytest.raises(SweepError, match="--metric m=separation_time: the signal plant.contact is not logged"):
+    with pytest.raises(SweepError, match="--metric m=separation_time: a hand task needs its plant: a HandPlant"):
         parse_metric("m=separation_time").check(load_diagram(ROOT / "diagrams" / "toy.yaml"))
+    unlogged = load_diagram(ROOT / "diagrams" / "regrasp.yaml", overrides={})
+    unlogged.log = [entry for entry in unlogged.log if entry.signal != "plant.contact"]
+    with pytest.raises(SweepError, match="--metric m=separation_time: the signal plant.contact is not logged"):
+        parse_metric("m=separation_time").check(unlogged)
 
 
 def test_peak_ratio_takes_the_disturbance_from_a_push_block_or_needs_it():
@@ -104,9 +109,9 @@ def test_a_sweep_of_the_regrasp_task_records_the_separation_time(tmp_path):
 
     out = tmp_path / "sweep"
     assert main(["sweep", str(ROOT / "diagrams" / "regrasp.yaml"), "-o", str(out), "--grid",
-                 "suppress.S_b=0.06,0.15", "--metric", "sep=separation_time", "--metric", "dropped=object_dropped",
+                 "ctrl.suppress.S_b=0.01,0.05", "--metric", "sep=separation_time", "--metric", "dropped=object_dropped",
                  "--serial", "-q"]) == 0
     with open(out / "sweep.csv", newline="") as f:
-        rows = {r["suppress.S_b"]: r for r in csv.DictReader(f)}
+        rows = {r["ctrl.suppress.S_b"]: r for r in csv.DictReader(f)}
     assert all(r["status"] == "ok" and r["dropped"] == "0.0" for r in rows.values())
-    assert 0 < float(rows["0.06"]["sep"]) < float(rows["0.15"]["sep"])
+    assert 0 < float(rows["0.01"]["sep"]) < float(rows["0.05"]["sep"])

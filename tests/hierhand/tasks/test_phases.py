@@ -58,7 +58,7 @@ def test_the_hand_registers_its_phases_as_plot_markers():
     assert notes == []
     spans = [(0.0, parameters["support"]["until"])]
     for finger in ("middle", "fore"):
-        waypoints = parameters["manip"]["trajectories"][finger]["waypoints"]
+        waypoints = parameters["ctrl.manip"]["trajectories"][finger]["waypoints"]
         spans.append((waypoints[0][0], waypoints[-1][0]))
     assert [(m.start, m.end) for m in found] == spans
     assert found[0].during == "object on its support (released at 0.1 s)"

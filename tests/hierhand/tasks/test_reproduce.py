@@ -122,13 +122,6 @@ def test_figures_and_report_are_written(reproduced):
         assert (out / "runs" / task / "signals.npz").is_file()
 
 
-def test_the_summary_takes_the_hand_of_the_plant_the_controller_refers_to():
-    from hierhand.tasks.reproduce import run_hand
-
-    parameters = {"manip": {"hand": "arm", "kp": 1.0}, "arm": {"object": {"pos": [0.01, 0.07]}}, "plant": {}}
-    assert run_hand(parameters).object_pose0.tolist() == [0.01, 0.07, 0.0]
-
-
 def test_a_missing_task_diagram_is_bad_input_found_before_anything_runs(tmp_path):
     from hierhand.tasks.reproduce import MissingDiagram, reproduce
 
@@ -145,13 +138,12 @@ def test_fig14_legend_names_the_unsuppressed_run_as_such():
     from matplotlib.figure import Figure
 
     from hierhand.tasks.figures import _torque_axes
-    from hierhand.tasks.summaries import TaskBlocks
 
     labels = {}
     for task in ("regrasp", "regrasp_unsuppressed"):
         results = blocks.simulate(blocks.load_diagram(ROOT / "diagrams" / f"{task}.yaml"), t_end=0.01)
         ax = Figure().add_subplot()
-        _torque_axes(ax, results, 3, TaskBlocks(), "Fig. 14")
+        _torque_axes(ax, results, 3, "Fig. 14")
         labels[task] = [t.get_text() for t in ax.get_legend().get_texts()]
     assert "grasp torque applied (after the suppresser)" in labels["regrasp"]
     unsuppressed = " | ".join(labels["regrasp_unsuppressed"])

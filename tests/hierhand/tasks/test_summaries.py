@@ -20,8 +20,13 @@ def test_rigid_target_recovers_a_known_motion():
     np.testing.assert_allclose(rigid_target(tips0, tips1, pose0), [*(pose0[:2] + shift), 0.2 + angle], atol=1e-12)
 
 
+TASK_INFO = {"block_types": {"plant": "HandPlant", "reflex": "GraspReflex", "manip": "ManipulationPD",
+                             "suppress": "Suppresser"}}
+"""What run.json says of a task diagram's blocks (the summaries find them by type)."""
+
+
 def fake_results(t, ratio, contact, obj):
-    return Results({"plant.ratio": (t, ratio), "plant.contact": (t, contact), "plant.obj": (t, obj)}, {})
+    return Results({"plant.ratio": (t, ratio), "plant.contact": (t, contact), "plant.obj": (t, obj)}, TASK_INFO)
 
 
 def test_grasp_summary_measures_peak_recovery_and_steady_ratio():
@@ -75,7 +80,7 @@ def regrasp_results(grasp_torque, touch_again=False):
     reflex[:, 1] = 0.001  # too small a torque to judge suppression by
     signals = {"plant.ratio": (t, np.zeros((t.size, 3))), "plant.contact": (t, contact), "plant.obj": (t, obj),
                "suppress.tau_g_eff": (t, tau_g), "manip.tau_m": (t_m, tau_m), "reflex.tau_g": (t, reflex)}
-    return Results(signals, {})
+    return Results(signals, TASK_INFO)
 
 
 def test_regrasp_summary_measures_the_grasp_torque_against_the_manipulation_torque():

@@ -12,7 +12,7 @@ import pytest
 import blocks
 from hierhand.control.inverse_kinematics import UnreachableError
 from hierhand.model import load_hand
-from hierhand.tasks.summaries import rigid_target
+from hierhand.tasks.summaries import TaskBlocks, rigid_target
 from hierhand.tasks.variations import SPREAD, Variation, carry, sample
 
 DIAGRAMS = Path(__file__).resolve().parents[3] / "diagrams"
@@ -22,7 +22,24 @@ SAME = Variation(mass=0.3, size=(1.0, 1.0), links=(1.0,) * 9, mu_s=1.0, stiffnes
 
 
 def parameters(task: str) -> dict:
-    return blocks.load_diagram(DIAGRAMS / f"{task}.yaml").parameters()
+    """A task diagram's parameters, keyed by role (``manip``, ``reflex``, ...) as well as by
+    block name."""
+    diagram = blocks.load_diagram(DIAGRAMS / f"{task}.yaml")
+    by_role = TaskBlocks.of_diagram(diagram)
+    values = diagram.parameters()
+    return {**values, **{role: values[getattr(by_role, role)] for role in ("manip", "reflex", "suppress")},
+            "roles": by_role}
+
+
+def carried(base: dict, v: Variation, moves_object: bool = False) -> dict:
+    """``carry``'s overrides, keyed by role."""
+    roles = base["roles"]
+    names = {roles.block(role): role for role in ("plant", "manip", "reflex", "suppress")}
+    out = {}
+    for key, value in carry(base, v, moves_object, roles).items():
+        block, _, rest = key.rpartition(".")
+        out[f"{names[block]}.{rest}" if block in names else key] = value
+    return out
 
 
 def hand_of(overrides: dict, base: dict):
@@ -36,7 +53,7 @@ def hand_of(overrides: dict, base: dict):
 @pytest.mark.parametrize("task, moves", [("grasp", False), ("manipulate", True), ("regrasp", False)])
 def test_the_shipped_point_carries_onto_itself(task, moves):
     base = parameters(task)
-    overrides = carry(base, SAME, moves)
+    overrides = carried(base, SAME, moves)
     hand = hand_of(overrides, base)
     np.testing.assert_allclose(hand.q0, load_hand(base["plant"]).q0, atol=1e-9)
     for name, spec in overrides.get("manip.trajectories", {}).items():  # the diagram's waypoints are rounded
@@ -47,7 +64,7 @@ def test_the_shipped_point_carries_onto_itself(task, moves):
 def test_a_larger_object_keeps_each_tip_s_gap_to_its_face():
     base = parameters("regrasp")
     bigger = dataclasses.replace(SAME, size=(1.2, 0.8))
-    overrides = carry(base, bigger)
+    overrides = carried(base, bigger)
     old, new = load_hand(base["plant"]), hand_of(overrides, base)
     gap = lambda hand, f: abs(hand.tip_positions(hand.q0)[f, 0] - hand.object_pose0[0]) - hand.params.object.size[0] / 2
     for f in (0, 1):  # thumb and forefinger beside the left and right faces
@@ -62,7 +79,7 @@ def test_a_larger_object_keeps_each_tip_s_gap_to_its_face():
 def test_a_manipulation_keeps_its_rigid_motion_of_the_object():
     base = parameters("manipulate")
     varied = dataclasses.replace(SAME, size=(0.85, 1.15), links=(1.05, 0.95, 1.0, 0.92, 1.08, 1.0, 1.0, 1.0, 1.0))
-    overrides = carry(base, varied, moves_object=True)
+    overrides = carried(base, varied, moves_object=True)
 
     def motion(trajectories, hand):
         first = np.array([trajectories[f]["waypoints"][0][1:3] for f in ("thumb", "fore")])
@@ -76,13 +93,13 @@ def test_a_manipulation_keeps_its_rigid_motion_of_the_object():
 def test_a_hand_that_cannot_reach_the_task_is_said_so():
     short = dataclasses.replace(SAME, links=(0.6,) * 9)
     with pytest.raises(UnreachableError, match="thumb: unreachable"):
-        carry(parameters("grasp"), short)
+        carried(parameters("grasp"), short)
 
 
 def test_the_push_and_the_gains_follow_the_variation():
     varied = dataclasses.replace(SAME, kp=1.3, kd=0.8, ki=2.0, S_a=0.7, S_b=1.4, safety_ratio=0.5, push=(3.0, 1.0))
     base = parameters("grasp")
-    overrides = carry(base, varied)
+    overrides = carried(base, varied)
     assert overrides["push.after"][:2] == [3.0, 1.0]
     assert overrides["manip.kp"] == pytest.approx(1.3 * base["manip"]["kp"])
     assert overrides["reflex.ki"] == pytest.approx(2.0 * base["reflex"]["ki"])

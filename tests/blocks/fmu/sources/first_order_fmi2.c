@@ -8,7 +8,8 @@
  * Value references: a 0, b 1, x0 2, threshold 3, scale 4 (Integer), frozen 5 (Boolean),
  * u 6, y 7, z[1] 8, z[2] 9.
  * Built with FAIL_SET_AT (FAIL_GET_AT), setting u (getting y) fails with fmi2Error, logged,
- * once the FMU's time has reached that value. Built with INTERNAL_STEP, doStep refuses
+ * once the FMU's time has reached that value. Built with MISBEHAVE (and misbehave.c), it
+ * misbehaves as its resources/misbehave.txt says (misbehave.h). Built with INTERNAL_STEP, doStep refuses
  * (fmi2Error, logged) a communication step that is not a whole multiple of it.
  */
 #include <math.h>
@@ -16,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "fmi2Functions.h"
+#include "misbehave.h"
 
 #ifdef TRACE_RUNS
 void trace_run(const char *event); /* marker.c: leaves a file saying the code ran */
@@ -58,6 +60,8 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const 
 fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
                               const fmi2CallbackFunctions *cb, fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)resources; (void)visible; (void)loggingOn;
+    MISBEHAVE_SETUP(resources);
+    MISBEHAVE_AT("fmi2Instantiate", 0.0);
 #ifdef TRACE_RUNS
     trace_run("instantiated");
 #endif
@@ -76,6 +80,7 @@ fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, f
 
 void fmi2FreeInstance(fmi2Component c) {
     Model *m = c;
+    MISBEHAVE_AT("fmi2FreeInstance", 0.0);
     if (!m) return;
     free(m->name);
     free(m);
@@ -84,21 +89,30 @@ void fmi2FreeInstance(fmi2Component c) {
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tolDef, fmi2Real tol, fmi2Real start,
                                fmi2Boolean stopDef, fmi2Real stop) {
     (void)tolDef; (void)tol; (void)stopDef; (void)stop;
+    MISBEHAVE_AT("fmi2SetupExperiment", start);
     ((Model *)c)->time = start;
     return fmi2OK;
 }
-fmi2Status fmi2EnterInitializationMode(fmi2Component c) { (void)c; return fmi2OK; }
+fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
+    MISBEHAVE_AT("fmi2EnterInitializationMode", ((Model *)c)->time);
+    return fmi2OK;
+}
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
     Model *m = c;
+    MISBEHAVE_AT("fmi2ExitInitializationMode", m->time);
     m->x = m->r[2];
     outputs(m);
     return fmi2OK;
 }
-fmi2Status fmi2Terminate(fmi2Component c) { (void)c; return fmi2OK; }
+fmi2Status fmi2Terminate(fmi2Component c) {
+    MISBEHAVE_AT("fmi2Terminate", ((Model *)c)->time);
+    return fmi2OK;
+}
 fmi2Status fmi2Reset(fmi2Component c) { set_defaults((Model *)c); outputs((Model *)c); return fmi2OK; }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, fmi2Real v[]) {
     Model *m = c;
+    MISBEHAVE_AT("fmi2GetReal", m->time);
     for (size_t i = 0; i < n; i++) {
         if (vr[i] >= NREAL) return fmi2Error;
 #ifdef FAIL_GET_AT
@@ -114,6 +128,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
 }
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n, const fmi2Real v[]) {
     Model *m = c;
+    MISBEHAVE_AT("fmi2SetReal", m->time);
     for (size_t i = 0; i < n; i++) {
         if (vr[i] > 6 || vr[i] == 4 || vr[i] == 5) {
             m->cb.logger(m->cb.componentEnvironment, m->name, fmi2Error, "logStatusError",
@@ -157,6 +172,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetPrior) {
     Model *m = c;
     (void)noSetPrior;
+    MISBEHAVE_AT("fmi2DoStep", t);
     fmi2Real u = m->r[6], threshold = m->r[3];
 #ifdef SIGINT_AT
     if (t >= SIGINT_AT) {

@@ -7,11 +7,14 @@
  *
  * Value references: a 0, b 1, x0 2, threshold 3, scale 4 (Int32), frozen 5 (Boolean),
  * u 6, y 7, z 8 (2 values), w 10 (2 values), wsum 11, yf 12 (Float32).
+ * Built with MISBEHAVE (and misbehave.c), it misbehaves as its resources/misbehave.txt
+ * says (misbehave.h).
  */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "fmi3Functions.h"
+#include "misbehave.h"
 
 #define TOKEN "{3f1c7d52-41a6-4f7e-9a55-0c3b3b6f0003}"
 
@@ -45,6 +48,8 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
         fmi3IntermediateUpdateCallback intermediateUpdate) {
     (void)name; (void)resources; (void)visible; (void)loggingOn; (void)eventModeUsed;
     (void)earlyReturnAllowed; (void)required; (void)nRequired; (void)intermediateUpdate;
+    MISBEHAVE_SETUP(resources);
+    MISBEHAVE_AT("fmi3InstantiateCoSimulation", 0.0);
     if (strcmp(token, TOKEN) != 0) {
         if (log) log(env, fmi3Error, "logStatusError", "wrong instantiation token");
         return NULL;
@@ -56,21 +61,28 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String name, fmi3String token, fmi3
     return m;
 }
 
-void fmi3FreeInstance(fmi3Instance i) { free(i); }
+void fmi3FreeInstance(fmi3Instance i) { MISBEHAVE_AT("fmi3FreeInstance", 0.0); free(i); }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance i, fmi3Boolean tolDef, fmi3Float64 tol,
         fmi3Float64 start, fmi3Boolean stopDef, fmi3Float64 stop) {
     (void)tolDef; (void)tol; (void)stopDef; (void)stop;
+    MISBEHAVE_AT("fmi3EnterInitializationMode", start);
     ((Model *)i)->time = start;
     return fmi3OK;
 }
-fmi3Status fmi3ExitInitializationMode(fmi3Instance i) { Model *m = i; m->x = m->x0; return fmi3OK; }
-fmi3Status fmi3Terminate(fmi3Instance i) { (void)i; return fmi3OK; }
+fmi3Status fmi3ExitInitializationMode(fmi3Instance i) {
+    Model *m = i;
+    MISBEHAVE_AT("fmi3ExitInitializationMode", m->time);
+    m->x = m->x0;
+    return fmi3OK;
+}
+fmi3Status fmi3Terminate(fmi3Instance i) { MISBEHAVE_AT("fmi3Terminate", ((Model *)i)->time); return fmi3OK; }
 fmi3Status fmi3Reset(fmi3Instance i) { set_defaults((Model *)i); return fmi3OK; }
 
 fmi3Status fmi3GetFloat64(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr,
                           fmi3Float64 v[], size_t nv) {
     Model *m = i;
+    MISBEHAVE_AT("fmi3GetFloat64", m->time);
     size_t k = 0;
     for (size_t j = 0; j < nvr; j++) {
         switch (vr[j]) {
@@ -92,6 +104,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance i, const fmi3ValueReference vr[], size_t 
 fmi3Status fmi3SetFloat64(fmi3Instance i, const fmi3ValueReference vr[], size_t nvr,
                           const fmi3Float64 v[], size_t nv) {
     Model *m = i;
+    MISBEHAVE_AT("fmi3SetFloat64", m->time);
     size_t k = 0;
     for (size_t j = 0; j < nvr; j++) {
         switch (vr[j]) {
@@ -139,6 +152,7 @@ fmi3Status fmi3DoStep(fmi3Instance i, fmi3Float64 t, fmi3Float64 h, fmi3Boolean 
                       fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
     Model *m = i;
     (void)noSetPrior;
+    MISBEHAVE_AT("fmi3DoStep", t);
     *eventHandlingNeeded = fmi3False;
     *terminateSimulation = fmi3False;
     *earlyReturn = fmi3False;

@@ -1,11 +1,13 @@
 /* The FMI 2.0 model-exchange API over a test model of me_model.h (built with
  * fmi2_unsupported.c and one model source). Modes are not checked; a value reference the
- * model does not have is an error, logged. */
+ * model does not have is an error, logged. Built with MISBEHAVE (and misbehave.c), it
+ * misbehaves as its resources/misbehave.txt says (misbehave.h). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "fmi2Functions.h"
 #include "me_model.h"
+#include "misbehave.h"
 #ifdef SIGINT_AT
 #include <signal.h> /* Ctrl-C in fmi2GetDerivatives once t >= SIGINT_AT, then a log message, then SIGINT_STATUS */
 #endif
@@ -32,6 +34,8 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean on, size_t n, const 
 fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid, fmi2String resources,
                               const fmi2CallbackFunctions *cb, fmi2Boolean visible, fmi2Boolean loggingOn) {
     (void)resources; (void)visible; (void)loggingOn;
+    MISBEHAVE_SETUP(resources);
+    MISBEHAVE_AT("fmi2Instantiate", 0.0);
     if (type != fmi2ModelExchange || strcmp(guid, MODEL_TOKEN) != 0) {
         if (cb && cb->logger) cb->logger(cb->componentEnvironment, name, fmi2Error, "logStatusError",
                                          "not a model-exchange instantiation of this FMU (GUID %s)", guid);
@@ -108,6 +112,7 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 
 fmi2Status fmi2EnterEventMode(fmi2Component c) { (void)c; return fmi2OK; }
 fmi2Status fmi2NewDiscreteStates(fmi2Component c, fmi2EventInfo *info) {
+    MISBEHAVE_AT("fmi2NewDiscreteStates", ((Instance *)c)->v.time);
     Event e = {false, false, false, INFINITY};
     model_event(&((Instance *)c)->v, &e);
     info->newDiscreteStatesNeeded = e.again;
@@ -122,12 +127,17 @@ fmi2Status fmi2EnterContinuousTimeMode(fmi2Component c) { (void)c; return fmi2OK
 fmi2Status fmi2CompletedIntegratorStep(fmi2Component c, fmi2Boolean noSetPrior, fmi2Boolean *enterEventMode,
                                        fmi2Boolean *terminateSimulation) {
     (void)noSetPrior;
+    MISBEHAVE_AT("fmi2CompletedIntegratorStep", ((Instance *)c)->v.time);
     *enterEventMode = model_step_event(&((Instance *)c)->v);
     *terminateSimulation = fmi2False;
     return fmi2OK;
 }
 
-fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) { ((Instance *)c)->v.time = time; return fmi2OK; }
+fmi2Status fmi2SetTime(fmi2Component c, fmi2Real time) {
+    MISBEHAVE_AT("fmi2SetTime", time);
+    ((Instance *)c)->v.time = time;
+    return fmi2OK;
+}
 fmi2Status fmi2SetContinuousStates(fmi2Component c, const fmi2Real x[], size_t nx) {
     Instance *m = c;
     if (nx != (size_t)MODEL_NX) return refuse(m, "fmi2SetContinuousStates: wrong number of states", (unsigned)nx);
@@ -147,6 +157,7 @@ fmi2Status fmi2GetNominalsOfContinuousStates(fmi2Component c, fmi2Real nominals[
 }
 fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t nx) {
     Instance *m = c;
+    MISBEHAVE_AT("fmi2GetDerivatives", m->v.time);
     if (nx != (size_t)MODEL_NX) return refuse(m, "fmi2GetDerivatives: wrong number of states", (unsigned)nx);
 #ifdef SIGINT_AT
     if (m->v.time >= SIGINT_AT && !m->interrupted) {
@@ -168,6 +179,7 @@ fmi2Status fmi2GetDerivatives(fmi2Component c, fmi2Real dx[], size_t nx) {
 }
 fmi2Status fmi2GetEventIndicators(fmi2Component c, fmi2Real z[], size_t nz) {
     Instance *m = c;
+    MISBEHAVE_AT("fmi2GetEventIndicators", m->v.time);
     if (nz != (size_t)MODEL_NZ) return refuse(m, "fmi2GetEventIndicators: wrong number of indicators", (unsigned)nz);
     model_indicators(&m->v, z);
     return fmi2OK;
