@@ -32,7 +32,6 @@ N_STEPS = 50  # 50 ms
 Q = [f"q[{i}]" for i in range(1, 10)]
 OBJ = [f"obj[{i}]" for i in range(1, 4)]
 REPO = Path(__file__).resolve().parents[2]
-FMI_HEADERS = Path(__import__("fmpy").__file__).parent / "c-code"
 
 
 @pytest.fixture(scope="module")
@@ -345,18 +344,6 @@ def test_the_binary_needs_no_python(fmus, fmi, tmp_path):
     assert exported and all(s.startswith(f"fmi{fmi}") for s in exported if s[0].isalpha()), exported
 
 
-@pytest.fixture(scope="module")
-def c_host(tmp_path_factory):
-    """tests/hierhand/fmu_host/fmi2_host.c compiled: dlopen and the FMI 2 API, no Python."""
-    compiler = shutil.which("gcc") or shutil.which("cc")
-    if compiler is None:
-        pytest.skip("no C compiler")
-    exe = tmp_path_factory.mktemp("host") / "fmi2_host"
-    subprocess.run([compiler, "-std=c99", "-O1", "-I", str(FMI_HEADERS), "-o", str(exe),
-                    str(Path(__file__).with_name("fmu_host") / "fmi2_host.c"), "-ldl"], check=True)
-    return exe
-
-
 def test_a_c_host_without_python_runs_the_fmu(fmus, c_host, tmp_path):
     md = read_model_description(str(fmus[2]))
     folder = Path(extract(str(fmus[2]), tmp_path))
@@ -492,13 +479,6 @@ def test_cli_reports_an_invalid_hand_file_in_one_line(tmp_path):
     assert done.returncode == 2
     assert done.stderr.strip() == f"{bad}:1: object.mass must be > 0, got -1"
     assert not list(tmp_path.glob("*.fmu"))
-
-
-@pytest.fixture(scope="module")
-def native_regrasp():
-    import blocks
-
-    return blocks.simulate(blocks.load_diagram(REPO / "diagrams" / "regrasp.yaml"))
 
 
 @pytest.mark.parametrize("fmi", [2, 3])

@@ -300,6 +300,20 @@ def test_steps_off_the_grid_are_refused_and_a_stop_block_ends_the_fmu(tmp_path, 
         slave.close()
 
 
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_the_stop_time_is_enforced(toy_fmus, fmi, tmp_path):
+    slave = Slave(toy_fmus[fmi], tmp_path, stop_time=5e-3)
+    try:
+        slave.initialize()
+        for k in range(5):
+            slave.step(k * 1e-3, 1e-3)
+        with pytest.raises(Exception, match="DoStep"):
+            slave.step(5e-3, 1e-3)
+        assert slave.errors() == ["a step to t=0.006 s passes the stop time 0.005 s"]
+    finally:
+        slave.close()
+
+
 def _tool(name: str) -> str:
     found = shutil.which(name)
     if found is None:
