@@ -686,6 +686,11 @@ static void describe_failure(blk_instance *inst)
     const blk_kernel_type *k = inst->x.blocks[b].type;
     if (o->code == BLK_END_RUN)
         snprintf(message, sizeof message, "asked to end the run in its %s at t=%.10g s", phase, when);
+    else if (o->code == BLK_NONFINITE)
+        snprintf(message, sizeof message,
+                 "its output value %d (counting its outputs' elements from 0) is not finite at t=%.10g s (an "
+                 "exported diagram stops at the first NaN or infinity a block outputs)",
+                 o->which, when);
     else if (k->failure != NULL)
         k->failure(inst->build->built[b].ctx, o->code, o->which, phase, when, message, sizeof message);
     else
