@@ -26,12 +26,29 @@ _SYMBOLS: dict[str, dict[str, int]] = {
     "Hz": {"s": -1}, "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
 }
 _FACTORS = {"g": 1e-3}
-_TOKEN = re.compile(r"^([A-Za-z]+)(?:\^?(-?\d+))?$")
+_SCALED = {"deg": ("rad", 3.141592653589793 / 180.0), "min": ("s", 60.0), "h": ("s", 3600.0)}
+"""Units that are a known symbol times a factor."""
+_PREFIXES = {"n": 1e-9, "u": 1e-6, "µ": 1e-6, "m": 1e-3, "c": 1e-2, "k": 1e3, "M": 1e6, "G": 1e9}
+_TOKEN = re.compile(r"^([A-Za-zµ]+)(?:\^?(-?\d+))?$")
+
+
+def _symbol(token: str) -> tuple[dict[str, int], float] | None:
+    """A unit symbol's base-unit exponents and factor: a known symbol, a scaled one
+    (``deg``), or an SI prefix before a known symbol (``mm``, ``kN``, ``ms``)."""
+    if token in _SYMBOLS:
+        return _SYMBOLS[token], _FACTORS.get(token, 1.0)
+    if token in _SCALED:
+        symbol, factor = _SCALED[token]
+        return _SYMBOLS[symbol], factor
+    if len(token) > 1 and token[0] in _PREFIXES and token[1:] in _SYMBOLS:
+        return _SYMBOLS[token[1:]], _PREFIXES[token[0]] * _FACTORS.get(token[1:], 1.0)
+    return None
 
 
 def base_units(unit: str) -> tuple[dict[str, int], float] | None:
-    """The SI base-unit exponents and factor of ``unit`` ("N m", "m/s^2", "1/(N m)"), or
-    None when it holds a symbol not known here ("1" is dimensionless: no exponents)."""
+    """The SI base-unit exponents and factor of ``unit`` ("N m", "m/s^2", "1/(N m)", "mm",
+    "deg/s"), or None when it holds a symbol not known here ("1" is dimensionless: no
+    exponents); such a unit is declared without a BaseUnit."""
     numerator, _, denominator = unit.partition("/")
     exponents: dict[str, int] = {}
     factor = 1.0
@@ -40,12 +57,13 @@ def base_units(unit: str) -> tuple[dict[str, int], float] | None:
             if token == "1":
                 continue
             m = _TOKEN.match(token)
-            if m is None or m.group(1) not in _SYMBOLS:
+            known = None if m is None else _symbol(m.group(1))
+            if known is None:
                 return None
             power = sign * int(m.group(2) or 1)
-            for base, e in _SYMBOLS[m.group(1)].items():
+            for base, e in known[0].items():
                 exponents[base] = exponents.get(base, 0) + e * power
-            factor *= _FACTORS.get(m.group(1), 1.0) ** power
+            factor *= known[1] ** power
     return {k: e for k, e in exponents.items() if e}, factor
 
 

@@ -12,8 +12,10 @@
   (``reflex.ki``, ``plant.object.mass``; in a diagram of one block without the block's
   name, ``object.mass``), their start values what the diagram gives.
 
-Units and element names come from the blocks (``port_units``, ``element_labels``) and the
-tunables; element names go into each variable's description.
+Units and element names come from the diagram (``Diagram.port_units``, ``element_labels``:
+a block's own, or those the diagram gives its port with ``units:`` / ``elements:``; a
+diagram input's from the ports it feeds) and the tunables; element names go into each
+variable's description.
 """
 
 from __future__ import annotations
@@ -119,12 +121,11 @@ def fmu_variables(plan: Plan) -> Variables:
     for name, signal in outputs:
         block, port = signal.rsplit(".", 1)
         b = index[block]
-        blk = d.blocks[block].block
-        width = blk.outputs[port]
+        width = d.blocks[block].block.outputs[port]
         base = int(t.ports[int(t.blocks[b, B_FIRST_PORT]) + names.ports[b].index(port), P_OFFSET])
         depends = _reaching(d, block, port, input_of, initial=False)
         initial = _reaching(d, block, port, input_of, initial=True)
-        labels, units = blk.element_labels(port), blk.port_units(port)
+        labels, units = d.element_labels(block, port), d.port_units(block, port)
         for i in range(width):
             v.outputs.append(Variable(
                 _element(name, i, width), 0, "output", _describe(f"output {signal}", labels, i, ()),

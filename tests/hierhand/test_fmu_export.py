@@ -110,6 +110,12 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
         assert name in params
     mass = next(v for v in md.modelVariables if v.name == "object.mass")
     assert float(mass.start) == 0.3 and mass.variability == "fixed"
+    units = {v.name: v.unit for v in md.modelVariables}
+    assert (units["tau[1]"], units["q[1]"], units["qd[1]"], units["fn[1]"], units["object.mass"]) == (
+        "N m", "rad", "rad/s", "N", "kg")
+    assert "element fore.1" in next(v for v in md.modelVariables if v.name == "q[4]").description
+    newton = next(u for u in md.unitDefinitions if u.name == "N").baseUnit
+    assert (newton.kg, newton.m, newton.s) == (1, 1, -2)
     outputs = [v for v in md.modelVariables if v.causality == "output"]
     assert all(v.initial == "calculated" for v in outputs)
     assert all(u.dependencies == [] for u in md.outputs)  # no direct feedthrough

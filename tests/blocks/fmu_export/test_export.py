@@ -350,3 +350,30 @@ def test_units_are_declared_where_the_blocks_give_them(tmp_path):
     assert "element a" in outputs["mux.y[1]"].description and "element b" in outputs["mux.y[2]"].description
     time = next(v for v in md.modelVariables if v.name == "time")
     assert time.unit == "s" and "s" in {u.name for u in md.unitDefinitions}
+
+
+def test_the_units_and_element_names_a_diagram_gives_its_ports_are_the_fmus(tmp_path):
+    (tmp_path / "annotated.yaml").write_text(textwrap.dedent("""\
+        name: annotated
+        time: {t_end: 10 ms}
+        blocks:
+          pose: {type: Constant, params: {value: [0.1, 0.2, 0.5]},
+                 units: {y: [mm, mm, deg]}, elements: {y: [x, y, theta]}}
+          turn: {type: Gain, period: 1 ms, params: {k: 2.0}}
+          rate: {type: DiscreteStateSpace, period: 1 ms, params: {A: [[0.5]], B: [[1.0]], C: [[1.0]], D: [[0.0]]}}
+        connections:
+          - pose.y[theta] -> turn.u
+        units: {turn.u: deg, turn.y: deg, rate.u: deg/s, rate.y: deg/s}
+        inputs: {w: rate.u}
+        outputs: {pose: pose.y, turn: turn.y, rate: rate.y}
+        """))
+    md = read_model_description(str(export_fmu(blocks.load_diagram(tmp_path / "annotated.yaml"),
+                                               tmp_path / "a.fmu", 2)))
+    by_name = {v.name: v for v in md.modelVariables}
+    assert [(n, by_name[n].unit) for n in ("pose[1]", "pose[2]", "pose[3]", "turn", "w", "rate")] == [
+        ("pose[1]", "mm"), ("pose[2]", "mm"), ("pose[3]", "deg"), ("turn", "deg"), ("w", "deg/s"), ("rate", "deg/s")]
+    assert "element theta" in by_name["pose[3]"].description
+    units = {u.name: u.baseUnit for u in md.unitDefinitions}
+    assert (units["mm"].m, units["mm"].factor) == (1, 0.001)
+    assert units["deg/s"].rad == 1 and units["deg/s"].s == -1 and units["deg/s"].factor == pytest.approx(np.pi / 180)
+    assert validate_fmu(str(tmp_path / "a.fmu")) == []
