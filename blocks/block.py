@@ -276,6 +276,14 @@ class Block:
         return copy.deepcopy(default) if isinstance(default, (list, Mapping)) else None
 
     @classmethod
+    def override_path(cls, parts: list[str]) -> list[str]:
+        """Where a ``--set block.<parts>`` path leads in the block's parameters: here the
+        path itself. A block whose parameters hold named values of their own (an FMU's
+        variables in ``start_values``) may lead a path that names none of its parameters
+        there, so that ``--set plant.k=2`` sets what the block calls ``k``."""
+        return parts
+
+    @classmethod
     def registered_name(cls) -> str:
         return cls.type_name or cls.__name__
 

@@ -145,8 +145,10 @@ def test_python_block_runs(body: str, line: int, workdir, tmp_path):
 SET_EXAMPLE = re.compile(r"`--set ([\w.]+)=([^`]+)`")
 # --set examples in the prose, each run on a diagram that has the block it names; the
 # Observer example's 'obs.plant=other' and the subsystem examples' 'ctrl....' belong to
-# diagrams the README only sketches (tests/blocks/test_subsystems.py runs them).
-SET_DIAGRAM = {"plant.A": "diagrams/toy.yaml", "obs.plant": None, "ctrl.prop.k": None, "ctrl.integ.A": None}
+# diagrams the README only sketches (tests/blocks/test_subsystems.py runs them), as do the SSP
+# examples' (tests/blocks/ssp).
+SET_DIAGRAM = {"plant.A": "diagrams/toy.yaml", "obs.plant": None, "ctrl.prop.k": None, "ctrl.integ.A": None,
+               "COMPONENT.PARAM": None, "sub.comp.k": None}
 SET_EXAMPLES = SET_EXAMPLE.findall(README.read_text(encoding="utf-8"))
 
 

@@ -12,13 +12,13 @@ its own ``Program`` from ``GENERIC_COMMANDS``' members and its commands (``hierh
 
 from __future__ import annotations
 
-from . import block_types, fmu, graph, plot, run, sweep, validate
+from . import block_types, fmu, graph, plot, run, ssp, sweep, validate
 from .program import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, Command, Program, UsageError,
                       build_parser, entry, main)
 
 GENERIC_COMMANDS: tuple[Command, ...] = (run.add, validate.add, graph.add, plot.add,
                                          fmu.group("export a diagram as an FMU, or describe an FMU", fmu.export,
-                                                   fmu.info), sweep.command(), sweep.plot,
+                                                   fmu.info), ssp.add, sweep.command(), sweep.plot,
                                          block_types.add)
 """Every generic command, in the order of the help."""
 

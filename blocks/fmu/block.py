@@ -184,6 +184,15 @@ class FMU(Block):
         self.integration: Integration | None = None
         """How a model-exchange FMU is integrated between the hits, once the block has its period."""
 
+    @classmethod
+    def override_path(cls, parts: list[str]) -> list[str]:
+        """``--set plant.k=2`` sets the FMU variable ``k`` (``start_values.k``) when ``k`` is
+        not a parameter of the block; the rest of the path is the variable's name, dots
+        and all (``--set plant.body.m=2``: the variable ``body.m``)."""
+        if parts[0] in cls.parameters():
+            return parts
+        return ["start_values", ".".join(parts)]
+
     @property
     def fmi_version(self) -> str:
         return self._model.md.fmiVersion
@@ -258,6 +267,24 @@ class FMU(Block):
         """Why ``port`` is not a port of this FMU, when it names one of its variables."""
         why = self._model.not_ports.get(port)
         return f"{why} ({self._model.shown})" if why else None
+
+    def element_variables(self, port: str) -> list[str] | None:
+        """The FMU variable behind each element of a port (``q[1]``, ``q[2]``, ...; a scalar's
+        own name), as other tools name them (an SSD's connectors); None for an FMI 3
+        array, whose elements are one variable."""
+        spec = self._model.inputs.get(port) or self._model.outputs.get(port)
+        if spec is None:
+            raise KeyError(port)
+        if len(spec.vrs) != spec.width:
+            return None
+        if spec.labels is None:
+            return [spec.source]
+        base = spec.source[:-len("[...]")] if spec.source.endswith("[...]") else spec.source
+        return [f"{base}[{label}]" for label in spec.labels]
+
+    def assigned_values(self) -> list[tuple[str, str, list]]:
+        """The start values the block sets: (variable, FMI type, values), in the order given."""
+        return [(a.name, a.kind, list(a.values)) for a in self._assignments]
 
     def variable_of(self, port: str) -> str:
         """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""

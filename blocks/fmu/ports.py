@@ -64,8 +64,22 @@ def variable_width(v: Any) -> int:
 
 def element_of(v: Any) -> tuple[str, tuple[int, ...]] | None:
     """``("x", (1, 2))`` for a scalar named ``x[1,2]``, None for any other variable."""
-    m = None if v.dimensions else _INDEXED.match(v.name)
+    return None if v.dimensions else indexed_name(v.name)
+
+
+def indexed_name(name: str) -> tuple[str, tuple[int, ...]] | None:
+    """``("x", (1, 2))`` for the name ``x[1,2]``, None for a name without indices."""
+    m = _INDEXED.match(name)
     return (m.group("base"), tuple(int(i) for i in m.group("index").split(","))) if m else None
+
+
+def port_of(name: str) -> tuple[str, str | None]:
+    """The port a scalar variable named ``name`` is (part of) and its element label there:
+    ``("p_e", "2")`` for ``p.e[2]``, ``("k", None)`` for ``k`` (a whole port)."""
+    element = indexed_name(name)
+    if element is None:
+        return port_name(name), None
+    return port_name(element[0]), ",".join(map(str, element[1]))
 
 
 def group_variables(variables: list, what: str, fmu: str, major: int) -> dict[str, Port]:
