@@ -1,7 +1,7 @@
 """The framework's command line: generic commands for any diagram, and the program that runs them.
 
 One module per command (or group): ``run``, ``validate``, ``graph``, ``plot``, ``fmu``
-(the group, with ``info``), ``sweep`` (``sweep`` and ``sweep-plot``) and
+(the group, with ``export`` and ``info``), ``sweep`` (``sweep`` and ``sweep-plot``) and
 ``block_types`` (``blocks``); ``options`` holds the diagram options they share,
 ``program`` the parser, the error handling and the exit codes, ``run_output`` what
 ``run`` needs to save its results whatever happens (and ``blocks.stop`` the signals).
@@ -17,7 +17,8 @@ from .program import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, Co
                       build_parser, entry, main)
 
 GENERIC_COMMANDS: tuple[Command, ...] = (run.add, validate.add, graph.add, plot.add,
-                                         fmu.group("describe an FMU", fmu.info), ssp.add, sweep.command(), sweep.plot,
+                                         fmu.group("export a diagram as an FMU, or describe an FMU", fmu.export,
+                                                   fmu.info), ssp.add, sweep.command(), sweep.plot,
                                          block_types.add)
 """Every generic command, in the order of the help."""
 

@@ -114,6 +114,12 @@ class FMU(Block):
     substep : duration
         'solver: euler' only: the sub-step, which must divide the period; default: the
         FMU's DefaultExperiment stepSize (made to divide the period), else the period
+    feedthrough : bool
+        co-simulation only: true reads the outputs at a hit after setting that hit's
+        inputs, for the outputs the FMU declares dependent on them (its ModelStructure),
+        so a loop through it is evaluated in order as one through native blocks is (an
+        exported controller); false (the default): the outputs of the previous step, no
+        feedthrough
     isolation : str
         'process': each instance runs in a process of its own, so that a crash, an exit()
         or a hang in the FMU fails the run (with its results so far) instead of ending it;
@@ -128,7 +134,8 @@ class FMU(Block):
 
     def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
                  tolerance: float | None = None, interface: str | None = None, solver: str | None = None,
-                 substep: Any = None, isolation: str | None = None, call_timeout: Any = None):
+                 substep: Any = None, feedthrough: bool = False, isolation: str | None = None,
+                 call_timeout: Any = None):
         if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
             raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
         file = Path(path).expanduser()
@@ -173,7 +180,12 @@ class FMU(Block):
         self.outputs = {p.name: p.width for p in model.outputs.values()}
         self.input_defaults = input_starts(model, self._assignments)
         self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
-        self.feedthrough = False
+        if not isinstance(feedthrough, bool):
+            raise ValueError(f"parameter 'feedthrough' must be true or false, got {feedthrough!r}")
+        if feedthrough and model.exchange:
+            raise ValueError(f"parameter 'feedthrough' is for co-simulation FMUs; {shown} runs as model exchange")
+        self._direct = feedthrough and any(model.direct_reads.values())
+        self.feedthrough = model.direct_reads if self._direct else False
         self.initial_feedthrough = model.initial_reads
         self._step = 0.0
         self.integration: Integration | None = None
@@ -356,7 +368,15 @@ class FMU(Block):
     def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         if state.time is None:
             self._start(t, state, inputs)
+        elif self._direct and state.ended is None:
+            inst = state.instance
+            self.step_calls(inst, t, self._read_through, t, state, inst, inputs)
         return state.outputs
+
+    def _read_through(self, t: float, state: FMUState, inst: Instance, inputs: Mapping[str, Signal]) -> None:
+        """``feedthrough``: the outputs at ``t`` once the inputs of ``t`` are set."""
+        inst.write(inputs, t)
+        state.outputs = inst.read(t)
 
     def update(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> FMUState:
         if state.time is None:
@@ -410,8 +430,8 @@ class FMU(Block):
 
     def kernel(self) -> Kernel | None:
         """The steady step in C (``blocks.fmu.kernel``) when every port is Float64; an FMU
-        with ports of other types runs in Python."""
-        return fmu_kernel(self)
+        with ports of other types, or read with ``feedthrough``, runs in Python."""
+        return None if self._direct else fmu_kernel(self)
 
     def _failure(self, inst: Instance, what: str) -> BlockError:
         """The error of a failed call into the FMU, which breaks the instance: ``what`` with

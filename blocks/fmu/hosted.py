@@ -1,7 +1,7 @@
 """An FMU instance hosted in a process of its own, seen from the run that uses it.
 
 ``HostedInstance`` has the surface of ``instance.Instance`` that the block, its kernel and
-the pool use (``start``, ``read``, ``step``, ``stop``, ``free``, ``log_text``, ``broken``),
+the pool use (``start``, ``write``, ``read``, ``step``, ``stop``, ``free``, ``log_text``, ``broken``),
 and does each through the channel (``channel``) to its host (``host``), forked by the
 launcher (``launcher``). A steady step is one round trip through shared memory (the
 inputs and outputs stay there); everything else is a message.
@@ -127,6 +127,13 @@ class HostedInstance:
         error = self._message(("start", t, assignments, tolerance), f"initialising it at t={t:.9g} s")
         self.started = True
         self._outputs(t, error)
+
+    def write(self, inputs: Mapping[str, Signal], t: float) -> None:
+        """Set the inputs at ``t`` (an FMU read with ``feedthrough``): the outputs then read afresh."""
+        self._usable()
+        put_ports(self.region.inputs, self.model.in_ports, inputs)
+        self._outputs_at = None
+        self._message(("write", t), f"setting its inputs at t={t:.9g} s")
 
     def read(self, t: float) -> dict[str, Signal]:
         """The outputs at ``t``: those the last step or start left in the channel, else read."""

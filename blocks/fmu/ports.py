@@ -202,3 +202,21 @@ def initial_reads(md: Any, inputs: dict[str, Port], outputs: dict[str, Port]) ->
             break
         reads |= {port_of_vr[d.valueReference] for d in u.dependencies if d.valueReference in port_of_vr}
     return {name: frozenset(reads) for name in outputs}
+
+
+def direct_reads(md: Any, inputs: dict[str, Port], outputs: dict[str, Port]) -> dict[str, frozenset[str]]:
+    """For each output port, the input ports its value depends on at a communication point
+    (the modelDescription's ModelStructure Outputs: all inputs where an output's list is
+    absent, none where it is empty), for the FMU block's ``feedthrough``."""
+    port_of_vr = {vr: p.name for p in inputs.values() for vr in p.vrs}
+    port_of_output = {vr: p.name for p in outputs.values() for vr in p.vrs}
+    reads: dict[str, set[str]] = {name: set() for name in outputs}
+    for u in md.outputs:
+        port = port_of_output.get(getattr(u.variable, "valueReference", None))
+        if port is None:
+            continue
+        if u.dependencies is None:
+            reads[port] |= set(inputs)
+        else:
+            reads[port] |= {port_of_vr[d.valueReference] for d in u.dependencies if d.valueReference in port_of_vr}
+    return {name: frozenset(found) for name, found in reads.items()}
