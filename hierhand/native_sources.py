@@ -14,7 +14,7 @@ library's, so any diagram of library and hand blocks leaves as an FMU.
 
 from __future__ import annotations
 
-import hashlib
+import zlib
 from pathlib import Path
 
 CSRC = "hierhand/csrc"
@@ -48,11 +48,15 @@ def fmu_sources(framework: list[str]) -> list[str]:
 
 
 def sources_digest(root: Path) -> str:
-    """The hash of every C source and header under ``root / CSRC``: the build stamps it into
-    the extension, so that a checkout whose C sources changed since the build says so."""
+    """A checksum of every C source and header under ``root / CSRC``: the build stamps it
+    into the extension, so that a checkout whose C sources changed since the build says so.
+    CRC-32 and Adler-32 of the names and contents (zlib, not hashlib: this runs on every
+    import of hierhand, before the command line can handle Ctrl-C, and OpenSSL takes 10 ms
+    to load; it detects edits, it is not a seal against tampering)."""
     folder = Path(root) / CSRC
-    h = hashlib.sha256()
+    crc, adler, size = 0, 1, 0
     for path in sorted(folder.rglob("*")):
         if path.suffix in (".c", ".h"):
-            h.update(path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return h.hexdigest()
+            data = path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0"
+            crc, adler, size = zlib.crc32(data, crc), zlib.adler32(data, adler), size + len(data)
+    return f"{crc:08x}{adler:08x}{size:x}"
