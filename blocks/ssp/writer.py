@@ -1,17 +1,20 @@
 """A diagram as an SSP: ``export_ssp`` writes ``SystemStructure.ssd`` and the FMUs under ``resources/``.
 
-Each top-level block becomes an ``ssd:Component`` whose FMU is the one its FMU block
-names (copied once per distinct file); its connectors are the FMU's input and output
-variables (element by element for a vector port, typed as the FMU declares them), its
-start values an inline ``ssd:ParameterBindings``, its period a libcosim
-``osp:StepSizeHint``. The connections become ``ssd:Connection``s between those variables.
-The end time is the ``ssd:DefaultExperiment`` stopTime, whose libcosim
-``osp:FixedStepAlgorithm`` baseStepSize and the system's OMSimulator ``FixedStepMaster``
-stepSize are the greatest common divisor of the components' periods (OMSimulator steps
-every component of a system at one step). A block that cannot become a component (not
-an FMU block, a block inside a subsystem, a delayed connection, an offset, a port type
-SSP 1.0 has no connector type for) is one error naming it. The SSD validates against the
-SSP schemas (the tests check it).
+Each top-level block or subsystem becomes an ``ssd:Component``: an FMU block's FMU is
+copied once per distinct file; any other block, and a subsystem, leaves as an FMU of its
+own (``components``, exported by ``blocks.fmu_export``), stepped at the largest multiple
+of its internal step that its partners' steps allow. Its connectors are the FMU's input
+and output variables (element by element for a vector port, typed and with units as the
+FMU declares them; ``ssd:Units`` from the FMUs' definitions), its start values an inline
+``ssd:ParameterBindings``, its step a libcosim ``osp:StepSizeHint``, and an FMU whose
+outputs feed through a ``blocks:Stepping`` annotation (``steps``). The top level's
+connections become ``ssd:Connection``s between those variables. The end time is the
+``ssd:DefaultExperiment`` stopTime, whose libcosim ``osp:FixedStepAlgorithm``
+baseStepSize and the system's OMSimulator ``FixedStepMaster`` stepSize are the greatest
+common divisor of the components' steps. What cannot become a component (a block or
+subsystem the FMU exporter refuses, a block whose inherited hits are uneven, a delayed
+connection, an offset, a port type SSP 1.0 has no connector type for) is one error
+naming it. The SSD validates against the SSP schemas (the tests check it).
 """
 
 from __future__ import annotations
