@@ -141,3 +141,20 @@ def test_the_command_line_exports_and_refuses_with_exit_code_2(first_order, tmp_
                            "--set", "a.x0=3"], capture_output=True, text=True, timeout=120)
     assert good.returncode == 0, good.stderr
     assert load_diagram(out).blocks["a"].params["start_values"] == {"x0": 3}
+
+
+def test_a_subsystem_the_fmu_exporter_refuses_is_one_error_at_its_block(first_order, tmp_path):
+    fmu = tmp_path / "fo.fmu"
+    fmu.write_bytes(first_order)
+    inner = DiagramBuilder("inner")
+    inner.add("f", "FMU", period="100 ms", params={"path": str(fmu)})
+    inner.output("y", "f.y")
+    b = DiagramBuilder("outer", t_end="1 s")
+    b.add_subsystem("sub", inner)
+    b.log("sub.f.y")
+    with pytest.raises(DiagramError) as caught:
+        export_ssp(b.build(), tmp_path / "x.ssp")
+    [issue] = caught.value.issues
+    assert issue.message == ("subsystem 'sub' cannot become an SSP component: block 'f' (FMU) cannot be exported: "
+                             "the FMU an FMU block runs is not carried inside an exported FMU")
+    assert issue.file == __file__ and not (tmp_path / "x.ssp").exists()
