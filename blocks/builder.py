@@ -107,7 +107,9 @@ class DiagramBuilder(DiagramRecord):
         """A block reference left to the including diagram, which binds it to one of its
         blocks (``bind: {name: block}``); this diagram's blocks name it as if it were a
         block. ``stand_in`` (a type name or class) makes the block that takes its place
-        when the diagram is loaded on its own (``Type.example()``), for validating it."""
+        when the diagram is loaded on its own (``Type.example()``), for validating it; a
+        ``Block`` instance stands in itself, so that blocks added as instances that were
+        made with it (``hand=plant``) refer to it without it being a block here."""
         self.references.append(ReferenceEntry(name, stand_in, where or call_site()))
 
     def log(self, signal: str, *, decimate: int = 1, where: Site | None = None) -> None:

@@ -152,6 +152,9 @@ class Constructor:
         for name, ref in self.top.references.items():
             if ref.stand_in is None:
                 continue
+            if isinstance(ref.stand_in, Block):  # a block made elsewhere stands in as it is
+                self.stand_ins[name] = ref.stand_in
+                continue
             try:
                 cls = ref.stand_in if isinstance(ref.stand_in, type) else \
                     resolve_type(str(ref.stand_in), self.top.builder.trust, self.top.code_dir)
@@ -392,6 +395,11 @@ class Constructor:
                     p.params[key] = level.name_of(flat) or flat
                     continue
             if p.instance is not None:
+                standing = next((n for n, b in self.stand_ins.items() if b is target), None)
+                if standing is not None:  # the block one of the top diagram's references stands in for
+                    p.references[key] = Bound(standing, stand_in=True)
+                    p.params[key] = standing
+                    continue
                 if isinstance(target, Block):
                     self.error(p.site, None, f"block '{p.name}': parameter '{key}' is a block that is not in "
                                "this diagram", "add that block to the diagram too")

@@ -37,7 +37,10 @@ def command(measures_help: str = MEASURES_HELP) -> Command:
                                            "installed packages (same versions). By default the points start "
                                            "at once in a local process, and a LocalCluster of one worker per "
                                            "core takes over when the runs left are worth starting one.")
-        sweep.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
+        sweep.add_argument("diagram", type=Path, metavar="DIAGRAM",
+                           help="YAML diagram file, or an SSP (.ssp archive, or a folder with SystemStructure.ssd)")
+        sweep.add_argument("--step", metavar="T",
+                           help="SSP only: the communication step of the components whose SSD gives none")
         sweep.add_argument("-o", "--output", type=Path, required=True, metavar="DIR",
                            help="sweep folder: sweep.csv and sweep.json (and runs/ with --keep-results)")
         sweep.add_argument("--grid", action="append", default=[], metavar="BLOCK.PARAM=V1,V2,...",
@@ -122,14 +125,14 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         metrics = parse_metrics(args.metrics)
         points, axes = sweep_points(args)
         if args.t_end is not None:
-            end_time(args, load_diagram(args.diagram, trust=args.trust))
+            end_time(args, load_diagram(args.diagram, trust=args.trust, step=args.step))
         if method and not serial and args.scheduler is None:
             start_method(method, start_variable)
         try:
             summary = run_sweep(args.diagram, points, metrics, args.output, t_end=args.t_end, workers=args.workers,
                                 scheduler=args.scheduler, serial=serial, trust=args.trust, progress=not args.quiet,
                                 axes=axes, origins=origins(args.grid, args.random, args.points, points),
-                                start_method=method, keep_results=args.keep_results)
+                                start_method=method, keep_results=args.keep_results, step=args.step)
         except SweepInterrupted as stop:
             from blocks.stop import exit_code
 

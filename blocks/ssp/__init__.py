@@ -3,9 +3,11 @@
 ``read_ssp`` reads an SSP (a ``.ssp`` zip archive or a folder with ``SystemStructure.ssd``)
 of co-simulation (or model-exchange) FMUs into a ``DiagramBuilder`` (``reader``), which
 ``blocks.load_diagram`` builds like any diagram; ``export_ssp`` writes a diagram as an SSP
-whose components are FMUs (``writer``). Modules: ``package`` (the archive or folder, its
-files), ``xml`` (namespaces, safe parsing), ``parameters`` (bindings, ``.ssv``, ``.ssm``),
-``steps`` (the step-size annotations of libcosim and OMSimulator).
+whose components are FMUs (``writer``; ``components``: a block or subsystem as the diagram
+its FMU is exported from). Modules: ``package`` (the archive or folder, its files), ``xml``
+(namespaces, safe parsing), ``parameters`` (bindings, ``.ssv``, ``.ssm``), ``steps`` (the
+step-size annotations of libcosim and OMSimulator, and blocks' own stepping one),
+``units`` (``ssd:Units`` from the FMUs).
 """
 
 from .package import SSD_NAME, is_ssp

@@ -45,7 +45,7 @@ from ..scopes import NAME
 from ..timebase import DurationError, parse_duration
 from .package import Package, PackageError, open_package
 from .parameters import BindingError, binding_values
-from .steps import base_step, libcosim_period, step_hint, system_step
+from .steps import base_step, feedthrough, libcosim_period, step_hint, system_step
 from .xml import XmlError, child, children, elements, exact, local, parse_file, q, shown
 
 FMU_TYPE = "application/x-fmu-sharedlibrary"
@@ -273,11 +273,11 @@ class _Reader:
         params: dict[str, Any] = {"path": self.package.relative(fmu), "start_values": me.start_values}
         if IMPLEMENTATIONS[implementation]:
             params["interface"] = IMPLEMENTATIONS[implementation]
+        if feedthrough(item):
+            params["feedthrough"] = True
         b.add(name, "FMU", period=period, params=params, where=self.site(item))
-        for c in me.connectors.values():
-            port, label = port_of(c.name)
-            if c.unit is not None and label is None:
-                b.annotate(f"{name}.{port}", units=c.unit, where=Site(self.file, c.line))
+        for port, (units, line) in _port_units(me.connectors.values()).items():
+            b.annotate(f"{name}.{port}", units=units, where=Site(self.file, line))
         return me
 
     def period(self, item: Any, name: str, system_step_: Fraction | None) -> Fraction | None:
@@ -458,6 +458,35 @@ class _Reader:
                     found.start_values[tail] = v.value
                     break
                 target, rest = found, tail
+
+
+def _port_units(connectors: Any) -> dict[str, tuple[str | list[str], int | None]]:
+    """The units the connectors give their components' ports, and the line that gives
+    each: a whole port's connector its unit; element connectors (``q[1]``, ``q[2]``, ...)
+    one unit if they all say the same, else one per element when they are the port's
+    elements 1 to n, each with a unit (other mixes give none: the FMU's own stand)."""
+    whole: dict[str, tuple[str, int | None]] = {}
+    by_element: dict[str, dict[str, tuple[str | None, int | None]]] = {}
+    for c in connectors:
+        port, label = port_of(c.name)
+        if label is None:
+            if c.unit is not None:
+                whole[port] = (c.unit, c.line)
+        else:
+            by_element.setdefault(port, {})[label] = (c.unit, c.line)
+    found: dict[str, tuple[str | list[str], int | None]] = dict(whole)
+    for port, elements_ in by_element.items():
+        if port in whole:
+            continue
+        units = [unit for unit, _ in elements_.values()]
+        line = next(iter(elements_.values()))[1]
+        if None in units:
+            continue
+        if len(set(units)) == 1:
+            found[port] = (units[0], line)
+        elif sorted(elements_) == sorted(str(i) for i in range(1, len(elements_) + 1)):
+            found[port] = ([elements_[str(i)][0] for i in range(1, len(elements_) + 1)], line)
+    return found
 
 
 def _number(text: str) -> Fraction | None:

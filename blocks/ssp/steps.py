@@ -8,6 +8,12 @@ a component without a hint steps at the base step, one with a hint every
 ``org.openmodelica`` on an ``ssd:System``, ``<oms:Annotations><oms:SimulationInformation>
 <oms:FixedStepMaster stepSize=.../>``: the step of every component of that system (older
 files leave out the ``oms:Annotations`` level, or the prefix).
+
+blocks itself reads and writes, in an annotation of type ``org.hierhand.blocks``, a
+component's ``<blocks:Stepping feedthrough="true"/>``: the importer reads the component's
+outputs at a communication point after setting that point's inputs (the FMU block's
+``feedthrough``), as the diagram it was exported from evaluates it; other tools step it
+as they do every FMU (libcosim: on the inputs of the previous communication point).
 """
 
 from __future__ import annotations
@@ -16,7 +22,7 @@ import math
 from fractions import Fraction
 from typing import Any
 
-from .xml import OMS_ANNOTATION, OSP_ANNOTATION, annotations, child, local, q
+from .xml import BLOCKS_ANNOTATION, OMS_ANNOTATION, OSP_ANNOTATION, annotations, child, local, q
 
 Step = tuple[str, int | None]
 """A step as written (its text) and the line it is written at."""
@@ -48,6 +54,12 @@ def system_step(system: Any) -> Step | None:
     return None
 
 
+def feedthrough(component: Any) -> bool:
+    """Whether a component's ``blocks:Stepping`` asks for feedthrough."""
+    return any(content.tag == q("blocks", "Stepping") and content.get("feedthrough") in ("true", "1")
+               for content in annotations(component, BLOCKS_ANNOTATION))
+
+
 def libcosim_period(hint: Fraction, base: Fraction) -> Fraction:
     """The period libcosim runs a component of step-size hint ``hint`` at, on base step ``base``."""
     return base * max(1, math.ceil(hint / base))
@@ -62,6 +74,11 @@ def number(value: Fraction) -> str:
 def add_step_hint(component: Any, period: Fraction) -> None:
     """Write a component's ``osp:StepSizeHint``."""
     _annotation(component, OSP_ANNOTATION).append(_make("osp", "StepSizeHint", value=number(period)))
+
+
+def add_feedthrough(component: Any) -> None:
+    """Write a component's ``blocks:Stepping feedthrough="true"``."""
+    _annotation(component, BLOCKS_ANNOTATION).append(_make("blocks", "Stepping", feedthrough="true"))
 
 
 def add_base_step(experiment: Any, step: Fraction) -> None:

@@ -20,12 +20,16 @@ SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
 SSB = "http://ssp-standard.org/SSP1/SystemStructureSignalDictionary"
 OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
 OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
-PREFIXES = {"ssd": SSD, "ssc": SSC, "ssv": SSV, "ssm": SSM, "osp": OSP, "oms": OMS}
+BLOCKS = "urn:hierhand:blocks:ssp"
+PREFIXES = {"ssd": SSD, "ssc": SSC, "ssv": SSV, "ssm": SSM, "osp": OSP, "oms": OMS, "blocks": BLOCKS}
 
 OSP_ANNOTATION = "com.opensimulationplatform"
 """The annotation type libcosim reads (step-size hints, the fixed-step algorithm)."""
 OMS_ANNOTATION = "org.openmodelica"
 """The annotation type OMSimulator reads (its simulation information)."""
+
+BLOCKS_ANNOTATION = "org.hierhand.blocks"
+"""The annotation type this package reads and writes (how a component is stepped)."""
 
 MAX_XML_BYTES = 16 * 1024 * 1024
 """Limit on the size of one SSD, SSV or SSM file."""

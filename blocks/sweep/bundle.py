@@ -72,6 +72,10 @@ class DiagramBundle:
     files: tuple[BundleFile, ...]
     hash: str
     blobs: Mapping[str, bytes] | None = None
+    ssp: bool = False
+    """The diagram is an SSP: ``diagram`` is its archive (a folder SSP zipped), ``text`` empty."""
+    step: str | None = None
+    """For an SSP, the step of the components whose SSD gives none (``--step``)."""
 
     def manifest(self) -> "DiagramBundle":
         """This bundle without the files' content: what a task carries."""
@@ -91,8 +95,11 @@ class DiagramBundle:
     def load(self, overrides: Mapping[str, Any] | None = None, trust: bool = False,
              origins: Mapping[str, str] | None = None):
         """The diagram, loaded from this bundle's copy of its files (written on first use)."""
-        from blocks import loads_diagram
+        from blocks import load_diagram, loads_diagram
 
+        if self.ssp:
+            return load_diagram(folder(self) / self.diagram, overrides=overrides, trust=trust, origins=origins,
+                                step=self.step)
         return loads_diagram(self.text, filename=self.filename, base_dir=self.base_dir, overrides=overrides,
                              trust=trust, origins=origins, files=self.file_map(folder(self)))
 
@@ -108,12 +115,17 @@ def _layout_name(ref: str, sha: str, diagram_dir: str) -> str:
     return posixpath.normpath(posixpath.join(diagram_dir, Path(ref).as_posix()))
 
 
-def make_bundle(path: str | Path, files: Mapping[str, Path], text: str | None = None) -> DiagramBundle:
+def make_bundle(path: str | Path, files: Mapping[str, Path], text: str | None = None,
+                step: str | None = None) -> DiagramBundle:
     """The bundle of the diagram file ``path`` with ``files`` (reference -> file to read, as
-    ``Diagram.files``); ``text``: the diagram's text if already read."""
+    ``Diagram.files``); ``text``: the diagram's text if already read. An SSP is bundled as
+    its archive alone (its FMUs are inside), with ``step`` (``--step``)."""
+    from blocks.ssp import is_ssp
     from blocks.yamlsource import read_yaml_file
 
     path = Path(path)
+    if is_ssp(path):
+        return _ssp_bundle(path, step)
     try:
         text = read_yaml_file(path) if text is None else text
         contents = {ref: Path(real).read_bytes() for ref, real in sorted(files.items())}
@@ -140,6 +152,38 @@ def make_bundle(path: str | Path, files: Mapping[str, Path], text: str | None = 
                          blobs={shas[ref]: data for ref, data in contents.items()})
 
 
+def _ssp_bundle(path: Path, step: str | None) -> DiagramBundle:
+    """An SSP's bundle: the archive's bytes (a folder's, or an ``.ssd`` file's folder,
+    zipped with its files in name order), its hash covering them and ``step``."""
+    try:
+        if path.is_file() and path.suffix.lower() == ".ssp":
+            data = path.read_bytes()
+        else:
+            data = _zipped(path if path.is_dir() else path.parent)
+    except OSError as exc:
+        raise BundleError(f"cannot read the SSP {path}: {exc.strerror or exc}") from None
+    sha = _sha256(data)
+    name = f"tree/{path.stem or 'system'}.ssp"
+    digest = _sha256(json.dumps({"ssp": sha, "step": step}, sort_keys=True).encode("utf-8"))
+    return DiagramBundle(filename=str(path), base_dir=str(path.parent), diagram=name, text="",
+                         files=(BundleFile(str(path), name, sha, len(data)),), hash=digest, blobs={sha: data},
+                         ssp=True, step=step)
+
+
+def _zipped(folder: Path) -> bytes:
+    """The files under ``folder`` (links and all: the SSP reader refuses them) as a zip."""
+    import io
+    import zipfile
+
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for file in sorted(folder.rglob("*")):
+            if file.is_file() or file.is_symlink():
+                info = zipfile.ZipInfo(file.relative_to(folder).as_posix(), date_time=(1980, 1, 1, 0, 0, 0))
+                archive.writestr(info, file.read_bytes(), zipfile.ZIP_DEFLATED)
+    return buffer.getvalue()
+
+
 def _ups(ref: str) -> int:
     """How many folders above the diagram's folder a relative reference reaches."""
     level = low = 0
@@ -152,14 +196,16 @@ def _ups(ref: str) -> int:
     return -low
 
 
-def bundle_for(path: str | Path, diagrams: Iterable[Any], more: Mapping[str, Path] | None = None) -> DiagramBundle:
+def bundle_for(path: str | Path, diagrams: Iterable[Any], more: Mapping[str, Path] | None = None,
+               step: str | None = None) -> DiagramBundle:
     """The bundle of the diagram file ``path`` with the files that any of ``diagrams``
-    (loaded from it, with different overrides) read, and ``more`` (reference -> file)."""
+    (loaded from it, with different overrides) read, and ``more`` (reference -> file);
+    ``step``: an SSP's ``--step``."""
     files: dict[str, Path] = {}
     for diagram in diagrams:
         files.update(diagram.files)
     files.update(more or {})
-    return make_bundle(path, files)
+    return make_bundle(path, files, step=step)
 
 
 # -- the copies in this process ----------------------------------------------------------
@@ -223,9 +269,10 @@ def _write(bundle: DiagramBundle) -> Path:
             place.parent.mkdir(parents=True, exist_ok=True)
             if not place.exists():
                 place.write_bytes(data)
-        place = target / bundle.diagram
-        place.parent.mkdir(parents=True, exist_ok=True)
-        place.write_text(bundle.text, encoding="utf-8")
+        if not bundle.ssp:  # an SSP's archive is one of its files
+            place = target / bundle.diagram
+            place.parent.mkdir(parents=True, exist_ok=True)
+            place.write_text(bundle.text, encoding="utf-8")
     except BaseException:
         shutil.rmtree(target, ignore_errors=True)
         raise

@@ -56,7 +56,7 @@ class SweepPlan:
 
 def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_end: str | None = None,
             trust: bool = False, axes: dict[str, Any] | None = None,
-            origins: dict[str, str] | None = None, keep_results: bool = False) -> SweepPlan:
+            origins: dict[str, str] | None = None, keep_results: bool = False, step: str | None = None) -> SweepPlan:
     """Check the points' parameter names and the metrics against the diagram; bundle the
     diagram with every file it reads (``bundle``) and hash the points with the bundle's hash.
 
@@ -73,16 +73,16 @@ def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_e
         if list(p) != keys:
             raise SweepError(f"every point must set the same parameters; {point_json(p)} differs from "
                              f"{', '.join(keys)}")
-    base = load_diagram(diagram, trust=trust)
+    base = load_diagram(diagram, trust=trust, step=step)
     checked = base
     try:
-        checked = load_diagram(diagram, overrides=points[0], trust=trust, origins=origins)
+        checked = load_diagram(diagram, overrides=points[0], trust=trust, origins=origins, step=step)
     except DiagramError as exc:
         if any(i.override for i in exc.issues):
             raise
     for metric in metrics:
         metric.check(checked)
-    bundle = bundle_for(diagram, [base, checked], _swept_files(base, points))
+    bundle = bundle_for(diagram, [base, checked], _swept_files(base, points), step=step)
     job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust,
                    origins=tuple((origins or {}).items()), bundle=bundle, keep_results=keep_results)
     return SweepPlan(job=job, points=unique_points(points, bundle.hash, t_end), parameters=keys,
@@ -211,7 +211,7 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
               t_end: str | None = None, workers: int | None = None, scheduler: str | None = None,
               serial: bool = False, trust: bool = False, progress: bool = True,
               axes: dict[str, Any] | None = None, origins: dict[str, str] | None = None,
-              start_method: str | None = None, keep_results: bool = False) -> SweepSummary:
+              start_method: str | None = None, keep_results: bool = False, step: str | None = None) -> SweepSummary:
     """Run the diagram file at every point and append one row per run to OUTPUT/sweep.csv.
 
     ``points``: dicts of ``block.param`` overrides, all naming the same parameters
@@ -224,7 +224,9 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
     LocalCluster of one worker per core takes over when the runs left are worth starting
     one (``local``): a sweep of a fraction of a second never waits for Dask. Points already in the file are skipped, so calling again resumes; a point
     that fails is recorded as failed and the others go on. ``axes`` is recorded in
-    sweep.json; ``origins`` says how each parameter was given, for load errors.
+    sweep.json; ``origins`` says how each parameter was given, for load errors. ``step``:
+    for an SSP (a ``.ssp`` archive or a folder), the step of the components whose SSD
+    gives none, as ``--step`` gives it.
 
     The diagram travels as content: its text and every file it reads go to each worker
     once (``bundle``), so workers need the installed packages but none of the client's
@@ -238,7 +240,7 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
     for name, flag in (("serial", serial), ("trust", trust), ("progress", progress), ("keep_results", keep_results)):
         boolean(name, flag)
     plan = prepare(diagram, points, parse_metrics(metrics), t_end=None if t_end is None else str(t_end),
-                   trust=trust, axes=axes, origins=origins, keep_results=keep_results)
+                   trust=trust, axes=axes, origins=origins, keep_results=keep_results, step=step)
     t0 = time.perf_counter()
     try:
         report, skipped, failed = execute(plan, output, workers=workers, scheduler=scheduler,
