@@ -253,28 +253,18 @@ static int step(blk_run *r, int64_t index, const int64_t *op, int64_t ke, int *w
     return k->update(k->ctx, t, k->state, inputs, which);
 }
 
-/* The index of the first of n values that is not finite, or -1. The values are looked over
-   first as bits, without a branch, which compilers vectorise (GCC when asked, at -O2): the
-   hand plant's advance rows alone are some 500 000 values per simulated second. A NaN or an
-   infinity has every exponent bit set, so adding one to its exponent carries into the sign.
-   Inlined into the two scans below, each compiled for its own instruction set. */
+/* The index of the first of n values that is not finite, or -1: blk_all_finite first (the
+   hand plant's advance rows alone are some 500 000 values per simulated second), then the
+   search. Inlined into the two scans below, each compiled for its own instruction set
+   (GCC vectorises when asked, at -O2). */
 #if defined(__GNUC__) && !defined(__clang__)
-#define VECTORISED __attribute__((optimize("tree-vectorize")))
 #define SCAN_INLINE static inline __attribute__((always_inline))
 #else
-#define VECTORISED
 #define SCAN_INLINE static inline
 #endif
 SCAN_INLINE int64_t scan_nonfinite(const double *v, int64_t n)
 {
-    const uint64_t exponent = 0x7ff0000000000000u, one = 0x0010000000000000u;
-    uint64_t carried = 0;
-    for (int64_t i = 0; i < n; i++) {
-        uint64_t bits;
-        memcpy(&bits, v + i, sizeof bits);
-        carried |= (bits & exponent) + one;
-    }
-    if (!(carried >> 63))
+    if (blk_all_finite(v, n))
         return -1;
     for (int64_t i = 0; i < n; i++)
         if (!isfinite(v[i]))
@@ -283,7 +273,7 @@ SCAN_INLINE int64_t scan_nonfinite(const double *v, int64_t n)
 }
 
 /* The scan of a few values (an output op's ports). */
-VECTORISED static int64_t first_nonfinite(const double *v, int64_t n)
+BLK_VECTORISED static int64_t first_nonfinite(const double *v, int64_t n)
 {
     return scan_nonfinite(v, n);
 }
@@ -294,7 +284,7 @@ VECTORISED static int64_t first_nonfinite(const double *v, int64_t n)
    the AVX2 version's set-up and call would slow. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__)
 enum { WIDE_SCAN = 64 };
-__attribute__((optimize("tree-vectorize"), target_clones("avx2", "default"))) static int64_t
+__attribute__((optimize("tree-vectorize", "unroll-loops"), target_clones("avx2", "default"))) static int64_t
 scan_wide(const double *v, int64_t n)
 {
     return scan_nonfinite(v, n);
