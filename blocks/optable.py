@@ -174,12 +174,14 @@ def op_table(diagram: Diagram, schedule: Schedule) -> OpTable:
 
 
 def stepping_table(diagram: Diagram, schedule: Schedule, extra: tuple[EventProgram, ...],
-                   n_ticks: int) -> tuple[OpTable, list[int]]:
+                   n_ticks: int, span: int) -> tuple[OpTable, list[int]]:
     """The op table of a run stepped in parts by a program of its own (an exported FMU):
     without logs, every event program with a final one (the outputs of a communication
     point at that event), ``extra`` programs after the others (their indices returned),
-    and ``n_ticks`` in its header. Not cached: an export builds it once."""
-    compiler = _Compiler(diagram, schedule, logs=False)
+    and ``n_ticks`` in its header. ``span``: the base ticks an advance steps in one call
+    where no event cuts it (the parts the run is stepped in), which the advanced blocks'
+    rows hold. Not cached: an export builds it once."""
+    compiler = _Compiler(diagram, schedule, logs=False, span=span)
     table = compiler.table(extra=extra, every_final=True, n_ticks=n_ticks)
     return table, compiler.extra_programs
 
@@ -193,9 +195,11 @@ def _frozen(rows: list, width: int) -> np.ndarray:
 class _Compiler:
     """Lays out the arena and writes the programs of a Schedule as ops."""
 
-    def __init__(self, diagram: Diagram, schedule: Schedule, logs: bool = True):
+    def __init__(self, diagram: Diagram, schedule: Schedule, logs: bool = True, span: int | None = None):
         self.d, self.s = diagram, schedule
         self.logs = logs
+        self.span = span
+        """Without events, the ticks one advance call covers (None: the whole run)."""
         self.names = list(diagram.blocks)
         self.index = {n: i for i, n in enumerate(self.names)}
         self.size = 0
@@ -369,8 +373,8 @@ class _Compiler:
         ticks = s.event_ticks
         if len(ticks):  # from t = 0 to the first event, between events, around the hyperperiod
             longest = int(np.diff(np.concatenate(([0], ticks, [s.hyperperiod + ticks[0]]))).max())
-        else:  # no events: one span from t = 0 to the end
-            longest = max(s.n_ticks, 1)
+        else:  # no events: one span from t = 0 to the end, or the parts a stepped run takes
+            longest = max(s.n_ticks if self.span is None else self.span, 1)
         rows, first_input, first_port = [], 0, 0
         for name in self.names:
             blk = d.blocks[name].block

@@ -35,7 +35,6 @@ from pathlib import Path
 from ..atomic_file import write_atomically
 from ..compiled import native
 from ..diagram import Diagram
-from ..timebase import DurationError, parse_duration
 from .description import build_description, model_description
 from .kernel_sets import FmuExportError, KernelSet, installed_binary, kernel_sets, set_for
 from .plan import Plan, plan_export
@@ -67,11 +66,10 @@ def export_fmu(diagram: Diagram, out: Path | str, fmi: int = 2, *, model: str | 
     """
     if fmi not in FMI_VERSIONS:
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
-    plan = plan_export(diagram, {signal.rsplit(".", 1)[0] for _, signal in output_signals(diagram)})
+    plan = plan_export(diagram, {signal.rsplit(".", 1)[0] for _, signal in output_signals(diagram)}, step)
     variables = fmu_variables(plan)
     chosen = kernel_set or set_for({b.record.kind for b in plan.blocks})
     grid = plan.grid * plan.schedule.base_tick
-    step = grid if step is None else _step(diagram, step, grid)
     model = model or diagram.name
     library = chosen.binary(fmi).read_bytes()
     sources = {path.name: path.read_bytes() for path in chosen.sources(fmi)}
@@ -81,7 +79,7 @@ def export_fmu(diagram: Diagram, out: Path | str, fmi: int = 2, *, model: str | 
     token = "{" + str(uuid.UUID(hashlib.sha256(identifier.encode()).hexdigest()[:32])) + "}"
     resources = resource_file(plan, variables, token, model)
     described = model_description(
-        fmi, identifier, token, model, _description(diagram, grid), variables, grid, step, diagram.t_end,
+        fmi, identifier, token, model, _description(diagram, grid), variables, grid, plan.step, diagram.t_end,
         dict(zip(native().EXPORT_LOG_CATEGORIES, LOG_DESCRIPTIONS)), f"blocks {_version()}", compiled)
     files = {
         "modelDescription.xml": described,
@@ -107,19 +105,6 @@ def model_identifier(model: str, fmi: int, resources: bytes, library: bytes, sou
     if not (stem[0].isalpha() or stem[0] == "_"):
         stem = "m_" + stem
     return f"{stem}_{h.hexdigest()[:12]}"
-
-
-def _step(diagram: Diagram, step, grid: Fraction) -> Fraction:
-    from ..issues import DiagramError
-
-    try:
-        value = parse_duration(step)
-    except DurationError as exc:
-        raise DiagramError([diagram.issue(None, f"step: {exc}")]) from None
-    if value <= 0 or (value / grid).denominator != 1:
-        raise DiagramError([diagram.issue(None, f"the step {step} is not a positive multiple of the FMU's "
-                                          f"internal step {float(grid):g} s", f"use a multiple of {float(grid):g} s")])
-    return value
 
 
 def _description(diagram: Diagram, grid: Fraction) -> str:

@@ -7,6 +7,10 @@ first step, the outputs between events, and those of lazy blocks the FMU's outpu
 Its length is open (the importer's stop time ends it). Communication points fall on a
 grid: the base tick, or the period of the blocks the table advances in one call (their
 advances stop and go on at every communication point, which must be one of their hits).
+Where no event cuts the advances (a diagram of advanced blocks alone, such as the plant
+export), each communication step advances them in one kernel call: their rows hold the
+hits of the default communication step, and of at least ``MIN_SPAN_GRIDS`` grid steps
+(an importer stepping longer takes a call per that many).
 
 Every block must run through a compiled kernel that has a record (``Kernel.record``): a
 block in Python, or one whose kernel cannot leave Python (an FMU block's), is refused
@@ -17,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -27,9 +32,13 @@ from ..issues import DiagramError
 from ..kernel import KernelRecord
 from ..optable import MAX_TICKS, OpTable, stepping_table
 from ..schedule import Schedule, between_program, build_schedule, initial_outputs_program, lazy_outputs_program
+from ..timebase import DurationError, parse_duration
 
 OPEN_END = MAX_TICKS // 2
 """The table's length in base ticks: no end but the importer's stop time."""
+
+MIN_SPAN_GRIDS = 64
+"""Without events, the advanced blocks' rows hold at least this many grid steps' hits."""
 
 
 @dataclass(frozen=True)
@@ -53,25 +62,43 @@ class Plan:
     blocks: tuple[ExportBlock, ...]
     grid: int
     """Communication steps are whole numbers of this many base ticks."""
+    step: Fraction
+    """The default communication step, in seconds."""
     initial_outputs: int
     between: int
     lazy: int
     """Programs of the table (-1: none needed)."""
 
 
-def plan_export(diagram: Diagram, output_blocks: set[str]) -> Plan:
-    """The plan of ``diagram`` as an FMU whose outputs read ``output_blocks``; DiagramError
-    naming every block that cannot leave Python."""
+def plan_export(diagram: Diagram, output_blocks: set[str], step=None) -> Plan:
+    """The plan of ``diagram`` as an FMU whose outputs read ``output_blocks``, with the
+    default communication step ``step`` (a duration; default: the grid); DiagramError
+    naming every block that cannot leave Python, or for a step off the grid."""
     schedule = build_schedule(diagram, diagram_length(diagram))
+    grid = math.lcm(1, *(schedule.period_ticks[n] for n in schedule.advanced))
+    grid_step = grid * schedule.base_tick
+    default_step = grid_step if step is None else _step(diagram, step, grid_step)
+    span = max(int(default_step / schedule.base_tick), MIN_SPAN_GRIDS * grid)
     initial = initial_outputs_program(diagram, schedule)
     between = between_program(diagram, schedule)
     lazy = lazy_outputs_program(diagram, schedule, output_blocks)
     extra = (initial, between, lazy)
-    table, (i_initial, i_between, i_lazy) = stepping_table(diagram, schedule, extra, OPEN_END)
+    table, (i_initial, i_between, i_lazy) = stepping_table(diagram, schedule, extra, OPEN_END, span)
     blocks = exported_blocks(diagram, table)
-    grid = math.lcm(1, *(schedule.period_ticks[n] for n in schedule.advanced))
-    return Plan(diagram, schedule, table, blocks, grid, i_initial, i_between if between.evaluate else -1,
-                i_lazy if lazy.evaluate else -1)
+    return Plan(diagram, schedule, table, blocks, grid, default_step, i_initial,
+                i_between if between.evaluate else -1, i_lazy if lazy.evaluate else -1)
+
+
+def _step(diagram: Diagram, step, grid: Fraction) -> Fraction:
+    """``step`` (a duration) as seconds; DiagramError unless a positive multiple of ``grid``."""
+    try:
+        value = parse_duration(step)
+    except DurationError as exc:
+        raise DiagramError([diagram.issue(None, f"step: {exc}")]) from None
+    if value <= 0 or (value / grid).denominator != 1:
+        raise DiagramError([diagram.issue(None, f"the step {step} is not a positive multiple of the FMU's "
+                                          f"internal step {float(grid):g} s", f"use a multiple of {float(grid):g} s")])
+    return value
 
 
 def diagram_length(diagram: Diagram):

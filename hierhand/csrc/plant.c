@@ -20,6 +20,7 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "blocks_kernel.h"
 #include "contact.h"
 #include "dynamics.h"
 #include "hand.h"
@@ -172,12 +173,15 @@ static int first_non_finite(const double *x, int n)
     return -1;
 }
 
-/* The first non-finite quantity of the rigid-body state. Velocities first: a blow-up
- * shows in them one step before it reaches the positions. */
-static int check_state(const double *state, int *which)
+/* The first non-finite quantity of the rigid-body state (HH_S_Q to HH_S_WINDOW, looked over
+ * at once first). Velocities first: a blow-up shows in them one step before it reaches the
+ * positions. */
+BLK_VECTORISED static int check_state(const double *state, int *which)
 {
     static const int order[4][3] = {
         {HH_S_QD, 9, HH_ERR_QD}, {HH_S_Q, 9, HH_ERR_Q}, {HH_S_OBJ_VEL, 3, HH_ERR_OBJ_VEL}, {HH_S_OBJ, 3, HH_ERR_OBJ}};
+    if (blk_all_finite(state + HH_S_Q, HH_S_WINDOW - HH_S_Q))
+        return HH_OK;
     for (int k = 0; k < 4; k++) {
         int i = first_non_finite(state + order[k][0], order[k][1]);
         if (i >= 0) {

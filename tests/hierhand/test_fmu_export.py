@@ -227,6 +227,26 @@ def test_a_numerical_blow_up_is_an_error_status_not_a_crash(fmus, fmi, tmp_path)
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
+def test_long_communication_steps_land_where_short_ones_do(fmus, fmi, tmp_path):
+    """A step of 25 ms is 250 plant steps, more than one advance call of the FMU takes:
+    it gives the native plant's samples as 25 steps of 1 ms do."""
+    slave = Slave(fmus[fmi], tmp_path)
+    try:
+        slave.set(**{"f_ext[1]": 0.5})
+        slave.initialize()
+        rows = []
+        for k in range(2):
+            slave.step(k * 0.025, 0.025)
+            rows.append(slave.get(Q + OBJ))
+    finally:
+        slave.close()
+    ref = native(f_ext=(0.5, 0.0, 0.0), n_steps=50)
+    got = np.array(rows)
+    np.testing.assert_array_equal(got[:, :9], ref["q"][[25, 50]])
+    np.testing.assert_array_equal(got[:, 9:], ref["obj"][[25, 50]])
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
 def test_communication_step_must_be_a_multiple_of_the_internal_step(fmus, fmi, tmp_path):
     short = simulate_in(tmp_path, fmus[fmi], stop_time=2 * STEP, output_interval=5e-4, output=["q[1]"])
     assert len(short) == 5  # 0.5 ms is 5 internal steps
