@@ -19,12 +19,12 @@ files.
 from __future__ import annotations
 
 import shutil
-import tempfile
 import threading
 import weakref
 import zipfile
 from pathlib import Path
 
+from .. import scratch
 from ..block import BlockError
 from .archive import ArchiveError, extract_archive
 from .description import MODEL_DESCRIPTION
@@ -88,7 +88,7 @@ class PooledModel(Model):
         """What an instance needs, extracting the archive the first time (a run starts)."""
         with self.extract_lock:
             if self.binary is None:
-                folder = Path(tempfile.mkdtemp(prefix="blocks-fmu-"))
+                folder = scratch.folder("fmu-")
                 self._dirs.append(str(folder))
                 try:
                     extract_archive(self.path, folder)

@@ -13,13 +13,13 @@ from __future__ import annotations
 import atexit
 import hashlib
 import shutil
-import tempfile
 import threading
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from urllib.parse import unquote, urlparse
 
+from .. import scratch
 from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, open_regular
 from ..safepath import inside
 
@@ -114,7 +114,7 @@ def _unpack(path: Path, shown: str) -> Path:
         found = _unpacked.get(digest)
         if found is not None and found.is_dir():
             return found
-        dest = Path(tempfile.mkdtemp(prefix="blocks-ssp-"))
+        dest = scratch.folder("ssp-")
         try:
             extract_archive(path, dest)
         except ArchiveError as exc:
