@@ -20,7 +20,7 @@ from pathlib import Path, PurePosixPath
 from urllib.parse import unquote, urlparse
 
 from .. import scratch
-from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, open_regular
+from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, file_kind, open_regular
 from ..safepath import inside
 
 SSD_NAME = "SystemStructure.ssd"
@@ -65,6 +65,9 @@ class Package:
         if not inside(target, self.root):
             raise PackageError(f"'{text}' lies outside the SSP")
         if not target.is_file():
+            if target.exists():
+                raise PackageError(f"'{text}' is {file_kind(target.stat().st_mode)}, not a regular file "
+                                   f"({self.where(target)})")
             raise PackageError(f"'{text}' is not in the SSP (looked at {self.where(target)})")
         return target
 
