@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .limits import MAX_DATA_BYTES
+from .safepath import unusable_path
 
 MAX_MEMBERS = 1_000_000
 """Most arrays one archive may hold (a results file holds two per logged signal)."""
@@ -37,8 +38,8 @@ def read_npz(path: str | Path, shown: str, limit: int, inflation: int | None = N
         raise ValueError(f"{shown}: no such file") from None
     except OSError as exc:
         raise ValueError(f"{shown}: cannot open: {exc.strerror or exc}") from None
-    except ValueError:
-        raise ValueError(f"{shown}: cannot open: the path contains a NUL character") from None
+    except ValueError as exc:
+        raise ValueError(f"{shown}: cannot open: {unusable_path(exc)}") from None
     with os.fdopen(fd, "rb") as fh:
         info = os.fstat(fh.fileno())
         if not stat.S_ISREG(info.st_mode):

@@ -10,6 +10,7 @@ with (``~/.ssh/...``, ``/etc/...``). And a diagram's ``name:`` names its results
 from __future__ import annotations
 
 import re
+import sys
 from pathlib import Path
 
 from .limits import MAX_FOLDER_NAME
@@ -17,6 +18,17 @@ from .limits import MAX_FOLDER_NAME
 _UNSAFE = re.compile(r"(?:[^\w.-]|\.{2,})+")
 """Runs of anything but letters, digits (of any script), '_', '-' and single dots: path
 separators, NUL and other control characters, spaces, and '..'."""
+
+
+def unusable_path(exc: ValueError) -> str:
+    """Why a path that the system refused with ``exc`` cannot be opened (``os.open`` raises
+    ValueError for a NUL character, UnicodeEncodeError for a character that the system's
+    file-name encoding cannot write, as ASCII cannot 'ü' in a C locale without UTF-8 mode)."""
+    if isinstance(exc, UnicodeEncodeError):
+        return (f"the path has a character ({exc.object[exc.start:exc.end]!r}) that this system's file names "
+                f"({sys.getfilesystemencoding()}) cannot hold; run in a UTF-8 locale (LC_ALL=C.UTF-8) or with "
+                "PYTHONUTF8=1")
+    return "the path contains a NUL character"
 
 
 def inside(path: str | Path, folder: str | Path) -> bool:

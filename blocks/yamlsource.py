@@ -23,6 +23,7 @@ from typing import Any, Sequence
 import yaml
 
 from .limits import MAX_ALIAS_VALUES, MAX_NUMBER_CHARS, MAX_YAML_BYTES, MAX_YAML_DEPTH
+from .safepath import unusable_path
 
 
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -106,8 +107,8 @@ def read_yaml_file(path: str | Path, kind: str = "YAML") -> str:
         raise
     except OSError as exc:
         raise YamlSourceError(f"cannot open: {exc.strerror or exc}", None) from None
-    except ValueError:
-        raise YamlSourceError("cannot open: the path contains a NUL character", None) from None
+    except ValueError as exc:
+        raise YamlSourceError(f"cannot open: {unusable_path(exc)}", None) from None
     info = os.fstat(fd)
     if not stat.S_ISREG(info.st_mode):
         os.close(fd)

@@ -76,3 +76,13 @@ def end_time(args: argparse.Namespace, diagram):
     if t_end <= 0:
         raise UsageError(f"--t-end must be positive, got {args.t_end!r}")
     return t_end
+
+
+def png_output(path: Path) -> Path:
+    """``path`` as the PNG file an ``-o`` option names: UsageError for a name that does not
+    end in .png (the picture would be written under another name) or for a folder."""
+    if path.is_dir():
+        raise UsageError(f"-o {path}: is a folder; name the .png file to write (e.g. -o {path / 'signals.png'})")
+    if path.suffix.lower() != ".png":
+        raise UsageError(f"-o {path}: write a .png file (e.g. -o {path.with_suffix('.png')})")
+    return path

@@ -7,6 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from .options import png_output
 from .program import EXIT_OK, UsageError
 
 SELECTION_HELP = ("an axis: a signal (plant.q), elements of it by label or 0-based index "
@@ -35,8 +36,8 @@ def cmd_plot(args: argparse.Namespace) -> int:
     from blocks.plot import plot_signals
     from blocks.plot_markers import markers
 
+    out = png_output(args.output) if args.output is not None else args.run_dir / "plots" / "signals.png"
     results = Results.load(args.run_dir)
-    out = args.output or args.run_dir / "plots" / "signals.png"
     events: list = []
     if not args.no_markers:
         events, notes = markers(results.info)

@@ -128,17 +128,23 @@ class NotARegularFile(OSError):
     """A path that names a folder, FIFO, device or socket where a file is read."""
 
 
+def file_kind(mode: int) -> str:
+    """What a file of ``st_mode`` ``mode`` is, for messages: 'a folder', 'a FIFO (named pipe)', ..."""
+    kind = stat.S_IFMT(mode)
+    return {stat.S_IFREG: "a regular file", stat.S_IFDIR: "a folder", stat.S_IFIFO: "a FIFO (named pipe)",
+            stat.S_IFCHR: "a device", stat.S_IFBLK: "a device", stat.S_IFSOCK: "a socket"}.get(kind,
+                                                                                            "not a regular file")
+
+
 def open_regular(path: str | os.PathLike):
     """The regular file ``path`` opened for binary reading. Opening does not wait for a
     FIFO's writer, and only a regular file is returned: anything else raises
     ``NotARegularFile``; a file that cannot be opened raises the OSError of ``os.open``."""
     fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
     try:
-        kind = stat.S_IFMT(os.fstat(fd).st_mode)
-        if kind != stat.S_IFREG:
-            what = {stat.S_IFDIR: "a folder", stat.S_IFIFO: "a FIFO (named pipe)", stat.S_IFCHR: "a device",
-                    stat.S_IFBLK: "a device", stat.S_IFSOCK: "a socket"}.get(kind, "not a regular file")
-            raise NotARegularFile(f"it is {what}, not a regular file")
+        mode = os.fstat(fd).st_mode
+        if not stat.S_ISREG(mode):
+            raise NotARegularFile(f"it is {file_kind(mode)}, not a regular file")
         os.set_blocking(fd, True)
         return os.fdopen(fd, "rb")
     except BaseException:

@@ -143,11 +143,15 @@ class FMU(Block):
         shown = f"FMU '{path}'"
         try:
             with open_fmu_file(resolved, shown) as fp:
+                fp.read(1)  # a file that cannot be read says so (is_zipfile would call it no zip archive)
+                fp.seek(0)
                 is_zip = zipfile.is_zipfile(fp)
         except FMUNotFound:
             raise ValueError(f"FMU file not found: looked at {resolved} (in a diagram, a relative path "
                              "is resolved against the diagram's folder; from Python, against the "
                              "current directory)") from None
+        except OSError as exc:
+            raise ValueError(f"{shown} cannot be read: {exc.strerror or exc}") from None
         if not is_zip:
             raise ValueError(f"{shown} is not an FMU: not a zip archive")
         if start_values is None:

@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree
 
+from ..safepath import unusable_path
 from ..timebase import DurationError, parse_duration
 from .archive import ArchiveError, NotARegularFile, open_regular, read_member
 
@@ -59,8 +60,8 @@ def open_fmu_file(path: str | Path, shown: str):
             raise FMUNotFound(f"FMU file not found: looked at {path} (a part of the path is a file, "
                               "not a folder)") from None
         raise FMUInfoError(f"{shown} cannot be read: {exc.strerror or exc}") from None
-    except ValueError:  # a NUL character in the path
-        raise FMUInfoError(f"{shown} cannot be read: the path contains a NUL character") from None
+    except ValueError as exc:  # a NUL character in the path, or one the file names cannot hold
+        raise FMUInfoError(f"{shown} cannot be read: {unusable_path(exc)}") from None
 
 
 def shown_text(text: Any) -> str:

@@ -16,7 +16,9 @@ checks and messages), so results are the same to the last bit; what it adds is:
 
 Requests are the messages of ``channel``: ``("instantiate", binary, inputs, outputs)``,
 ``("start", t, assignments, tolerance)``, ``("write", t)`` (set the channel's inputs: an FMU
-read with ``feedthrough``), ``("read", t)``, ``("stop",)``, ``("free",)``;
+read with ``feedthrough``), ``("read", t)``, ``("stop",)`` (terminate), ``("end",)``
+(freeInstance after a run: the binary stays loaded, the process runs on, and the next run
+instantiates again), ``("free",)`` (the host ends);
 a step is the channel's HOST_STEP. Every answer is ``("ok", value)``, ``("error",
 exception)`` or, for a step, ``("outcome", outcome, read error)``.
 """
@@ -133,7 +135,7 @@ class Host:
 
     # -- requests -------------------------------------------------------------------------
 
-    REQUESTS = ("instantiate", "start", "write", "read", "stop", "free")
+    REQUESTS = ("instantiate", "start", "write", "read", "stop", "end", "free")
     """The messages the run sends, each answered by the method of its name."""
 
     def handle(self, request: tuple) -> tuple:
@@ -147,11 +149,19 @@ class Host:
             return ("error", encode(exc))
 
     def instantiate(self, binary: Binary, inputs: list[tuple[str, int]], outputs: list[tuple[str, int]]) -> None:
-        cls = hosted_class(instance_class(binary))
-        cls.region = self.region
-        self.inputs, self.outputs = inputs, outputs
-        self.input_views = ports_of(self.region.inputs, inputs)
-        self.inst = inst = cls(binary)
+        """The instance: made (its binary loaded) the first time, made again on the loaded
+        binary after a run ended the last one (``end``)."""
+        self.ready(False)
+        self.table = None
+        if self.inst is None:
+            cls = hosted_class(instance_class(binary))
+            cls.region = self.region
+            self.inputs, self.outputs = inputs, outputs
+            self.input_views = ports_of(self.region.inputs, inputs)
+            self.inst = inst = cls(binary)
+        else:
+            inst = self.inst
+            inst.renew()
         self._trace(inst)
         if isinstance(inst, CoSimulation) and all(x.kind.name == "Float64" for x in (*inst.writes, *inst.reads)):
             self.table = self._fast_table(inst)
@@ -173,6 +183,13 @@ class Host:
         self.ready(False)
         self.inst.stop()
         return self.inst.broken
+
+    def end(self) -> None:
+        """The run is over: free the FMU's instance (freeInstance), keeping its binary
+        loaded and this process running for the next run (``instantiate``)."""
+        self.ready(False)
+        self.table = None
+        self.inst.end()
 
     def free(self) -> None:
         self.ready(False)

@@ -14,12 +14,14 @@ that names the FMU, the FMU function it was in (traced by the host), the time, a
 signal, exit code or timeout, with the FMU's last log messages; the run fails there with
 its results so far. A signal that stops the run (Ctrl-C, SIGTERM) while it waits for the
 host is raised as it came; the host, left inside a call, is killed when the instance is
-next touched or freed. Terminate runs when a run gives its instance back at its end
-(``FMU.finish``), before its results are made: a host that dies there fails the run at its
-end time, naming the call. FreeInstance runs when the block frees its pooled instances
-(``close``, or at exit), after every run: a host that dies there is reported on the
-``blocks.fmu`` logger as a warning, as is a terminate for a run's state given back only
-when it is dropped.
+next touched or freed. Terminate and freeInstance run when a run gives its instance back at its end
+(``FMU.finish``), before its results are made: a host that dies in either fails the run at
+its end time, naming the call. The host's process runs on with the FMU's binary loaded,
+pooled for the block's next run, which instantiates the FMU again there (a message, no
+new process). A run's state given back only when it is dropped (a run that failed
+already) terminates and frees the same way, and a host that dies then is reported on the
+``blocks.fmu`` logger as a warning, as is one that dies when the block ends its idle
+hosts (``close``, or at exit).
 """
 
 from __future__ import annotations
@@ -62,6 +64,9 @@ class HostedInstance:
         self.model = model
         self.timeout = model.timeout
         self.started = self.used = self.broken = self.freed = False
+        self.ended = False
+        """Whether the last run ended the FMU's instance (freeInstance in the host, whose
+        process runs on): the next run instantiates it again."""
         self.killed = False
         """Whether the host was killed (left inside a call, or too late)."""
         self.status: int | None = None
@@ -122,6 +127,9 @@ class HostedInstance:
 
     def start(self, t: float, assignments: list, tolerance: float | None, inputs: Mapping[str, Signal]) -> None:
         self._usable()
+        if self.ended:
+            self._message(("instantiate", self.model, self.model.in_ports, self.model.out_ports), "instantiating it")
+            self.ended = False
         self.used = True
         put_ports(self.region.inputs, self.model.in_ports, inputs)
         error = self._message(("start", t, assignments, tolerance), f"initialising it at t={t:.9g} s")
@@ -184,10 +192,12 @@ class HostedInstance:
         return terminate, early, last
 
     def stop(self, report: bool = False) -> None:
-        """End a started run's simulation (terminate); an instance that fails to is broken.
-        Called when a run gives the instance back: with ``report`` (at the end of the run,
-        before its results are made) a host that dies there raises its HostFailure, else
-        (a run's state dropped later) it is a warning."""
+        """End a started run: terminate the FMU's simulation, then free its instance
+        (freeInstance) in the host, whose process runs on with the binary loaded for the
+        next run; an instance whose terminate fails is broken. Called when a run gives the
+        instance back: with ``report`` (at the end of the run, before its results are made)
+        a host that dies in either call raises its HostFailure, else (a run's state dropped
+        later) it is a warning."""
         if not self.started or self.broken or self.inherited:
             return
         self.started = False
@@ -198,7 +208,9 @@ class HostedInstance:
             self.broken = True
             return
         try:
-            self.broken = bool(self._message(("stop",), "terminating it after its run"))
+            broken = bool(self._message(("stop",), "terminating it after its run"))
+            self._message(("end",), "freeing it after its run")
+            self.broken, self.ended = broken, True
         except HostFailure as exc:
             self.broken = True
             if report:
@@ -211,8 +223,8 @@ class HostedInstance:
             self.broken = True
 
     def free(self) -> None:
-        """Free the instance (freeInstance, in its host, which then ends) and its channel;
-        a host that dies there is a warning: the runs are over."""
+        """End the host (freeing the FMU's instance there first if no run's end did) and
+        close the channel; a host that dies there is a warning: the runs are over."""
         if self.freed:
             return
         self.freed = True

@@ -142,12 +142,18 @@ class Instance:
             if os.getcwd() != cwd:
                 os.chdir(cwd)
         self.slave = slave
+        self._make()
+
+    def _make(self) -> None:
+        """Instantiate the FMU on its loaded binary and preallocate the value transfers."""
+        model, slave = self.model, self.slave
         interrupt.arm()
         try:
-            self._instantiate(f"{model.shown} ({name})")
+            self._instantiate(f"{model.shown} ({slave.instanceName})")
         except Exception as exc:
             fmi2_buffers.pop(self.serial, None)
             slave.freeLibrary()
+            self.freed = True
             interrupt.check()
             raise BlockError(f"{model.shown}: instantiating the FMU failed: {exc}{self.log_text()}") from None
         self.component = slave.component
@@ -292,8 +298,38 @@ class Instance:
                 self.broken = True
             interrupt.deliver()
 
+    def end(self) -> None:
+        """Free the FMU's instance (freeInstance) and keep its binary loaded, to be
+        instantiated again by ``renew`` (an FMU host does so after each run, so that a crash
+        in freeInstance fails the run it ends). A failing call raises."""
+        if self.freed or self.component is None:
+            return
+        component, self.component = self.component, None
+        self.started = False
+        self.arm()
+        try:
+            self.slave._functions[f"fmi{self.model.major}FreeInstance"](component)
+        finally:
+            fmi2_buffers.pop(self.serial, None)
+        interrupt.deliver()
+
+    @property
+    def ended(self) -> bool:
+        """Whether ``end`` freed the FMU's instance (and ``renew`` has not made another)."""
+        return self.component is None and not self.freed
+
+    def renew(self) -> None:
+        """A new instance of the FMU on the binary loaded, after ``end``: as it was made
+        (BlockError if instantiating fails)."""
+        self.used = self.started = self.broken = False
+        self.messages.clear()
+        self._make()
+
     def free(self) -> None:
         if self.freed or self.slave is None:
+            return
+        if self.component is None:  # ended: the instance is freed, the binary goes with the process
+            self.freed = True
             return
         self.freed = True
         try:

@@ -6,7 +6,9 @@ instances its runs gave back and hands them to the next runs. ``PooledModel`` is
 block's ``Model`` with that pool: a run takes an idle instance (reset when it starts) or a
 new one (in this process, or for ``isolation: process`` in a process of its own,
 ``hosted``), extracting the archive the first time a run needs one; giving it back
-terminates the FMU's simulation and pools the instance, or frees it if it failed. A
+terminates the FMU's simulation and pools the instance (an isolated one is freed in its
+process, which is pooled and instantiates the FMU again for the next run), or frees it if
+it failed. A
 process forked from this one drops the isolated instances it inherited (their hosts
 belong to the parent) and makes its own, and an isolated instance whose process ended
 while it was idle is dropped too. Closing the block,
@@ -17,12 +19,12 @@ files.
 from __future__ import annotations
 
 import shutil
-import tempfile
 import threading
 import weakref
 import zipfile
 from pathlib import Path
 
+from .. import scratch
 from ..block import BlockError
 from .archive import ArchiveError, extract_archive
 from .description import MODEL_DESCRIPTION
@@ -86,7 +88,7 @@ class PooledModel(Model):
         """What an instance needs, extracting the archive the first time (a run starts)."""
         with self.extract_lock:
             if self.binary is None:
-                folder = Path(tempfile.mkdtemp(prefix="blocks-fmu-"))
+                folder = scratch.folder("fmu-")
                 self._dirs.append(str(folder))
                 try:
                     extract_archive(self.path, folder)
@@ -108,8 +110,10 @@ class PooledModel(Model):
 
     def release(self, inst: Instance, report: bool = False) -> None:
         """Take an instance back from a run: terminate and pool it, or free it if it failed.
-        With ``report`` (the run's end) a crash in terminate raises its HostFailure, to fail
-        the run; the pooled instance is freed (freeInstance) when the block is closed."""
+        An instance in a process of its own is also freed there (freeInstance; its process,
+        the binary loaded, is what the pool keeps). With ``report`` (the run's end) a crash
+        in either call raises its HostFailure, to fail the run; an instance in this process
+        is freed when the block is closed."""
         try:
             inst.stop(report=report)
         finally:

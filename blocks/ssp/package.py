@@ -13,14 +13,14 @@ from __future__ import annotations
 import atexit
 import hashlib
 import shutil
-import tempfile
 import threading
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from urllib.parse import unquote, urlparse
 
-from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, open_regular
+from .. import scratch
+from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, file_kind, open_regular
 from ..safepath import inside
 
 SSD_NAME = "SystemStructure.ssd"
@@ -65,6 +65,9 @@ class Package:
         if not inside(target, self.root):
             raise PackageError(f"'{text}' lies outside the SSP")
         if not target.is_file():
+            if target.exists():
+                raise PackageError(f"'{text}' is {file_kind(target.stat().st_mode)}, not a regular file "
+                                   f"({self.where(target)})")
             raise PackageError(f"'{text}' is not in the SSP (looked at {self.where(target)})")
         return target
 
@@ -114,7 +117,7 @@ def _unpack(path: Path, shown: str) -> Path:
         found = _unpacked.get(digest)
         if found is not None and found.is_dir():
             return found
-        dest = Path(tempfile.mkdtemp(prefix="blocks-ssp-"))
+        dest = scratch.folder("ssp-")
         try:
             extract_archive(path, dest)
         except ArchiveError as exc:

@@ -9,6 +9,7 @@ readers (libcosim) match the prefixes rather than the namespaces.
 
 from __future__ import annotations
 
+import os
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -52,11 +53,16 @@ def parse_file(path: Path) -> tuple[Any, str]:
     """The root element of the XML file ``path`` and its text; XmlError if it cannot be read."""
     from lxml import etree
 
+    from ..fmu.archive import NotARegularFile, open_regular
+
     try:
-        size = path.stat().st_size
-        if size > MAX_XML_BYTES:
-            raise XmlError(f"the file is {size} bytes, more than the limit of {MAX_XML_BYTES}")
-        data = path.read_bytes()
+        with open_regular(path) as fp:  # a FIFO or a device is refused unopened, not waited on or read
+            size = os.fstat(fp.fileno()).st_size
+            data = fp.read(MAX_XML_BYTES + 1) if size <= MAX_XML_BYTES else b""
+        if size > MAX_XML_BYTES or len(data) > MAX_XML_BYTES:
+            raise XmlError(f"the file is {max(size, len(data))} bytes or more, more than the limit of {MAX_XML_BYTES}")
+    except NotARegularFile as exc:
+        raise XmlError(f"cannot be read: {exc}") from None
     except OSError as exc:
         raise XmlError(f"cannot be read: {exc.strerror or exc}") from None
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,

@@ -10,7 +10,8 @@ it is what the sweep's point hashes are made from, so a changed params file or F
 new points rather than reusing old rows.
 
 In each process that runs points the bundle is written once into a private temporary
-folder (``folder``), keyed by its hash, each file checked against its sha256 first. The
+folder (``folder``, in the scratch root of ``blocks.scratch``, which the sweep's process
+removes at its exit, also after a runner was killed under it), keyed by its hash, each file checked against its sha256 first. The
 files keep the layout the diagram expects: the diagram's folder is a subfolder deep enough
 that ``../fmu/X.fmu`` lands inside the bundle folder; a file named by an absolute path goes
 to ``abs/<sha256>/NAME``. The diagram is then loaded from its text with ``files`` mapping
@@ -29,18 +30,18 @@ import json
 import os
 import posixpath
 import shutil
-import tempfile
 import threading
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from blocks import scratch
 from blocks.loader import CODE_DIR_KEY
 
 from .errors import SweepError
 
-TEMP_PREFIX = "blocks-bundle-"
-"""Prefix of the temporary folders bundles are written into."""
+TEMP_PREFIX = "bundle-"
+"""Prefix of the temporary folders bundles are written into (in the scratch root, ``blocks.scratch``)."""
 
 
 class BundleError(SweepError):
@@ -258,7 +259,7 @@ def _intact(bundle: DiagramBundle, target: Path) -> bool:
 
 
 def _write(bundle: DiagramBundle) -> Path:
-    target = Path(tempfile.mkdtemp(prefix=f"{TEMP_PREFIX}{bundle.hash[:12]}-"))
+    target = scratch.folder(f"{TEMP_PREFIX}{bundle.hash[:12]}-")
     try:
         for f in bundle.files:
             data = bundle.blobs.get(f.sha256)

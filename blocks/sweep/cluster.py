@@ -185,13 +185,17 @@ def _local_cluster(workers: int | None, method: str | None):
     import dask
     from distributed import LocalCluster
 
+    from .. import scratch
     from .worker_plugin import IgnoreCtrlC
 
-    settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method(method)}
+    settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method(method),
+                "temporary-directory": str(scratch.folder("dask-"))}  # the scheduler's and workers' folders
     with dask.config.set(settings), _children_ignore_ctrl_c():
         return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
                             host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL,
-                            plugins={IgnoreCtrlC()})
+                            plugins={IgnoreCtrlC()}, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"})
+        # without a dashboard the scheduler still serves HTTP, by default on port 8787: a free port
+        # instead, so that another program on 8787 gets no warning printed
 
 
 def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQueue, record: Record,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from blocks import Block, BlockError, EndRun, ParameterError
@@ -33,6 +35,22 @@ class FastAccumulator(Accumulator):
         steps = np.arange(1, n + 1)[:, None]
         rows = state[None, :] + steps * inputs["u"][None, :]
         return rows[-1].copy(), {"y": rows}
+
+
+class ReadyAccumulator(FastAccumulator):
+    """The fast accumulator that creates the file ``path`` when an ``advance`` call begins
+    with at least ``after`` hits already done (u = 1): the sign a test waits for that a run
+    has logged the hits before that call (the executor logs each call's rows before the next)."""
+
+    def __init__(self, path: str = "", after: int = 0):
+        super().__init__()
+        self.path, self.after = path, after
+
+    def advance(self, t, state, inputs, n):
+        if state[0] >= self.after and not os.path.exists(self.path):
+            with open(self.path, "a", encoding="utf-8"):
+                pass
+        return super().advance(t, state, inputs, n)
 
 
 class ChunkStart(FastAccumulator):

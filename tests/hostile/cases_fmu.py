@@ -242,12 +242,18 @@ def _running_cases() -> list[Case]:
                       r"SIGBUS \(a bus error: e\.g\. a truncated or changed binary file\)",
                       files={"d.yaml": diagram(), "plant.fmu": fmu(plain[:len(plain) // 2])},
                       check=saved_as("failed at t=0 s: block 'plant' (FMU)")))
-    cases.append(Case("fmu-crash-in-terminate-fails-the-run-at-its-end", run, 1,
-                      r"failed at t=0\.5 s: block 'plant' \(FMU\) finish: FMU 'plant\.fmu' crashed in fmi2Terminate "
-                      r"\(terminating it after its run\): SIGSEGV",
-                      files={"d.yaml": diagram(), "plant.fmu": fmu(misbehaving, **{
-                          "resources__misbehave.txt": "fmi2Terminate segv"})},
-                      check=saved_as("failed at t=0.5 s: block 'plant' (FMU) finish")))
+    for name, instructions, message in (
+            ("crash-in-terminate", "fmi2Terminate segv",
+             r"crashed in fmi2Terminate \(terminating it after its run\): SIGSEGV"),
+            ("crash-in-free-instance", "fmi2FreeInstance segv",
+             r"crashed in fmi2FreeInstance \(freeing it after its run\): SIGSEGV"),
+            ("exit-in-free-instance", "fmi2FreeInstance exit0",
+             r"called exit\(0\) in fmi2FreeInstance \(freeing it after its run\)")):
+        cases.append(Case(f"fmu-{name}-fails-the-run-at-its-end", run, 1,
+                          r"failed at t=0\.5 s: block 'plant' \(FMU\) finish: FMU 'plant\.fmu' " + message,
+                          files={"d.yaml": diagram(), "plant.fmu": fmu(misbehaving, **{
+                              "resources__misbehave.txt": instructions})},
+                          check=saved_as("failed at t=0.5 s: block 'plant' (FMU) finish")))
     return cases
 
 

@@ -28,7 +28,8 @@ class Case:
     ``argv`` is the command line after ``hierhand``, where ``{dir}`` stands for the case's
     folder and ``{root}`` for the repository; ``message`` is a regular expression searched
     in stderr; ``absent`` lists paths (relative to the folder, may climb out with ``..``)
-    that must not exist afterwards; ``check`` runs further assertions on the folder.
+    that must not exist afterwards; ``check`` runs further assertions on the folder;
+    ``env`` sets variables of the command's environment (a locale, an encoding).
     """
 
     name: str
@@ -39,6 +40,7 @@ class Case:
     absent: tuple[str, ...] = ()
     timeout: float = 60.0
     check: Callable[[Path, subprocess.CompletedProcess], None] | None = None
+    env: dict[str, str] = field(default_factory=dict)
 
 
 def run(case: Case, folder: Path) -> subprocess.CompletedProcess:
@@ -51,7 +53,7 @@ def run(case: Case, folder: Path) -> subprocess.CompletedProcess:
         else:
             path.write_text(content, encoding="utf-8")
     argv = [a.format(dir=folder, root=ROOT) for a in case.argv]
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    env = dict(os.environ, PYTHONPATH=str(ROOT), **case.env)
     return subprocess.run([sys.executable, "-m", "hierhand", *argv], capture_output=True, text=True,
                           cwd=folder, env=env, timeout=case.timeout)
 

@@ -4,8 +4,8 @@ An isolated FMU gives the samples it gives in the run's process, to the last bit
 path (the steady step in C on both sides, the Python paths, model exchange). An FMU that
 crashes, calls exit() or hangs in any of its calls fails the run there with a message that
 names the call, the time and the signal, exit code or timeout, and the results so far are
-kept; one that does so in terminate or freeInstance (after the run) is reported and the
-results stand. The misbehaving FMUs are ``sources/misbehave.h``'s: one library per kind,
+kept; one that does so in terminate or freeInstance (at the run's end) fails the run at its
+end time, all its samples kept. The misbehaving FMUs are ``sources/misbehave.h``'s: one library per kind,
 told what to do by a file in the FMU's resources.
 """
 
@@ -306,16 +306,45 @@ def test_a_crash_in_terminate_fails_the_run_at_its_end_with_its_results(tmp_path
     assert len(results["f.y"][0]) == 6
 
 
-def test_a_crash_in_free_instance_after_the_runs_is_a_warning(tmp_path, misbehaving, caplog):
-    """freeInstance runs when the block frees its pooled instance, after its runs."""
-    path = misbehaving_fmu(tmp_path / "late.fmu", "cs2", misbehaving["cs2"], "fmi2FreeInstance exit3")
-    d = diagram(path)
-    with caplog.at_level(logging.WARNING, logger="blocks.fmu"):
-        results = simulate(d)
-        d.blocks["f"].block.close()
-    assert results.complete and len(results["f.y"][0]) == 6
-    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
-    assert any("called exit(3) in fmi2FreeInstance (freeing it)" in w for w in warnings), warnings
+@pytest.mark.parametrize("kind, call, how, message", [
+    ("cs2", "fmi2FreeInstance", "segv", "crashed in fmi2FreeInstance (freeing it after its run): SIGSEGV"),
+    ("cs2", "fmi2FreeInstance", "exit3", "called exit(3) in fmi2FreeInstance (freeing it after its run)"),
+    ("cs3", "fmi3FreeInstance", "abort", "crashed in fmi3FreeInstance (freeing it after its run): SIGABRT"),
+], ids=["fmi2-segv", "fmi2-exit3", "fmi3-abort"])
+def test_a_crash_in_free_instance_fails_the_run_at_its_end_with_its_results(tmp_path, misbehaving, kind, call, how,
+                                                                            message):
+    """freeInstance runs at the run's end too, after terminate, in the FMU's process: a
+    crash there fails the run it ends, every sample kept; the next run starts a new process."""
+    path = misbehaving_fmu(tmp_path / "late.fmu", kind, misbehaving[kind], f"{call} {how}")
+    d = diagram(path, kind)
+    results = simulate(d)
+    assert results.status.startswith("failed at t=0.5 s: block 'f' (FMU) finish: "), results.status
+    assert message in results.status, results.status
+    assert len(results["f.y"][0]) == 6
+    assert simulate(d).status == results.status
+
+
+def _host_pids(d) -> list[int]:
+    """The processes of the FMU instances the block ``f`` of ``d`` keeps for its next runs."""
+    return [inst.pid for inst in d.blocks["f"].block._model.idle]
+
+
+@pytest.mark.parametrize("kind", ["cs2", "cs3", "me2"])
+def test_the_runs_of_a_diagram_share_the_fmus_process_each_with_a_new_instance(tmp_path, misbehaving, fmus, kind):
+    """Each run ends by freeing its FMU instance, yet the process that ran it (the FMU's
+    binary loaded) serves the next run, which instantiates the FMU there again: the same
+    samples every time, and one process for all."""
+    path = misbehaving_fmu(tmp_path / "tame.fmu", kind, misbehaving[kind])
+    d = diagram(path, kind, params="solver: euler" if kind == "me2" else "")
+    first = simulate(d)
+    gc.collect()
+    pids = _host_pids(d)
+    for _ in range(2):
+        same(first, simulate(d))
+        gc.collect()
+        assert _host_pids(d) == pids and len(pids) == 1
+    d.blocks["f"].block.close()
+    assert first.complete and len(first[OUTPUT[kind]][0]) == 6
 
 
 def test_a_well_behaved_misbehaving_fmu_is_the_first_order_fmu(tmp_path, misbehaving, fmus):

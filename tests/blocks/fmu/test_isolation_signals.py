@@ -1,5 +1,5 @@
 """Signals while an isolated FMU never returns: Ctrl-C and SIGTERM stop the run (exit 130
-and 143) with its results so far, and no process is left behind, also when the run itself
+and 143) with its results so far, and no process nor temporary file is left behind, also when the run itself
 is killed. The FMU hangs in doStep at t = 0.3 s after writing its process's id and its
 parent's (the launcher) into a FIFO the test reads: the sign that it hangs now."""
 
@@ -44,7 +44,8 @@ connections: [src.y -> plant.u]
 log: [plant.y]
 """)
     fd = os.open(ready, os.O_RDONLY | os.O_NONBLOCK)
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    (folder / "tmp").mkdir()  # TMPDIR, where the FMU is unpacked
+    env = dict(os.environ, PYTHONPATH=str(ROOT), TMPDIR=str(folder / "tmp"), BLOCKS_SCRATCH="")
     proc = subprocess.Popen([sys.executable, "-m", "blocks", "run", "d.yaml", "-o", "out", "-q"], cwd=folder,
                             stderr=subprocess.PIPE, text=True, env=env)
     try:
@@ -83,6 +84,7 @@ def test_a_signal_stops_a_run_whose_fmu_never_returns(tmp_path, misbehaving, sig
     assert info["status"] == f"interrupted at t=0.3 s by {name}"
     assert (tmp_path / "out" / "signals.npz").is_file()
     assert ended(host) and ended(launcher)
+    assert list((tmp_path / "tmp").iterdir()) == []  # the unpacked FMU removed
 
 
 def test_killing_the_run_ends_its_fmu_processes(tmp_path, misbehaving):

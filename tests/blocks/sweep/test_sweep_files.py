@@ -10,13 +10,14 @@ import math
 import os
 import shutil
 import subprocess
+import tempfile
 import time
 import zipfile
 from pathlib import Path
 
 import pytest
 
-from blocks import Results, load_diagram
+from blocks import Results, load_diagram, scratch
 from blocks.sweep import grid_points, parse_metrics, run_sweep
 from blocks.sweep.plan import execute, prepare
 from blocks.sweep.runner import SweepJob, run_point
@@ -139,7 +140,7 @@ def test_points_run_where_the_client_files_are_not(tmp_path, monkeypatch):
             else:
                 assert results.status.startswith("failed") and math.isclose(results.stop_time, 0.005)
                 assert results["plant.y"][0][-1] <= 0.005 + 1e-12  # what it computed before it failed
-    assert not list(Path(os.environ.get("TMPDIR", "/tmp")).glob(f"blocks-bundle-{plan.diagram_hash[:12]}-*"))
+    assert not list(Path(tempfile.gettempdir()).glob(f"blocks-*/bundle-{plan.diagram_hash[:12]}-*"))
 
 
 def test_a_changed_params_file_makes_new_points(tmp_path):
@@ -286,7 +287,7 @@ def test_a_dask_worker_elsewhere_runs_the_points(tmp_path):
     dask = shutil.which("dask")
     elsewhere = tmp_path / "worker-home"
     elsewhere.mkdir()
-    env = {**os.environ, "TMPDIR": str(elsewhere)}
+    env = {**{k: v for k, v in os.environ.items() if k != scratch.ENV}, "TMPDIR": str(elsewhere)}  # another machine
     log = open(tmp_path / "dask.log", "w")
     procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
                               stdout=log, stderr=subprocess.STDOUT, cwd=elsewhere)]
@@ -301,7 +302,7 @@ def test_a_dask_worker_elsewhere_runs_the_points(tmp_path):
         report, _, failed = execute(plan, out, scheduler=address, progress=False)
         assert (report.ran, failed) == (4, 2)
         check(out, expected)
-        assert not list(elsewhere.glob("blocks-bundle-*"))  # the worker's copy goes with the sweep
+        assert not list(elsewhere.glob("blocks-*/bundle-*"))  # the worker's copy goes with the sweep
     finally:
         _stop(procs[1:])  # the worker first: without its scheduler it waits 8 s to be killed
         _stop(procs[:1])

@@ -1,6 +1,9 @@
 """Ctrl-C during ``hierhand sweep``, sent as a terminal sends it (SIGINT to the whole process
 group, workers included): one line and exit code 130, no traceback from any process, only
-whole rows in sweep.csv, no process left behind, and the same command then runs the rest."""
+whole rows in sweep.csv, no process left behind, and the same command then runs the rest.
+SIGTERM to the sweep's process alone (as a batch system or ``timeout`` sends it), and a
+point that kills the process running it: nothing left in TMPDIR (``blocks.scratch``), no
+process left."""
 
 from __future__ import annotations
 
@@ -34,6 +37,24 @@ def _command(out: Path, mode: list[str]) -> list[str]:
             "--t-end", "2000 s", "--metric", "y=final(plant.y)", "--grid", GRID, "-q", *mode]
 
 
+def _empty_tmpdir(tmp_path: Path) -> dict[str, str]:
+    """The environment of a sweep whose TMPDIR is a new empty folder, ``tmp_path / 'tmp'``."""
+    (tmp_path / "tmp").mkdir()
+    return {**{k: v for k, v in os.environ.items() if k != "BLOCKS_SCRATCH"}, "TMPDIR": str(tmp_path / "tmp")}
+
+
+def _left_in(folder: Path) -> list[str]:
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
+
+
+def _wait_for_rows(proc: subprocess.Popen, out: Path, rows: int) -> None:
+    """Wait until sweep.csv holds ``rows`` rows (the sweep's processes have run points)."""
+    deadline = time.monotonic() + 120
+    while _row_count(out) < rows and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()}"
+
+
 def _rows(out: Path) -> list[dict]:
     with open(out / "sweep.csv", newline="") as f:
         return list(csv.DictReader(f))
@@ -61,13 +82,11 @@ def _group_gone(pgid: int, timeout: float) -> bool:
 @pytest.mark.parametrize("mode", [["--workers", "2"], ["--serial"], []], ids=["local-cluster", "serial", "default"])
 def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
     out = tmp_path / "sweep"
+    env = _empty_tmpdir(tmp_path)
     proc = subprocess.Popen(_command(out, mode), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True)
+                            text=True, start_new_session=True, env=env)
     try:
-        deadline = time.monotonic() + 120
-        while _row_count(out) < 2 and proc.poll() is None and time.monotonic() < deadline:
-            time.sleep(0.02)
-        assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()}"
+        _wait_for_rows(proc, out, 2)
         os.killpg(proc.pid, signal.SIGINT)
         _, err = proc.communicate(timeout=60)
     finally:
@@ -80,6 +99,7 @@ def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
     assert len(lines) == 1 and lines[0].startswith("hierhand: sweep interrupted: ")
     assert "run the same command again" in lines[0]
     assert _group_gone(proc.pid, timeout=20), "a worker process outlived the interrupted sweep"
+    assert _left_in(tmp_path / "tmp") == []
 
     kept = _rows(out)
     assert 2 <= len(kept) < 8
@@ -93,3 +113,42 @@ def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
     assert len(final) == 8 and len({r["point_hash"] for r in final}) == 8
     assert {r["point_hash"]: r["y"] for r in final if r["point_hash"] in {k["point_hash"] for k in kept}} == \
         {r["point_hash"]: r["y"] for r in kept}
+
+
+@pytest.mark.skipif(not hasattr(os, "killpg"), reason="process groups are POSIX")
+@pytest.mark.parametrize("mode", [["--workers", "2"], []], ids=["local-cluster", "default"])
+def test_sigterm_to_the_sweep_leaves_nothing_in_tmpdir_and_no_process(tmp_path, mode):
+    """The sweep's process alone gets SIGTERM once rows are in (its local runner or its Dask
+    workers have written the diagram's files): exit 143, and the runner's and workers'
+    files, which they could not remove themselves, are gone with the sweep's own."""
+    out = tmp_path / "sweep"
+    proc = subprocess.Popen(_command(out, mode), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True, env=_empty_tmpdir(tmp_path))
+    try:
+        _wait_for_rows(proc, out, 2)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=10)
+    assert proc.returncode == 143, err
+    assert err.startswith("hierhand: sweep interrupted: ") and len(err.splitlines()) == 1, err
+    assert _group_gone(proc.pid, timeout=20), "a worker process outlived the stopped sweep"
+    assert _left_in(tmp_path / "tmp") == []
+
+
+def test_a_point_that_kills_its_process_leaves_nothing_in_tmpdir(tmp_path):
+    """The local runner dies under a point (its diagram files still written): the sweep runs
+    the rest in a new one, and at its end nothing of either is left."""
+    from .test_sweep_cli import CRASH_DIAGRAM, CRASH_MODULE
+
+    (tmp_path / "crash_block_mod.py").write_text(CRASH_MODULE, encoding="utf-8")
+    (tmp_path / "crash.yaml").write_text(CRASH_DIAGRAM, encoding="utf-8")
+    env = {**_empty_tmpdir(tmp_path), "PYTHONPATH": os.pathsep.join([str(tmp_path), str(ROOT)])}
+    done = subprocess.run([sys.executable, "-m", "hierhand", "sweep", "crash.yaml", "-o", "sweep", "--grid",
+                           "src.value=11,12,13", "--metric", "y=final(crash.y)", "--trust", "-q"], cwd=tmp_path,
+                          env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 1 and "1 point(s) failed" in done.stderr, done.stderr
+    assert "died (exit code 3)" in (tmp_path / "sweep" / "sweep.csv").read_text()
+    assert _left_in(tmp_path / "tmp") == []
