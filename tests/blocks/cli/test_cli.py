@@ -136,6 +136,8 @@ def test_validate_prints_tick_hyperperiod_and_order(tmp_path):
     assert "base tick: 100 us" in out
     assert "hyperperiod" in out and "10 ms" in out
     assert "execution order" in out
+    assert "(lazy: a stateless block of inherited rate, computed only when a block that fires reads it" in out
+    assert "(advanced between events: stepped over the ticks where nothing else fires in one call)" in out
     for name in TOY_BLOCKS:
         assert name in out
     order = out.split("execution order", 1)[1]
