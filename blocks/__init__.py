@@ -18,6 +18,18 @@ from .simulate import SimulationError, StopRequest, simulate
 from .timebase import parse_duration
 from .yamlwriter import WriteError, dump_diagram, save_diagram
 
+
+
+def _wiring_svg(diagram: Diagram) -> str:
+    """Jupyter's view of a Diagram: its wiring graph (``blocks.graph``, a layer above the
+    diagram's data, so attached here, where both are known, and imported when first shown)."""
+    from .graph import svg_text
+
+    return svg_text(diagram)
+
+
+Diagram._repr_svg_ = _wiring_svg
+
 __all__ = [
     "Block", "BlockError", "Diagram", "DiagramBuilder", "DiagramError", "EndRun", "Issue", "ParameterError",
     "Results", "ResultsError", "Schedule", "SimulationError", "StopRequest", "WriteError", "build_schedule",

@@ -79,6 +79,17 @@ class Results:
     def __len__(self) -> int:
         return len(self.signals)
 
+    def __repr__(self) -> str:
+        from .results_summary import as_text
+
+        return as_text(self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view: the status and a table of the signals."""
+        from .results_summary import as_html
+
+        return as_html(self)
+
     @property
     def status(self) -> str:
         return self.info.get("status", "complete")

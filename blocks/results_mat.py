@@ -42,20 +42,34 @@ def field_name(part: str, signal: str) -> str:
     return name
 
 
+def mat_paths(signals) -> dict[str, list[str]]:
+    """Each signal name's path of MATLAB field names (``ctrl._aux.y`` -> ctrl, x_aux, y);
+    MatNameError for a name that is no MATLAB path or meets another one."""
+    paths: dict[str, list[str]] = {}
+    seen: dict[tuple[str, ...], str] = {}
+    for signal in signals:
+        parts = [field_name(p, signal) for p in signal.split(".")]
+        for n in range(1, len(parts) + 1):
+            other = seen.get(tuple(parts[:n]))
+            if other is not None and (n == len(parts) or other != "block"):
+                taken = "a block's path" if other == "block" else f"signal '{other}'"
+                raise MatNameError(f"signal '{signal}' cannot be written to a MAT file: its MATLAB name "
+                                   f"'{'.'.join(parts[:n])}' is taken by {taken}")
+        for n in range(1, len(parts)):
+            seen[tuple(parts[:n])] = "block"
+        seen[tuple(parts)] = signal
+        paths[signal] = parts
+    return paths
+
+
 def mat_contents(results: Any) -> dict[str, Any]:
     """The variables of the MAT file of ``results``: ``signals`` and ``run``."""
     tree: dict[str, Any] = {}
-    for signal, (t, v) in results.signals.items():
-        parts = [field_name(p, signal) for p in signal.split(".")]
+    for signal, parts in mat_paths(results.signals).items():
+        t, v = results.signals[signal]
         node = tree
         for part in parts[:-1]:
             node = node.setdefault(part, {})
-            if "name" in node and isinstance(node["name"], str):
-                raise MatNameError(f"signal '{signal}' cannot be written to a MAT file: its block path "
-                                   f"is also a signal's name")
-        if parts[-1] in node:
-            raise MatNameError(f"signal '{signal}' cannot be written to a MAT file: its MATLAB name "
-                               f"'{'.'.join(parts)}' is another signal's or block's")
         width = np.shape(v)[1]
         labels = results.element_labels(signal) or [str(j) for j in range(width)]
         units = results.units(signal) or [""] * width

@@ -43,17 +43,22 @@ def remove_if_empty(out: Path) -> None:
         out.rmdir()
 
 
-def save_run(results: Results, out: Path, csv: bool, plot: bool, temp_prefix: str = "results-") -> Saved:
-    """Write the results (signals.csv with ``csv``, plots with ``plot``) into ``out``, or
-    failing that into a new temporary folder whose name starts with ``temp_prefix``."""
+def save_run(results: Results, out: Path, csv: bool, plot: bool, temp_prefix: str = "results-",
+             mat: bool = False, csv_digits: int | None = None) -> Saved:
+    """Write the results (signals.csv with ``csv``, at ``csv_digits``, signals.mat with
+    ``mat``, plots with ``plot``) into ``out``, or failing that into a new temporary folder
+    whose name starts with ``temp_prefix``."""
+    def write(folder: Path) -> list[Path]:
+        return write_set(results, folder, csv, plot, mat=mat, csv_digits=csv_digits)
+
     try:
-        return Saved(out, write(results, out, csv, plot))
+        return Saved(out, write(out))
     except OSError as exc:
         reason = describe(exc)
     spare = None
     try:
         spare = Path(tempfile.mkdtemp(prefix=temp_prefix))
-        plots = write(results, spare, csv, plot)
+        plots = write(spare)
     except OSError as exc:
         if spare is not None:
             shutil.rmtree(spare, ignore_errors=True)
@@ -62,12 +67,13 @@ def save_run(results: Results, out: Path, csv: bool, plot: bool, temp_prefix: st
     return Saved(spare, plots, f"cannot save the results in {out}: {reason}; saved them in {spare} instead")
 
 
-def write(results: Results, folder: Path, csv: bool, plot: bool) -> list[Path]:
+def write_set(results: Results, folder: Path, csv: bool, plot: bool, mat: bool = False,
+              csv_digits: int | None = None) -> list[Path]:
     """The run's files, and its plots, into ``folder`` as one set; returns the plots."""
     from blocks.plot import plot_signals
 
     with writing(folder) as staged:
-        results.write_files(staged, csv)
+        results.write_files(staged, csv, mat=mat, csv_digits=csv_digits)
         made = plot_signals(results, staged / PLOTS / "signals.png") if plot and len(results) else []
     return [folder / PLOTS / p.name for p in made]
 

@@ -414,6 +414,18 @@ def draw_frame(ax, frame: Frame, rect: tuple[float, float, float, float]) -> Non
             va="center", zorder=4)
 
 
+def svg_text(diagram: Diagram, schedule: Schedule | None = None, expand: bool = False) -> str:
+    """The wiring as SVG text (planned over the diagram's own t_end when no schedule is given)."""
+    import io
+
+    from ..schedule import build_schedule
+
+    fig = draw(diagram, schedule if schedule is not None else build_schedule(diagram, None), expand)
+    out = io.StringIO()
+    fig.savefig(out, format="svg")
+    return out.getvalue()
+
+
 def render(diagram: Diagram, schedule: Schedule, path: str | Path, expand: bool = False) -> Path:
     """Draw the diagram to an SVG, PNG or PDF file (format from the suffix)."""
     path = Path(path)

@@ -10,7 +10,7 @@ from scipy.io import loadmat
 
 import blocks
 from blocks import Results
-from blocks.results_mat import MatNameError
+from blocks.results_mat import MatNameError, mat_paths
 
 DIAGRAM = """
 name: mat-run
@@ -65,7 +65,8 @@ def test_a_subsystem_block_is_a_nested_struct_and_a_leading_underscore_gets_an_x
 def test_names_that_meet_in_matlab_are_refused(tmp_path):
     r = Results({"a._b": (np.array([0.0]), np.array([[1.0]])),
                  "a.x_b": (np.array([0.0]), np.array([[2.0]]))}, {"status": "complete"})
-    with pytest.raises(MatNameError, match="signal 'a.x_b' cannot be written to a MAT file"):
+    with pytest.raises(MatNameError, match="signal 'a.x_b' cannot be written to a MAT file: its MATLAB "
+                                           "name 'a.x_b' is taken by signal 'a._b'"):
         r.save_mat(tmp_path / "refused.mat")
     assert list(tmp_path.iterdir()) == []
 
@@ -76,3 +77,8 @@ def test_save_with_mat_writes_signals_mat_and_a_later_save_without_removes_it(tm
     assert (tmp_path / "signals.mat").is_file()
     r.save(tmp_path)
     assert not (tmp_path / "signals.mat").exists()
+
+
+def test_a_name_matlab_cannot_take_is_refused_naming_the_signal():
+    with pytest.raises(MatNameError, match="signal 'a.y-z' cannot be written to a MAT file: 'y-z' is not a MATLAB name"):
+        mat_paths(["a.y-z"])
