@@ -4,6 +4,9 @@ loader and the executor, against a hand-written Python loop of the same equation
 Prints microseconds per base tick (0.1 ms) for both, median of several runs, and the
 ratio. Target (issue 27): loader + executor at most 3 times the hand-written loop.
 
+The same simulate with the check for outputs that are not finite turned off
+(``check_finite=False``) shows what that check costs.
+
 Then the same toy with one pure-Python block in the loop: ``u`` (the Sum that feeds the
 plant, evaluated at every 1 ms event) as a ``PythonSum``, the library's Sum without its
 kernel, so the executor calls its Python ``output`` 1000 times per simulated second
@@ -86,6 +89,18 @@ def timed(fn, repeat: int) -> tuple[float, object]:
     return statistics.median(times), result
 
 
+def timed_pair(first, second, repeat: int) -> tuple[float, float]:
+    """Median seconds of ``first`` and of ``second``, run by turns (so that a change in the
+    machine's load falls on both alike)."""
+    times: tuple[list[float], list[float]] = ([], [])
+    for _ in range(repeat):
+        for fn, into in ((first, times[0]), (second, times[1])):
+            t0 = time.perf_counter()
+            fn()
+            into.append(time.perf_counter() - t0)
+    return statistics.median(times[0]), statistics.median(times[1])
+
+
 def chain_text(n: int) -> str:
     """A diagram of a Constant and ``n`` Gain blocks in a line, over 2 base ticks of 1 ms."""
     lines = ["time: {t_end: 2 ms}", "blocks:", "  src: {type: Constant, period: 1 ms, params: {value: 1.0}}"]
@@ -150,6 +165,9 @@ def main() -> None:
     def executor_only(diagram=blocks.load_diagram(TOY)):
         return blocks.simulate(diagram, t_end=args.t_end)
 
+    def executor_unchecked(diagram=blocks.load_diagram(TOY)):
+        return blocks.simulate(diagram, t_end=args.t_end, check_finite=False)
+
     block_types()[PythonSum.type_name] = PythonSum
     python_text = toy_with_python_block()
 
@@ -161,7 +179,7 @@ def main() -> None:
 
     t_hand, ref = timed(lambda: hand_loop(n_ticks), args.repeat)
     t_full, res = timed(framework, args.repeat)
-    t_exec, _ = timed(executor_only, args.repeat)
+    t_exec, t_unchecked = timed_pair(executor_only, executor_unchecked, args.repeat)
     t_python, res_python = timed(with_python_block, args.repeat)
     t_python_exec, _ = timed(python_block_executor_only, args.repeat)
     err = float(np.max(np.abs(res["plant.y"][1][:, 0] - ref)))
@@ -171,6 +189,8 @@ def main() -> None:
     print(f"hand-written loop          : {t_hand * per:7.3f} us/tick")
     print(f"blocks (load + simulate)   : {t_full * per:7.3f} us/tick   ratio to hand loop {t_full / t_hand:6.2f}")
     print(f"blocks (simulate only)     : {t_exec * per:7.3f} us/tick   ratio to hand loop {t_exec / t_hand:6.2f}")
+    print(f"simulate, no finite check  : {t_unchecked * per:7.3f} us/tick   the check costs "
+          f"{100 * (t_exec / t_unchecked - 1):+.1f} % of simulate only")
     print(f"toy, u a Python block      : {t_python * per:7.3f} us/tick   ratio to hand loop {t_python / t_hand:6.2f}"
           f"   (load + simulate)")
     print(f"toy, u a Python block      : {t_python_exec * per:7.3f} us/tick   ratio to hand loop "

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from . import compiled
+from .finite import nonfinite_error
 from .kernel import Kernel, address
 from .optable import ADVANCE, L_CAPACITY, L_WIDTH, LC_ROWS, OP_A, OP_CODE, UPDATE, OpTable
 
@@ -26,8 +27,10 @@ KERNEL_COLUMNS = ("output", "update", "advance", "context", "state", "nogil")
 class Binding:
     """What one run of ``table`` owns: states, input mappings, kernels, arena and logs."""
 
-    def __init__(self, diagram: Any, table: OpTable):
+    def __init__(self, diagram: Any, table: OpTable, check_finite: bool = True):
         self.diagram, self.table = diagram, table
+        self.check_finite = check_finite
+        """Whether an output value that is not finite fails the run (``blocks.finite``)."""
         names = table.names
         specs = [diagram.blocks[n].block for n in names.blocks]
         self.blocks = specs
@@ -88,6 +91,11 @@ class Binding:
         (the block's ``EndRun`` for ``END_RUN`` from an update)."""
         kernel = self.kernels[b]
         return (kernel.error or compiled.failure)(code, which, self.table.time(tick), phase)
+
+    def nonfinite_error(self, b: int, which: int) -> BaseException:
+        """The error of block ``b``'s output value ``which`` that is not finite (``NONFINITE``)."""
+        name = self.table.names.blocks[b]
+        return nonfinite_error(self.table, self.arena, lambda port: self.diagram.element_labels(name, port), b, which)
 
     def rows_logged(self, entry: int) -> np.ndarray:
         """The rows log entry ``entry`` (a row of the logs table) holds."""

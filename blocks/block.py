@@ -166,7 +166,8 @@ class Block:
         self.period = period
 
     def set_width(self, width: int) -> None:
-        """Give every port declared with width ``None`` the inferred ``width``."""
+        """Give every port declared with width ``None`` the inferred ``width``; a block whose
+        parameters cannot work at that width raises ValueError, a load error at its line."""
         self.inputs = {p: (width if w is None else w) for p, w in self.inputs.items()}
         self.outputs = {p: (width if w is None else w) for p, w in self.outputs.items()}
 
@@ -253,7 +254,9 @@ class Block:
         a list of one string per element where they differ (``["m", "m", "rad"]`` for a
         pose; ``""`` for an element of unknown unit); None, the default, when the block
         does not know. Plots put it beside the signal's name and run.json keeps it
-        (``units``); it is information for people, not checked against connections."""
+        (``units``), and a connection whose other end declares another unit is a load
+        error (``blocks.annotations``). A diagram may give the ports a block leaves None
+        units of their own (``units: {b.y: rad}``)."""
         return None
 
     def describe(self) -> str:

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
 from .issues import Issue
-from .records import (BlockEntry, DiagramRecord, DiagramSource, LogRequest, PortEntry, Problem, ReferenceEntry,
+from .records import (Annotation, BlockEntry, DiagramRecord, DiagramSource, LogRequest, PortEntry, Problem, ReferenceEntry,
                       Site, SubsystemEntry, WireEntry, call_site)
 
 if TYPE_CHECKING:
@@ -49,13 +49,33 @@ class DiagramBuilder(DiagramRecord):
 
     def add(self, name: str, block: Any, *, period: Any = None, offset: Any = None,
             params: Mapping[str, Any] | None = None, params_file: str | None = None,
+            units: Mapping[str, Any] | None = None, elements: Mapping[str, Any] | None = None,
             where: Site | None = None) -> None:
         """A block: ``block`` is a registered type name (``"Gain"``), ``"python:mod:Class"``,
         a ``Block`` subclass or a ``Block`` instance (whose parameters are its
         constructor's; it cannot take ``params`` or overrides). ``period`` and ``offset``
         are durations (``"1 ms"``, seconds, a Fraction); without a period it inherits.
-        ``params`` may name other blocks for its block-reference parameters."""
-        self.entries.append(BlockEntry(name, block, period, offset, params, params_file, where or call_site()))
+        ``params`` may name other blocks for its block-reference parameters. ``units`` and
+        ``elements`` give ports the block knows nothing of a unit and element names, by
+        port (``units={"y": "rad"}``), as ``annotate`` does."""
+        site = where or call_site()
+        self.entries.append(BlockEntry(name, block, period, offset, params, params_file, site))
+        for key, given in (("units", units), ("elements", elements)):
+            if not isinstance(given, Mapping | None):
+                self.fail(site.issue(f"block '{name}': '{key}' must map port names to {key}",
+                                     "units: {y: rad}, elements: {y: [x, y, theta]}"), name)
+        for port in {**(units if isinstance(units, Mapping) else {}),
+                     **(elements if isinstance(elements, Mapping) else {})}:
+            self.annotate(f"{name}.{port}", units=(units or {}).get(port), elements=(elements or {}).get(port),
+                          where=site)
+
+    def annotate(self, signal: str, *, units: Any = None, elements: Any = None, where: Site | None = None) -> None:
+        """Give port ``signal`` (``"plant.y"``, an output or input of a block of this diagram
+        whose block has none) a unit (one text, or one per element: ``["m", "m", "rad"]``)
+        and names of its elements (``["x", "y", "theta"]``), which run.json, CSV columns,
+        plots and connections by label then use, and a connection's other end is checked
+        against (a connection of two different units is an error)."""
+        self.annotations.append(Annotation(signal, units, elements, where or call_site()))
 
     def add_subsystem(self, name: str, diagram: DiagramRecord | DiagramSource, *,
                       params: Mapping[str, Any] | None = None,

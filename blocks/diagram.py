@@ -73,11 +73,30 @@ class BlockSpec:
     """The type as the diagram names it (``Gain``, ``python:mod:Cls``); None: ``type_name``."""
     scope: FileScope = field(default_factory=FileScope)
     """Where the relative paths of its file lead."""
+    units: dict[str, str | list[str]] = field(default_factory=dict)
+    """The units the diagram gives its ports (``blocks.annotations``), by port."""
+    labels: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    """The element names the diagram gives its ports, by port."""
+
+    def port_units(self, port: str) -> str | list[str] | None:
+        """The unit(s) of ``port``: the diagram's, else the block's own (None: unknown)."""
+        return self.units.get(port) or self.block.port_units(port)
+
+    def element_labels(self, port: str) -> list[str] | None:
+        """The element names of ``port``: the diagram's, else the block's (None: numbered)."""
+        given = self.labels.get(port)
+        return list(given) if given is not None else self.block.element_labels(port)
 
 
 @dataclass(frozen=True)
 class Connection:
-    """A wire from an output port to an input port, optionally delayed by one sample."""
+    """A wire from an output port to an input port, optionally delayed by one sample.
+
+    Either end may name some of its port's elements (``c.y[1] -> g.u``, ``a.y -> g.u[0]``,
+    by label, index or slice: ``blocks.elements``): ``src_select`` / ``dst_select`` as
+    written, and once the widths are known the 0-based ``src_elements`` / ``dst_elements``
+    they stand for (None: the whole port). Several connections may then drive one input,
+    each some of its elements."""
 
     src_block: str
     src_port: str
@@ -89,17 +108,37 @@ class Connection:
     file: str | None = None
     """The file the connection is written in (None: the diagram's own; a subsystem's file
     for a wire of a subsystem or one into or out of it)."""
+    src_select: str | None = None
+    dst_select: str | None = None
+    src_elements: tuple[int, ...] | None = None
+    dst_elements: tuple[int, ...] | None = None
 
     @property
     def src(self) -> str:
+        """The source port, ``block.port``."""
         return f"{self.src_block}.{self.src_port}"
 
     @property
     def dst(self) -> str:
+        """The destination port, ``block.port``."""
         return f"{self.dst_block}.{self.dst_port}"
 
+    @property
+    def src_text(self) -> str:
+        """The source as written: ``c.y`` or ``c.y[1]``."""
+        return self.src if self.src_select is None else f"{self.src}[{self.src_select}]"
+
+    @property
+    def dst_text(self) -> str:
+        return self.dst if self.dst_select is None else f"{self.dst}[{self.dst_select}]"
+
+    @property
+    def by_element(self) -> bool:
+        """Whether either end names elements."""
+        return self.src_select is not None or self.dst_select is not None
+
     def __str__(self) -> str:
-        return f"{self.src} -> {self.dst}" + (" (delay 1)" if self.delay else "")
+        return f"{self.src_text} -> {self.dst_text}" + (" (delay 1)" if self.delay else "")
 
 
 @dataclass(frozen=True)
@@ -290,17 +329,24 @@ class Diagram:
             raise ValueError(f"decimation must be a positive whole number, got {factor!r}")
         return dataclasses.replace(self, log=[dataclasses.replace(e, decimate=e.decimate * factor) for e in self.log])
 
-    def driver_of(self, block: str, port: str) -> Connection | None:
-        """The connection feeding input ``block.port``, if any."""
-        for c in self.connections:
-            if c.dst_block == block and c.dst_port == port:
-                return c
-        return None
+    def drivers_of(self, block: str, port: str) -> list[Connection]:
+        """The connections feeding input ``block.port``: one, or several that each drive some
+        of its elements; none for an unconnected input."""
+        return [c for c in self.connections if c.dst_block == block and c.dst_port == port]
 
     def width(self, signal: str) -> int:
         """Width of an output signal ``block.port`` (the block may be a path, ``ctrl.u``)."""
         block, port = signal.rsplit(".", 1)
         return self.blocks[block].block.outputs[port]
+
+    def element_labels(self, block: str, port: str) -> list[str] | None:
+        """The names of the elements of port ``block.port``, the diagram's or its block's
+        (None: numbered from 0)."""
+        return self.blocks[block].element_labels(port)
+
+    def port_units(self, block: str, port: str) -> str | list[str] | None:
+        """The unit(s) of port ``block.port``, the diagram's or its block's (None: unknown)."""
+        return self.blocks[block].port_units(port)
 
     def split_key(self, key: str) -> tuple[str, str] | None:
         """``ctrl.prop.k.0`` -> (``ctrl.prop``, ``k.0``): the block a ``block.param`` key

@@ -13,6 +13,7 @@ from typing import Callable
 
 from .binding import Binding
 from .compiled import native
+from .finite import NONFINITE
 from .kernel import END_RUN, RAISED
 from .optable import OP_A, OP_CODE, PHASES
 from .outcome import Outcome, stopped
@@ -39,7 +40,7 @@ def run_native(binding: Binding, progress: Callable[[int], None] | None) -> Outc
     side = PythonSide(binding)
     python = [python_spec(side, b) if k is None else None for b, k in enumerate(binding.kernels)]
     run = native().Run(table.arrays(), binding.arena, binding.logs, binding.counters, binding.kernel_rows(), python,
-                       binding.states, side, progress)
+                       binding.states, side, progress, allow_nonfinite=not binding.check_finite)
     status, end, reached, code, which, op, tick, error, end_op, end_asked, end_reason, message = run.run()
     names = table.names.blocks
     end_request = None if end_op < 0 else (names[int(table.ops[end_op, OP_A])], end_reason.reason, end_asked)
@@ -53,6 +54,8 @@ def run_native(binding: Binding, progress: Callable[[int], None] | None) -> Outc
         raise RuntimeError(f"the op table could not run: {message}")
     b = int(table.ops[op, OP_A])
     phase = PHASES[int(table.ops[op, OP_CODE])]
+    if code == NONFINITE:
+        return stopped(names[b], phase, tick, binding.nonfinite_error(b, which), reached, False, end_request)
     if code != RAISED and not (code == END_RUN and error is not None):
         error = binding.kernel_error(b, code, which, tick, phase)
     return stopped(names[b], phase, tick, error, reached, binding.kernels[b] is None, end_request)

@@ -27,9 +27,9 @@ from .scopes import NAME
 from .yamlsource import LineDict, LineList, YamlSourceError, line_of, load_yaml, read_yaml_file
 
 TOP_KEYS = ("version", "name", "description", "time", "blocks", "connections", "inputs", "outputs", "references",
-            "log")
+            "log", "units", "elements")
 TIME_KEYS = ("t_end",)
-BLOCK_KEYS = ("type", "period", "offset", "params", "params_file", "description")
+BLOCK_KEYS = ("type", "period", "offset", "params", "params_file", "description", "units", "elements")
 SUBSYSTEM_KEYS = ("diagram", "params", "bind", "description")
 CONNECTION_KEYS = ("from", "to", "delay", "initial")
 LOG_KEYS = ("signal", "decimate")
@@ -176,7 +176,24 @@ class _FrontEnd:
         self.ports_section(data, "outputs")
         self.references_section(data)
         self.log_section(data)
+        for key in ("units", "elements"):
+            self.annotations(data, key, "")
         return b
+
+    def annotations(self, data: LineDict, key: str, block: str) -> None:
+        """``units: {plant.y: rad}`` / ``elements: {plant.y: [x, y]}`` (on a block entry by
+        port: ``units: {y: rad}``): the diagram's units and element names of ports."""
+        section = data.get(key)
+        if section is None:
+            return
+        example = f"{key}: {{{'' if block else 'plant.'}y: {'rad' if key == 'units' else '[x, y, theta]'}}}"
+        if not isinstance(section, LineDict):
+            self.fail(data.line_of(key), f"'{key}' must map {'ports' if block else 'signals (block.port)'} to "
+                      f"{'units' if key == 'units' else 'lists of element names'}", example)
+            return
+        for port, value in section.items():
+            signal = f"{block}.{port}" if block else port
+            self.b.annotate(signal, where=self.site(section.line_of(port)), **{key: value})
 
     def time_section(self, data: LineDict) -> None:
         section = data.get("time")
@@ -219,6 +236,8 @@ class _FrontEnd:
             self.check_keys(spec, BLOCK_KEYS, "key", f" in block '{name}'")
             self.b.add(name, spec.get("type"), period=spec.get("period"), offset=spec.get("offset"),
                        params=spec.get("params"), params_file=spec.get("params_file"), where=site)
+            for key in ("units", "elements"):
+                self.annotations(spec, key, name)
 
     def connections_section(self, data: LineDict) -> None:
         section = data.get("connections")

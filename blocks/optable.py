@@ -34,7 +34,8 @@ from typing import Any
 
 import numpy as np
 
-from .diagram import Diagram
+from .diagram import Connection, Diagram
+from .elements import contiguous, paired_runs
 from .issues import DiagramError
 from .schedule import EventProgram, Schedule, final_program
 from .timebase import format_duration
@@ -69,9 +70,12 @@ TABLES = ("header", "blocks", "inputs", "ports", "ops", "copies", "programs", "e
 WIDTHS = (7, 9, 2, 3, 5, 3, 3, 2, 5, 1)
 """The tables in core.h's order, and their row widths."""
 
-FEEDS = ("source", "delayed", "default until fired", "unconnected")
-"""What an input port reads: its source's output; a buffer a delayed connection samples
-into; a buffer that holds its default until its source first fires; its default."""
+FEEDS = ("source", "delayed", "default until fired", "unconnected", "assembled")
+"""What an input port reads: its source's output (or a run of its elements); a buffer a
+delayed connection samples into; a buffer that holds its default until its source first
+fires; its default; a buffer that copies of its elements assemble from one or several
+outputs (connections naming elements), each as its source fires or, delayed, as its
+destination does."""
 
 PACK_MAGIC = 0x454C4241544B4C42
 PACK_VERSION = 1
@@ -191,8 +195,8 @@ class _Compiler:
         self.selections: list[int] = []
         self.forwards: dict[str, list[tuple[str, int]]] = {n: [] for n in self.names}
         """Per block, the copies that follow its outputs: (its port, copy)."""
-        self.sampled: dict[int, int] = {}
-        """Per delayed connection (its index), its copy."""
+        self.sampled: dict[int, list[int]] = {}
+        """Per delayed connection (its index), its copies."""
 
     def place(self, width: int, values: Any = None) -> int:
         offset = self.size
@@ -256,39 +260,73 @@ class _Compiler:
                        _frozen(logs, 5), _frozen(self.selections, 1), initial, names, s.base_tick)
 
     def lay_out_inputs(self):
-        """Where each input port reads: its source's output, or a buffer of its own when
-        the connection is delayed, when it holds a default until its source first fires,
-        or when nothing feeds it (its default)."""
+        """Where each input port reads: its source's output (a run of its elements), or a
+        buffer of its own when the connection is delayed, when it holds a default until its
+        source first fires, when nothing feeds it (its default), or when connections naming
+        elements assemble it."""
         d = self.d
-        feeding = {(c.dst_block, c.dst_port): (i, c) for i, c in enumerate(d.connections)}
+        feeding: dict[tuple[str, str], list[tuple[int, Connection]]] = {}
+        for i, c in enumerate(d.connections):
+            feeding.setdefault((c.dst_block, c.dst_port), []).append((i, c))
         rows, names, feeds = [], [], []
         for name in self.names:
             blk = d.blocks[name].block
             kinds = []
             for port, width in blk.inputs.items():
-                i, c = feeding.get((name, port), (None, None))
+                conns = feeding.get((name, port), [])
                 default = _value(blk.input_defaults.get(port), width)
-                if c is None:
+                one = conns[0][1] if len(conns) == 1 else None
+                if not conns:
                     kind, offset = "unconnected", self.place(width, default)
-                elif c.delay:
-                    kind = "delayed"
-                    initial = None if c.initial is None else np.broadcast_to(
-                        np.asarray(c.initial, dtype=float), (width,))
-                    offset = self.place(width, initial)
-                    self.sampled[i] = self.copy(offset, self.port_offset[c.src_block, c.src_port], width,
-                                                f"{c.src_block}.{c.src_port} -> {name}.{port} (delay 1)")
-                elif port in blk.input_defaults:
-                    kind, offset = "default until fired", self.place(width, default)
-                    self.forwards[c.src_block].append((c.src_port, self.copy(
-                        offset, self.port_offset[c.src_block, c.src_port], width,
-                        f"{c.src_block}.{c.src_port} -> {name}.{port} (its default until {c.src_block} first fires)")))
+                elif one is None or one.dst_elements is not None or not contiguous(one.src_elements or ()):
+                    kind, offset = "assembled", self.assemble(name, port, width, conns)
                 else:
-                    kind, offset = "source", self.port_offset[c.src_block, c.src_port]
+                    i, c = conns[0]
+                    source = self.port_offset[c.src_block, c.src_port] + (c.src_elements or (0,))[0]
+                    if c.delay:
+                        kind = "delayed"
+                        initial = None if c.initial is None else np.broadcast_to(
+                            np.asarray(c.initial, dtype=float), (width,))
+                        offset = self.place(width, initial)
+                        self.sampled[i] = [self.copy(offset, source, width, f"{c.src_text} -> {name}.{port} (delay 1)")]
+                    elif port in blk.input_defaults:
+                        kind, offset = "default until fired", self.place(width, default)
+                        self.forwards[c.src_block].append((c.src_port, self.copy(
+                            offset, source, width,
+                            f"{c.src_text} -> {name}.{port} (its default until {c.src_block} first fires)")))
+                    else:
+                        kind, offset = "source", source
                 rows.append([offset, width])
                 kinds.append(kind)
             names.append(tuple(blk.inputs))
             feeds.append(tuple(kinds))
         return rows, tuple(names), tuple(feeds)
+
+    def assemble(self, name: str, port: str, width: int, conns: list[tuple[int, Connection]]) -> int:
+        """The buffer of an input that connections assemble, element by element: the
+        input's default (or zeros), a delayed part's initial value where it goes; each
+        connection's copies, in runs, after its source's outputs or, delayed, at its
+        destination's hits."""
+        blk = self.d.blocks[name].block
+        values = np.zeros(width)
+        if port in blk.input_defaults:
+            values[:] = np.broadcast_to(np.asarray(blk.input_defaults[port], dtype=float).ravel(), (width,))
+        ends = [(c.src_elements if c.src_elements is not None else tuple(range(self.d.width(c.src))),
+                 c.dst_elements if c.dst_elements is not None else tuple(range(width))) for _, c in conns]
+        for (_, c), (_, dst) in zip(conns, ends):
+            if c.initial is not None:
+                values[list(dst)] = np.broadcast_to(np.asarray(c.initial, dtype=float), (len(dst),))
+        offset = self.place(width, values)
+        for (i, c), (src, dst) in zip(conns, ends):
+            at = self.port_offset[c.src_block, c.src_port]
+            copies = [self.copy(offset + b, at + a, n, f"{c.src_text} -> {c.dst_text}" + (
+                " (delay 1)" if c.delay else "") + f", {_span(a, n)} -> {_span(b, n)}")
+                for a, b, n in paired_runs(src, dst)]
+            if c.delay:
+                self.sampled[i] = copies
+            else:
+                self.forwards[c.src_block] += [(c.src_port, copy) for copy in copies]
+        return offset
 
     def copy(self, dst: int, src: int, width: int, what: str) -> int:
         self.copies.append([dst, src, width])
@@ -351,7 +389,7 @@ class _Compiler:
             ops.append([OUTPUT, b[name], first, end, self.selection(name, ports)])
             ops += [[COPY, c, 0, 0, 0] for port, c in self.forwards[name] if ports is None or port in ports]
         ops += [[UPDATE, b[name], 0, 0, 0] for name in program.update]
-        ops += [[COPY, self.sampled[i], 0, 0, 0] for i in program.sample]
+        ops += [[COPY, copy, 0, 0, 0] for i in program.sample for copy in self.sampled[i]]
         for name in program.advance:
             first, end = self.block_logs.get(name, (0, 0))
             ops.append([ADVANCE, b[name], first, end, int(name == program.advance[-1])])
@@ -365,3 +403,8 @@ def _value(value: Any, width: int) -> np.ndarray | None:
         return None
     array = np.asarray(value, dtype=float)
     return array if array.shape == (width,) else None
+
+
+def _span(first: int, length: int) -> str:
+    """Elements ``first`` .. ``first + length - 1`` as the op table's text names them."""
+    return f"[{first}]" if length == 1 else f"[{first}:{first + length}]"

@@ -1,7 +1,8 @@
 """What a plot shows: signals, elements of them, and which share an axis.
 
 A selection is the text of one ``plot -s``: one axis, holding one or more signals
-separated by commas, each optionally narrowed to some of its elements in brackets::
+separated by commas, each optionally narrowed to some of its elements in brackets, as a
+connection names them (``blocks.elements``)::
 
     plant.q                      every element of plant.q
     plant.q[fore.1]              the element the block labels fore.1
@@ -9,23 +10,18 @@ separated by commas, each optionally narrowed to some of its elements in bracket
     plant.q[thumb.1,fore.1]      several elements, by label or index
     plant.q[fore.1],ref.y        two signals overlaid on one axis
 
-A label is matched before an index, so a block whose elements are labelled ``1``, ``2``
-(an FMU's ``y[1]``) is selected by those labels. Commas inside brackets list elements;
-outside they separate signals.
+Commas inside brackets list elements; outside they separate signals.
 """
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass
 
+from .elements import ElementError, pick, split_signal
 from .results import Results
 
-_PART = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)+)\s*(?:\[(.*)\])?\s*$")
-_SLICE = re.compile(r"^\s*(-?\d+)?\s*:\s*(-?\d+)?\s*(?::\s*(-?\d+)\s*)?$")
 
-
-class SelectionError(ValueError):
+class SelectionError(ElementError):
     """A selection that names no logged signal or element (one line, with what there is)."""
 
 
@@ -60,10 +56,10 @@ def select(results: Results, text: str) -> list[Trace]:
     """The traces of one axis, from the text of one selection."""
     traces = []
     for part in split_signals(text):
-        found = _PART.match(part)
+        found = split_signal(part)
         if found is None:
             raise SelectionError(f"'{part}' is not a signal (block.port) or an element of one (block.port[label])")
-        signal, elements = found.group(1), found.group(2)
+        signal, elements = found
         if signal not in results:
             raise SelectionError(f"signal '{signal}' was not logged; logged signals: "
                                  f"{', '.join(results) or 'none'}")
@@ -96,32 +92,8 @@ def _trace(results: Results, signal: str, elements: str | None) -> Trace:
     if elements is None:
         return Trace(signal, tuple(range(width)), tuple(labels if given else (f"[{j}]" for j in range(width))),
                      signal)
-    text = elements.strip()
-    columns = _columns(text, labels, width, signal)
-    return Trace(signal, tuple(columns), tuple(labels[c] for c in columns), f"{signal}[{text}]")
-
-
-def _columns(text: str, labels: list[str], width: int, signal: str) -> list[int]:
-    if text in labels:
-        return [labels.index(text)]
-    if "," in text:
-        return [c for part in text.split(",") for c in _columns(part.strip(), labels, width, signal)]
     try:
-        index = int(text)
-    except ValueError:
-        pass
-    else:
-        if not -width <= index < width:
-            raise SelectionError(f"signal '{signal}' has {width} element(s): index {index} is out of range")
-        return [index % width]
-    found = _SLICE.match(text)
-    if found is not None and ":" in text:
-        start, stop, step = (None if g is None else int(g) for g in found.groups())
-        if step == 0:
-            raise SelectionError(f"'{signal}[{text}]': a slice step must not be 0")
-        picked = list(range(width))[slice(start, stop, step)]
-        if not picked:
-            raise SelectionError(f"'{signal}[{text}]' selects no element of its {width}")
-        return picked
-    raise SelectionError(f"signal '{signal}' has no element '{text}'; its elements: {', '.join(labels)} "
-                         "(or an index from 0, or a slice start:stop)")
+        columns = pick(elements, labels, width, f"signal '{signal}'")
+    except ElementError as exc:
+        raise SelectionError(str(exc)) from None
+    return Trace(signal, tuple(columns), tuple(labels[c] for c in columns), f"{signal}[{elements}]")

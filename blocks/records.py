@@ -105,6 +105,17 @@ class ReferenceEntry:
 
 
 @dataclass
+class Annotation:
+    """``annotate`` (or a block entry's ``units`` / ``elements``): the unit(s) and element
+    names the diagram gives a port (``signal``: ``block.port``) of a block that has none."""
+
+    signal: Any
+    units: Any
+    elements: Any
+    site: Site
+
+
+@dataclass
 class LogRequest:
     """``log``: a signal (``block.port``, ``sub.block.port``), or (``every``) every signal."""
 
@@ -155,6 +166,7 @@ class DiagramRecord:
         self.outputs: list[PortEntry] = []
         self.references: list[ReferenceEntry] = []
         self.logs: list[LogRequest] = []
+        self.annotations: list[Annotation] = []
         self.problems: list[Problem] = []
         self.texts: list[str] = []
         """The source texts the diagram comes from (its YAML), for its hash."""
@@ -188,5 +200,7 @@ class DiagramRecord:
             "references": [jsonable([r.name, block(r.stand_in)]) for r in self.references],
             "log": [jsonable([r.signal, r.decimate, r.every]) for r in self.logs],
         }
+        if self.annotations:
+            record["annotations"] = [jsonable([a.signal, a.units, a.elements]) for a in self.annotations]
         return json.dumps(record, sort_keys=True, default=str)
 

@@ -21,6 +21,7 @@ from typing import Callable
 from .binding import Binding
 from .block import EndRun
 from .compiled import native
+from .finite import first_nonfinite, nonfinite_output
 from .kernel import END_RUN
 from .optable import (B_FIRST_INPUT, B_N_INPUTS, B_OUT, B_PERIOD, B_ROWS, B_ROWS_CAPACITY, B_WIDTH, C_DST, C_SRC,
                       C_WIDTH, COPY, E_PROGRAM, E_TICK, H_FINAL, H_HYPERPERIOD, H_INITIAL, H_N_TICKS, I_OFFSET,
@@ -116,6 +117,9 @@ class ReferenceLoop:
             self.guarded(op, k, lambda: self.python.output(b, op[OP_D], t))
         else:
             self.checked(op, k, self.kernel_call(op, k, "output", self.b.kernels[b].output, t, self.out(b)))
+        bad = nonfinite_output(self.t, self.b.arena, b, op[OP_D]) if self.b.check_finite else -1
+        if bad >= 0:
+            self.fail(op, k, self.b.nonfinite_error(b, bad), python=False)
         row = self.out(b)
         for entry in range(op[OP_B], op[OP_C]):
             self.log(entry, row)
@@ -157,7 +161,14 @@ class ReferenceLoop:
                 done, error = self.python.advance(b, self.t.time(first), m)
             else:
                 done, error = self.kernel_advance(b, first, m, rows)
-            for i in range(done if error is not None else m):
+            logged = done if error is not None else m
+            for i in range(logged if self.b.check_finite else 0):
+                bad = first_nonfinite(rows[i * width:(i + 1) * width])
+                if bad >= 0:
+                    self.out(b)[:] = rows[i * width:(i + 1) * width]
+                    logged, done, error = i, i + 1, self.b.nonfinite_error(b, bad)
+                    break
+            for i in range(logged):
                 for entry in range(op[OP_B], op[OP_C]):
                     self.log(entry, rows[i * width:(i + 1) * width])
             if error is not None:

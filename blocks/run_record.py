@@ -43,8 +43,8 @@ class PortInfoFailure(Exception):
 
 
 def port_info(diagram: Diagram) -> tuple[dict[str, list[str]], dict[str, str | list[str]]]:
-    """The element labels and units of the logged signals whose blocks know them
-    (``Block.element_labels``, ``Block.port_units``), checked: one label per element; a
+    """The element labels and units of the logged signals whose blocks or diagram give them
+    (``BlockSpec.element_labels``, ``BlockSpec.port_units``), checked: one label per element; a
     unit, or one per element. What a block raises fails the run at t = 0 in that phase."""
     return _logged_port_info(diagram, "element_labels", _labels_of), _logged_port_info(diagram, "port_units",
                                                                                          _units_of)
@@ -54,7 +54,7 @@ def _logged_port_info(diagram: Diagram, phase: str, read: Callable[[Any, Any], A
     found = {}
     for e in diagram.log:
         try:
-            value = read(diagram.blocks[e.block].block, e)
+            value = read(diagram.blocks[e.block], e)
         except Exception as exc:
             raise PortInfoFailure(Failure(e.block, phase, 0, exc)) from exc
         if value is not None:
@@ -62,21 +62,21 @@ def _logged_port_info(diagram: Diagram, phase: str, read: Callable[[Any, Any], A
     return found
 
 
-def _labels_of(blk, e) -> list[str] | None:
-    labels = blk.element_labels(e.port)
+def _labels_of(spec, e) -> list[str] | None:
+    labels = spec.element_labels(e.port)
     if labels is None:
         return None
     labels = [str(label) for label in labels]
-    width = blk.outputs[e.port]
+    width = spec.block.outputs[e.port]
     if len(labels) != width:
         raise BlockError(f"{len(labels)} labels for the {width} elements of '{e.port}'", port=e.port)
     return labels
 
 
-def _units_of(blk, e) -> str | list[str] | None:
-    units = blk.port_units(e.port)
+def _units_of(spec, e) -> str | list[str] | None:
+    units = spec.port_units(e.port)
     try:
-        return checked_units(units, blk.outputs[e.port], e.port)
+        return checked_units(units, spec.block.outputs[e.port], e.port)
     except ValueError as exc:
         raise BlockError(str(exc), port=e.port) from None
 

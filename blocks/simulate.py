@@ -57,7 +57,7 @@ class SimulationError(Exception):
 
 
 def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | None = None,
-             raise_on_failure: bool = False, engine: str | None = None) -> Results:
+             raise_on_failure: bool = False, engine: str | None = None, check_finite: bool = True) -> Results:
     """Run ``diagram`` to ``t_end`` (default: the diagram's ``time.t_end``).
 
     A block failure does not lose the run: the returned Results carry the signals up to
@@ -66,7 +66,9 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     at its next hit; the Results are complete, with ``ended_by`` set when that was
     before ``t_end``. ``engine``: 'native' (the C core, the default where it is built and
     the run's tick times are exact in double) or 'reference' (the plain Python loop);
-    both give the same samples.
+    both give the same samples. An output that is not finite (NaN, an infinity) fails
+    the run at its first hit, naming block, port, element and time (``blocks.finite``),
+    unless ``check_finite`` is False.
     """
     t_end = _end_time(diagram, t_end)
     refused = diagram.open_issue()
@@ -83,7 +85,7 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     table = op_table(diagram, schedule)
     run = _engine(engine, table)
     wall0 = time.perf_counter()
-    binding = Binding(diagram, table)
+    binding = Binding(diagram, table, check_finite)
     total = schedule.n_ticks
 
     def report(tick: int) -> None:

@@ -12,12 +12,19 @@ order from a heap: a block that gets its width at (p, i) makes its connection j 
 scanning at (p, j) when j comes later in the sweep, else at (p + 1, j). Every scan that
 could assign something is thus made at the same moment as in the repeated sweep, with
 the same widths known, in O(E log E) for E connections.
+
+A connection that names elements carries as many values as its source selection picks
+(``c.y[0:3]``: 3, known once c.y's width is; ``c.y[1]``: 1 at once), which a whole
+destination takes as its width; it never gives its source a width, and a destination
+that names elements (``g.u[0]``) takes none from it: its width comes from elsewhere.
 """
 
 from __future__ import annotations
 
 import heapq
 from typing import TYPE_CHECKING, Callable, Sequence
+
+from .elements import count
 
 if TYPE_CHECKING:
     from .diagram import Connection
@@ -43,9 +50,13 @@ def propagate_widths(declared: PortWidth, connections: Sequence[Connection]) -> 
         sweep, i = heapq.heappop(scans)
         c = connections[i]
         ws, wd = width(c.src_block, "outputs", c.src_port), width(c.dst_block, "inputs", c.dst_port)
+        if c.src_select is not None:
+            ws = count(c.src_select, ws)
+        if c.dst_select is not None:
+            continue
         if ws is not None and wd is None:
             block, w = c.dst_block, ws
-        elif wd is not None and ws is None:
+        elif wd is not None and ws is None and c.src_select is None:
             block, w = c.src_block, wd
         else:
             continue

@@ -13,7 +13,7 @@ reported at the subsystem's entry), and the logged signals are resolved by path
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from .arrays import float_array
@@ -21,21 +21,13 @@ from .block import checked_units
 from .build_context import BuildContext, known, suggest
 from .records import PortEntry, Site, WireEntry
 from .diagram import BlockSpec, Composite, Connection, DeclaredReference, DiagramPort, LogEntry
+from .annotations import annotate, check_connected_units
+from .element_wiring import carried, check_assembled, received, resolve
+from .elements import ElementError, Endpoint, parse_endpoint, parse_wire_end
 from .scopes import NAME, Level
 from .widths import propagate_widths
 
-_ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
 _PATH = re.compile(r"^\s*[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)+\s*$")
-
-Endpoint = tuple[str, str]
-"""(block path name, port)."""
-
-
-def parse_endpoint(text: Any) -> Endpoint | None:
-    """``("plant", "y")`` from ``"plant.y"``; None if ``text`` is not of that form."""
-    m = _ENDPOINT.match(text) if isinstance(text, str) else None
-    return (m.group(1), m.group(2)) if m else None
-
 
 @dataclass
 class Ports:
@@ -187,6 +179,9 @@ class Wiring:
         """The level's wires as flat connections (and as written, ``wires``)."""
         wires = self.wires.setdefault(level.path, [])
         driven: dict[Endpoint, tuple[Connection, int | None]] = {}
+        """Each input a wire drives whole; those that drive some elements go to ``partly``,
+        checked element by element once the widths are known (``blocks.element_wiring``)."""
+        partly: dict[Endpoint, tuple[Connection, int | None]] = {}
         self.driven[level.path] = set()
         for w in level.builder.wires:
             written = self.wire(level, w)
@@ -194,32 +189,33 @@ class Wiring:
                 continue
             wire, sources, targets = written
             key = (wire.dst_block, wire.dst_port)
-            if key in driven:
-                first, line = driven[key]
-                self.ctx.add(w.site.issue(f"input {wire.dst} is driven twice: by {wire.src} and by "
-                                          f"{first.src} (line {line})", "an input takes exactly one connection; "
-                                          "add a Sum block to combine signals"))
+            first_wire = driven.get(key) or (partly.get(key) if wire.dst_select is None else None)
+            if first_wire is not None:
+                first, line = first_wire
+                self.ctx.add(w.site.issue(f"input {wire.dst} is driven twice: by {wire.src_text} and by "
+                                          f"{first.src_text} (line {line})", "an input takes exactly one connection "
+                                          "(or one per element: a.y -> g.u[0]); add a Sum block to combine signals"))
                 continue
-            driven[key] = (wire, w.site.line)
+            (driven if wire.dst_select is None else partly).setdefault(key, (wire, w.site.line))
             wires.append(wire)
             if sources is None or targets is None:
                 continue
             for dst in targets:
                 same = sources == (wire.src_block, wire.src_port) and dst == (wire.dst_block, wire.dst_port)
-                c = wire if same else Connection(sources[0], sources[1], dst[0], dst[1], wire.delay, wire.initial,
-                                                 wire.line, wire.file)
+                c = wire if same else replace(wire, src_block=sources[0], src_port=sources[1], dst_block=dst[0],
+                                              dst_port=dst[1])
                 self.connections.append(c)
                 self.written[id(c)] = wire
         ports = self.ports_of(level)
         for (name, port), input_name in ports.fed.items():
             key = (level.flat(name), port)
-            if key in driven:
-                first, line = driven[key]
+            if key in driven or key in partly:
+                first, line = driven.get(key) or partly[key]
                 decl = next(d for d in level.builder.inputs if d.name == input_name)
                 self.ctx.add(decl.site.issue(f"input {key[0]}.{port} is driven twice: by the diagram's input "
                                              f"'{input_name}' and by {first.src} (line {line})",
                                              "an input takes exactly one signal"))
-        self.driven[level.path] = set(driven)
+        self.driven[level.path] = set(driven) | set(partly)
 
     def wire(self, level: Level, w: WireEntry):
         """(the wire as written, its flat source, its flat targets) or None (reported).
@@ -241,22 +237,23 @@ class Wiring:
             if not delay:
                 self.ctx.add(site.issue("'initial' only applies to a connection with delay: 1", key="initial"))
                 return None
-        src, dst = parse_endpoint(w.src), parse_endpoint(w.dst)
+        src, dst = parse_wire_end(w.src), parse_wire_end(w.dst)
         text = f"{str(w.src).strip()} -> {str(w.dst).strip()}"
         if src is None or dst is None:
             bad = w.src if src is None else w.dst
             self.ctx.add(site.issue(f"connection '{text}': {str(bad).strip()!r} is not 'block.port'",
-                                    self.path_hint(level, bad) or "e.g. - plant.y -> err.u1"))
+                                    self.path_hint(level, bad)
+                                    or "e.g. - plant.y -> err.u1, or by element - plant.q[fore.1] -> pd.u"))
             return None
         what = f"connection '{text}'"
-        sources = self.reach_output(level, src, what, site)
+        sources = self.reach_output(level, src[:2], what, site)
         bad_src = sources is None and not self.spoiled(level, src[0])
-        targets = self.reach_input(level, dst, what, site)
+        targets = self.reach_input(level, dst[:2], what, site)
         bad_dst = targets is None and not self.spoiled(level, dst[0])
         if bad_src or bad_dst:
             return None
         wire = Connection(level.flat(src[0]), src[1], level.flat(dst[0]), dst[1], int(delay), initial, site.line,
-                          self.file_of(site))
+                          self.file_of(site), src_select=src[2], dst_select=dst[2])
         return wire, sources, targets
 
     def spoiled(self, level: Level, name: str) -> bool:
@@ -290,25 +287,66 @@ class Wiring:
                                    "with a known width is connected to it",
                                    "connect it to a block with fixed widths or give it a width parameter")
                     continue
-                spec.block.set_width(inferred[name])
+                try:
+                    spec.block.set_width(inferred[name])
+                except ValueError as e:
+                    self.ctx.error(spec.file or self.top.file, spec.line,
+                                   f"block '{name}' ({spec.type_name}) cannot take the width {inferred[name]} of "
+                                   f"what it connects to: {e}", "fix its parameters or give it a width parameter")
+                    self.failed.add(name)
+        annotate(self.top.levels(), blocks, self.failed, self.report)
+        unresolved = self.resolve_elements()
         for c in self.connections:
-            ws = blocks[c.src_block].block.outputs[c.src_port]
-            wd = blocks[c.dst_block].block.inputs[c.dst_port]
+            if id(c) in unresolved:
+                continue
+            ws, wd = carried(c, blocks), received(c, blocks)
             wire = self.written[id(c)]
-            dst = c.dst if wire.dst == c.dst else f"{wire.dst} ({c.dst})"
+            dst = c.dst_text if wire.dst == c.dst else f"{wire.dst_text} ({c.dst})"
+            what = "has width" if c.src_elements is None else "selects"
+            into = "has width" if c.dst_elements is None else "selects"
             if ws is not None and wd is not None and ws != wd:
                 self.ctx.error(c.file or self.top.file, c.line,
-                               f"connection '{wire.src} -> {wire.dst}': width mismatch: {wire.src} has width "
-                               f"{ws}, {dst} has width {wd}", "insert a Gain with a matrix k to map "
-                               "between widths, or fix the block parameters")
+                               f"connection '{wire.src_text} -> {wire.dst_text}': width mismatch: {wire.src_text} "
+                               f"{what} {ws}, {dst} {into} {wd}", "insert a Gain with a matrix k to map "
+                               "between widths, select elements (c.y[0:2] -> g.u), or fix the block parameters")
             elif c.initial is not None and ws is not None and len(c.initial) not in (1, ws):
                 self.ctx.error(c.file or self.top.file, c.line,
-                               f"connection '{wire.src} -> {wire.dst}': 'initial' has {len(c.initial)} "
-                               f"values, the signal has width {ws}")
+                               f"connection '{wire.src_text} -> {wire.dst_text}': 'initial' has "
+                               f"{len(c.initial)} values, the signal has width {ws}")
+
+    def resolve_elements(self) -> set[int]:
+        """The elements each connection's selections name, now that the widths are known;
+        a selection that names none is reported at its connection (the ids of those returned)."""
+        resolved, unresolved = [], set()
+        for c in self.connections:
+            wire = self.written.pop(id(c))
+            if c.by_element and all(w is not None for w in (self.specs[c.src_block].block.outputs[c.src_port],
+                                                             self.specs[c.dst_block].block.inputs[c.dst_port])):
+                try:
+                    c = resolve(c, wire, self.specs, self.labels)
+                except ElementError as exc:
+                    self.ctx.error(c.file or self.top.file, c.line, f"connection '{wire.src_text} -> "
+                                   f"{wire.dst_text}': {exc}", "elements by label, by index from 0, or a slice "
+                                   "start:stop, e.g. plant.q[fore.1], c.y[0:3]")
+                    unresolved.add(id(c))
+            resolved.append(c)
+            self.written[id(c)] = wire
+        self.connections[:] = resolved
+        return unresolved
+
+    def labels(self, block: str, port: str):
+        """The element names of ``block.port`` (an output or input), or None."""
+        return self.specs[block].element_labels(port)
+
+    def report(self, file: str | None, line: int | None, message: str, hint: str = "") -> None:
+        self.ctx.error(file or self.top.file, line, message, hint)
 
     def check_inputs(self) -> None:
         """Every input is driven, has a default, or is one of the top diagram's own inputs;
-        a subsystem's input that nothing drives is reported at its entry."""
+        a subsystem's input that nothing drives is reported at its entry; the elements of
+        an input that connections assemble are each driven once."""
+        check_assembled(self.connections, self.written, self.specs, self.report)
+        check_connected_units(self.connections, self.written, self.specs, self.report)
         driven = {(c.dst_block, c.dst_port) for c in self.connections}
         fed_by_port = set()
         for level in self.top.levels():
@@ -433,14 +471,14 @@ class Wiring:
                 f"{b}.{p} [{getattr(self.specs[b].block, kind)[p]}]" for b, p in signals),
                 "the inputs one diagram input feeds take the same signal"))
         units = labels = None
-        for blk, p in blocks:
+        for (b, p), (blk, _) in zip(signals, blocks):
             if units is None:
                 try:
-                    units = checked_units(blk.port_units(p), getattr(blk, kind)[p], p)
+                    units = checked_units(self.specs[b].port_units(p), getattr(blk, kind)[p], p)
                 except ValueError:
                     units = None
             if labels is None:
-                found = blk.element_labels(p)
+                found = self.specs[b].element_labels(p)
                 labels = tuple(str(x) for x in found) if found is not None else None
         return DiagramPort(name, tuple(f"{b}.{p}" for b, p in signals), min(widths), units, labels, site.line,
                            self.file_of(site))

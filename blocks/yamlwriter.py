@@ -109,6 +109,10 @@ class _Writer:
             params[key] = plain(value, f"block '{name}' parameter '{key}'")
         if params:
             entry["params"] = params
+        if spec.units:
+            entry["units"] = {port: plain(units, f"block '{name}' units") for port, units in spec.units.items()}
+        if spec.labels:
+            entry["elements"] = {port: list(names) for port, names in spec.labels.items()}
         return entry
 
     def subsystem_entry(self, sub: Composite) -> dict:
@@ -127,7 +131,8 @@ class _Writer:
         return entry
 
     def wire(self, level: Composite, c) -> str | dict:
-        text = (level.name_of(f"{c.src_block}.{c.src_port}"), level.name_of(f"{c.dst_block}.{c.dst_port}"))
+        text = (level.name_of(c.src) + ("" if c.src_select is None else f"[{c.src_select}]"),
+                level.name_of(c.dst) + ("" if c.dst_select is None else f"[{c.dst_select}]"))
         if not c.delay:
             return f"{text[0]} -> {text[1]}"
         out: dict[str, Any] = {"from": text[0], "to": text[1], "delay": c.delay}

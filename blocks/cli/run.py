@@ -30,6 +30,8 @@ def add(sub, program) -> argparse.ArgumentParser:
                           "decimate), for long runs")
     run.add_argument("--plot", action="store_true", help="also plot the logged signals to <output>/plots/")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary line")
+    run.add_argument("--allow-nonfinite", action="store_true",
+                     help="let outputs be NaN or infinite (by default the first such value fails the run)")
     run.set_defaults(handler=cmd_run)
     return run
 
@@ -107,7 +109,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     bar = ProgressBar(float(t_end), enabled=not args.quiet)
     with StopSignals(prog) as stops:
         try:
-            results = simulate(diagram, t_end=t_end, progress=bar)
+            results = simulate(diagram, t_end=t_end, progress=bar, check_finite=not args.allow_nonfinite)
         except (DiagramError, KeyboardInterrupt):  # refused, or stopped, before it started
             if created:
                 remove_if_empty(out)

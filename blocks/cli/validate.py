@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import argparse
 
+from blocks.block import checked_units
+
 from .options import diagram_args, end_time, load
 from .program import EXIT_OK
 
@@ -39,6 +41,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
     print_block_tree(diagram, s)
     print_terms(diagram, s)
     print_ports(diagram)
+    print_element_wiring(diagram)
     print_references_and_notes(diagram)
     print("execution order:")
     print(f"  t = 0: {s.initial.describe()}")
@@ -78,8 +81,8 @@ def print_block_tree(diagram, s) -> None:
                 print(f"{indent(path)}{path}: subsystem {sub.origin} (diagram {sub.diagram_name!r})"
                       + "".join(f"; {part}" for part in subsystem_parts(sub)))
         blk = spec.block
-        ins = ", ".join(f"{p}[{w}]" for p, w in blk.inputs.items()) or "-"
-        outs = ", ".join(f"{p}[{w}]" for p, w in blk.outputs.items()) or "-"
+        ins = ", ".join(port_of(spec, p, w) for p, w in blk.inputs.items()) or "-"
+        outs = ", ".join(port_of(spec, p, w) for p, w in blk.outputs.items()) or "-"
         notes = []
         if name in s.advanced:
             notes.append("advanced between events")
@@ -113,6 +116,22 @@ def print_terms(diagram, s) -> None:
             print(f"  ({term}: {meaning})")
 
 
+def port_of(spec, port: str, width: int) -> str:
+    """A block's port as ``validate`` lists it: ``y[3]``, with the unit(s) where the block or
+    the diagram gives them (``q[9] (rad)``, ``pose[3] (m, m, rad)``) and the names the diagram
+    gives its elements (``y[3] {x, y, theta}``)."""
+    try:
+        units = checked_units(spec.port_units(port), width, port)
+    except ValueError:
+        units = None
+    text = f"{port}[{width}]"
+    if units:
+        text += f" ({units})" if isinstance(units, str) else f" ({', '.join(u or '?' for u in units)})"
+    if port in spec.labels:
+        text += " {" + ", ".join(spec.labels[port]) + "}"
+    return text
+
+
 def subsystem_parts(sub) -> list[str]:
     """A subsystem's ports, bindings and the overrides it was given, as ``validate`` shows them."""
     def inner(port) -> str:
@@ -143,6 +162,26 @@ def print_ports(diagram) -> None:
         print("references the including diagram binds:")
         for ref in refs.values():
             print(f"  {ref.name}" + (f" (stand-in here: {ref.type_name})" if ref.type_name else ""))
+
+
+def print_element_wiring(diagram) -> None:
+    """The connections that name elements, each with the 0-based elements it stands for
+    (``m.y[pos.1] -> g.u  (m.y[2] -> g.u)``)."""
+    wires = [c for c in diagram.connections if c.by_element]
+    if not wires:
+        return
+    print("wiring by element:")
+    for c in wires:
+        src = c.src if c.src_elements is None else f"{c.src}[{index_text(c.src_elements)}]"
+        dst = c.dst if c.dst_elements is None else f"{c.dst}[{index_text(c.dst_elements)}]"
+        print(f"  {c}" + ("" if (src, dst) == (c.src_text, c.dst_text) else f"  ({src} -> {dst})"))
+
+
+def index_text(indices) -> str:
+    """0-based indices as a selection writes them: ``2``, ``0:3``, ``3,0,1``."""
+    if len(indices) > 1 and list(indices) == list(range(indices[0], indices[0] + len(indices))):
+        return f"{indices[0]}:{indices[0] + len(indices)}"
+    return ",".join(str(j) for j in indices)
 
 
 def print_references_and_notes(diagram) -> None:

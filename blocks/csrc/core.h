@@ -35,8 +35,9 @@
  *                            row logged; last: the event's last advance (how far an
  *                            interrupted run got is how far this one got)
  *                BLK_COPY    [copy, 0, 0, 0]: a row of the copies table
- *   copies     [destination, source, width]: a delayed connection sampling its source, or
- *              an input that holds its default until its source first fires
+ *   copies     [destination, source, width]: a delayed connection sampling its source, an
+ *              input that holds its default until its source first fires, or a run of
+ *              elements of an input that connections by element assemble
  *   programs   [first op, end op, final]: what runs at an event; final: the program that
  *              ends a run at such an event when a block asked for the end (-1: none)
  *   events     [tick, program]: the events of one hyperperiod, by tick (0 <= tick <
@@ -128,6 +129,13 @@ typedef struct {
 
 enum { BLK_RUN_COMPLETE, BLK_RUN_FAILED, BLK_RUN_STOPPED, BLK_RUN_BAD };
 
+/* The code of a failed op whose outputs hold a value that is not finite (a NaN or an
+   infinity): the core checks what every output and advance computes, unless the run
+   allows such values (blk_run.allow_nonfinite). which: the value's index among the
+   block's outputs, whose place in the arena then holds the outputs in question (for an
+   advance, the row that has it; the rows before it are logged). */
+#define BLK_NONFINITE (-3)
+
 /* How a run went. complete: it ended at tick end. failed: op failed with code (which: its
    detail) at tick; an advance's completed rows are logged. stopped: poll or the stop flag
    stopped it. reached: every block was computed up to this tick (an interrupted run's
@@ -143,7 +151,8 @@ typedef struct {
 /* One run: the table, the arena (header[BLK_H_ARENA] values, holding the table's initial
    values), one kernel per block, per log entry its buffer (capacity x width values) and
    counters (BLK_LC_N each, zero), the hooks. stop: any thread or a signal handler may set
-   it; the run stops at the next check, after an event or a chunk. */
+   it; the run stops at the next check, after an event or a chunk. allow_nonfinite: zero
+   (the default) fails an op whose outputs are not finite (BLK_NONFINITE). */
 typedef struct {
     const blk_table *table;
     double *arena;
@@ -153,6 +162,7 @@ typedef struct {
     blk_hooks hooks;
     volatile int stop;
     blk_outcome outcome;
+    int allow_nonfinite;
 } blk_run;
 
 /* Run the table from tick 0 to its end; returns run->outcome.status. */

@@ -613,15 +613,17 @@ static int bind_python(RunObject *r, PyObject *python, double *arena, int64_t si
 static int run_init(RunObject *r, PyObject *args, PyObject *kwds)
 {
     PyObject *tables, *arena, *logs, *counters, *kernels, *python, *states, *side, *progress = Py_None;
+    int allow_nonfinite = 0;
     static char *names[] = {"tables", "arena", "logs", "counters", "kernels", "python", "states", "side", "progress",
-                            NULL};
+                            "allow_nonfinite", NULL};
     if (r->owners != NULL) {
         PyErr_SetString(PyExc_TypeError, "Run: already initialised");
         return -1;
     }
-    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOOO!O|O", names, &tables, &arena, &logs, &counters, &kernels,
-                                     &python, &PyList_Type, &states, &side, &progress))
+    if (!PyArg_ParseTupleAndKeywords(args, kwds, "OOOOOOO!O|Op", names, &tables, &arena, &logs, &counters, &kernels,
+                                     &python, &PyList_Type, &states, &side, &progress, &allow_nonfinite))
         return -1;
+    r->run.allow_nonfinite = allow_nonfinite;
     r->owners = Py_BuildValue("(OOOOOO)", tables, arena, logs, counters, kernels, python);
     if (r->owners == NULL)
         return -1;
@@ -740,8 +742,9 @@ static PyTypeObject run_type = {
     PyVarObject_HEAD_INIT(NULL, 0).tp_name = "blocks._native.Run",
     .tp_basicsize = sizeof(RunObject),
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Run(tables, arena, logs, counters, kernels, python, states, side, progress=None): one run of an op "
-              "table (blocks/csrc/core.h) through the C core.",
+    .tp_doc = "Run(tables, arena, logs, counters, kernels, python, states, side, progress=None, "
+              "allow_nonfinite=False): one run of an op table (blocks/csrc/core.h) through the C core; outputs that "
+              "are not finite fail it (BLK_NONFINITE) unless allowed.",
     .tp_new = PyType_GenericNew,
     .tp_init = (initproc)run_init,
     .tp_dealloc = (destructor)run_dealloc,

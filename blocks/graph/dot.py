@@ -66,6 +66,8 @@ def to_dot(diagram: Diagram, schedule: Schedule, expand: bool = False) -> str:
             attrs += ["style=dashed", 'label="z\u207b\u00b9"']
         if c in feedback:
             attrs.append("constraint=false")
+        attrs += [f"{end}={dot_quoted(f'[{select}]')}" for end, select in (("taillabel", c.src_select),
+                                                                            ("headlabel", c.dst_select)) if select]
         lines.append(f"  {dot_quoted(c.src_block)}:{port_id('out', c.src_port)}:e -> "
                      f"{dot_quoted(c.dst_block)}:{port_id('in', c.dst_port)}:w [{', '.join(attrs)}];")
     rows = "".join(f'<tr><td bgcolor="{tint(colour, 0.35)}"><font color="{colour}">\u25a0</font> '

@@ -399,8 +399,10 @@ def draw_picture(pic: Picture):
                     color="black" if p in wired_out else "0.55")
             if p in wired_out:
                 ax.plot([x], [y], marker="o", markersize=3.5, color=colour, zorder=5)
+    nth_from: dict[tuple[str, str], int] = {}
     for i, c in enumerate(pic.wires):
         pts, codes, mark = wire_path(pic, lay, geo, i)
+        nth = nth_from[c.src_block, c.src_port] = nth_from.get((c.src_block, c.src_port), -1) + 1
         colour = pic.nodes[c.src_block].colour
         ax.add_patch(PathPatch(MPath(pts, codes), facecolor="none", edgecolor=colour, linewidth=1.3,
                                linestyle=(0, (4, 2.5)) if c.delay else "-", zorder=1, gid=f"wire:{c}",
@@ -408,6 +410,14 @@ def draw_picture(pic: Picture):
         x1, y1 = pts[-1]
         ax.add_patch(Polygon([(x1, y1), (x1 - 0.11, y1 - 0.045), (x1 - 0.11, y1 + 0.045)], closed=True,
                              facecolor=colour, edgecolor=colour, linewidth=0.5, zorder=5))
+        if c.by_element:  # the selections along the wire near its ends, those of one port's wires staggered
+            along = MPath(pts, codes).interpolated(40).vertices
+            for at, select in ((0.2 + 0.15 * (nth % 3), c.src_select), (0.8, c.dst_select)):
+                if select:
+                    x, y = along[int(at * (len(along) - 1))]
+                    ax.text(x, y, f"[{select}]", fontsize=SMALL_FONT, ha="center", va="center", zorder=6,
+                            color=colour, gid=f"elements:{c}", bbox=dict(boxstyle="round,pad=0.1",
+                                                                        facecolor="white", edgecolor="none"))
         if c.delay:
             ax.text(mark[0], mark[1], "z\u207b\u00b9", fontsize=SMALL_FONT, ha="center", va="center", zorder=6,
                     color=colour, bbox=dict(boxstyle="round,pad=0.15", facecolor="white", edgecolor=colour,

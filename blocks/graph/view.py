@@ -163,7 +163,10 @@ def feeds_through(diagram: Diagram, sub: Composite, output: str) -> frozenset[st
     """The subsystem inputs that its output ``output`` reads at the same hit, through the
     feedthrough of the blocks inside."""
     entry = {target: name for name, port in sub.inputs.items() for target in port.signals}
-    driver = {(c.dst_block, c.dst_port): c for c in diagram.connections if not c.delay}
+    drivers: dict[tuple[str, str], list] = {}
+    for c in diagram.connections:
+        if not c.delay:
+            drivers.setdefault((c.dst_block, c.dst_port), []).append(c)
     found: set[str] = set()
     seen: set[str] = set()
     stack = [sub.outputs[output].signals[0]]
@@ -178,7 +181,5 @@ def feeds_through(diagram: Diagram, sub: Composite, output: str) -> frozenset[st
             if target in entry:
                 found.add(entry[target])
                 continue
-            c = driver.get((block, read))
-            if c is not None and c.src_block.startswith(sub.path + "."):
-                stack.append(c.src)
+            stack += [c.src for c in drivers.get((block, read), ()) if c.src_block.startswith(sub.path + ".")]
     return frozenset(found)

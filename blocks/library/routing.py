@@ -103,8 +103,8 @@ class Selector(KernelBlock):
     (Python's slice notation, step included).
 
     Negative indices and open slices (``-1``, ``"2:"``) count from the input's end, so
-    they need ``width``. Without it the input's width comes from its connection and an
-    index past it stops the run at its first hit.
+    they need ``width``. Without it the input's width comes from its connection, and an
+    index past it is a load error at the block.
 
     Parameters
     ----------
@@ -147,6 +147,10 @@ class Selector(KernelBlock):
         if not picked:
             raise ValueError(f"parameter 'indices' selects nothing: {indices!r}")
         return picked
+
+    def set_width(self, width: int) -> None:
+        self.resolved(width)
+        super().set_width(width)
 
     def resolved(self, width: int) -> list[int]:
         """The indices into an input of ``width`` (negative ones from its end)."""

@@ -207,7 +207,7 @@ def test_a_problem_inside_a_subsystem_is_reported_in_its_file_under_the_block_pa
                   .replace("outputs: {u: u.y}", "outputs: {u: u.yy}\nbogus: 1"))
     assert problems(toy) == [
         f"{pi}:13: unknown top-level key 'bogus' (hint: allowed keys: version, name, description, time, blocks, "
-        "connections, inputs, outputs, references, log)",
+        "connections, inputs, outputs, references, log, units, elements)",
         f"{pi}:6: block 'ctrl.prop': period must be positive, got '-10 ms' (hint: write e.g. period: 1 ms; leave it "
         "out to inherit)",
         f"{pi}:12: diagram output 'u': block 'ctrl.u' (Sum) has no output 'yy' (hint: did you mean 'y'?)"]
@@ -231,7 +231,8 @@ def test_widths_are_checked_across_the_boundary(toy):
                                "ref:   {type: Constant, params: {value: [1.0, 2.0]}}"))
     issues = problems(toy)
     assert f"{toy}:12: connection 'err.y -> ctrl.e': width mismatch: err.y has width 2, ctrl.e (ctrl.integ.u) has " \
-           "width 1 (hint: insert a Gain with a matrix k to map between widths, or fix the block parameters)" in issues
+           "width 1 (hint: insert a Gain with a matrix k to map between widths, select elements (c.y[0:2] -> g.u), " \
+           "or fix the block parameters)" in issues
 
 
 def test_a_loop_through_a_subsystem_names_the_inner_port_chain(toy):

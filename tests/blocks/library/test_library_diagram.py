@@ -31,6 +31,7 @@ blocks:
   div:    {type: Divide, params: {ops: "/", multiplication: matrix, shapes: [[2, 2]]}}
   cat4:   {type: Concatenate, params: {widths: [2, 2]}}
   bias4:  {type: Bias, params: {bias: [3.0, 0.0, 0.0, 3.0]}}
+  bias2:  {type: Bias, params: {bias: [2.0, 2.0]}}
   abs:    {type: Abs}
   sign:   {type: Sign}
   bias:   {type: Bias, params: {bias: 0.25}}
@@ -70,7 +71,8 @@ connections:
   - sel.y -> cat.u0
   - chirp.y -> cat.u1
   - sine.y -> prod.u0
-  - demux.y1 -> prod.u1
+  - demux.y1 -> bias2.u
+  - bias2.y -> prod.u1
   - cat.y -> abs.u
   - abs.y -> sign.u
   - sign.y -> bias.u

@@ -50,17 +50,29 @@ def test_selector_picks_like_numpy(indices, width, picked):
     np.testing.assert_array_equal(step(block, {"u": u})["y"], u[:, picked])
 
 
-def test_an_index_past_a_connected_width_stops_the_run_at_once():
-    diagram = blocks.loads_diagram("""
+def test_an_index_past_a_connected_width_is_a_load_error_at_the_selector():
+    with pytest.raises(blocks.DiagramError) as error:
+        blocks.loads_diagram("""
 blocks:
   c: {type: Constant, params: {value: [1.0, 2.0, 3.0]}}
   s: {type: Selector, params: {indices: [0, 3]}}
 connections: [c.y -> s.u]
 log: [s.y]
 """)
-    results = blocks.simulate(diagram, t_end=1.0)
-    assert results.status.startswith("failed at t=0 s") and "index 3 is out of range for an input of width 3" \
-        in results.status
+    message = str(error.value)
+    assert ":4: block 's' (Selector) cannot take the width 3" in message
+    assert "index 3 is out of range for an input of width 3" in message
+
+
+def test_indices_within_a_connected_width_load_and_pick():
+    diagram = blocks.loads_diagram("""
+blocks:
+  c: {type: Constant, params: {value: [1.0, 2.0, 3.0]}}
+  s: {type: Selector, params: {indices: [2, 0]}}
+connections: [c.y -> s.u]
+log: [s.y]
+""")
+    np.testing.assert_array_equal(blocks.simulate(diagram, t_end=0.1)["s.y"][1][0], [3.0, 1.0])
 
 
 @pytest.mark.parametrize("cls, params, word", [
