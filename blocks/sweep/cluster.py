@@ -27,6 +27,7 @@ import signal
 import threading
 import time
 import uuid
+import warnings
 from collections import deque
 from contextlib import contextmanager
 from dataclasses import replace
@@ -185,7 +186,10 @@ def _local_cluster(workers: int | None, method: str | None):
     from .worker_plugin import IgnoreCtrlC
 
     settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method(method)}
-    with dask.config.set(settings), _children_ignore_ctrl_c():
+    with dask.config.set(settings), _children_ignore_ctrl_c(), warnings.catch_warnings():
+        # the scheduler's HTTP server (health checks; no dashboard) takes another port when
+        # 8787 is taken, as on a machine where another Dask runs: no news for the user
+        warnings.filterwarnings("ignore", message=r"Port \d+ is already in use", category=UserWarning)
         return LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=True,
                             host="127.0.0.1", dashboard_address=None, silence_logs=logging.CRITICAL,
                             plugins={IgnoreCtrlC()})
