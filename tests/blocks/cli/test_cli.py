@@ -25,6 +25,12 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
 def hierhand(*args: str, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
+    """``python -m hierhand ARGS`` in ``cwd``: a process of its own, forked from the session's
+    command-line server (``tests.forked_cli``), or with ``env`` a fresh interpreter."""
+    if env is None:
+        from tests.forked_cli import shared
+
+        return shared().run([str(a) for a in args], cwd, timeout=300)
     return subprocess.run([sys.executable, "-m", "hierhand", *map(str, args)], capture_output=True,
                           text=True, cwd=cwd, env=env, timeout=300)
 
