@@ -1,22 +1,25 @@
-"""Build the hand's C core: the Python extension and the FMI 2 / FMI 3 plant libraries.
+"""Build the C code: the two Python extensions and the FMI 2 / FMI 3 binaries of exported FMUs.
 
 Metadata lives in pyproject.toml; this file only declares what is compiled, because
 setuptools' extension support is the build path every pip and every Python install
 already has (no CMake, no code generator), and copies the shipped diagrams into the
 package (``hierhand/diagrams/``), which package data cannot reach from outside it. The framework's extension ``blocks._native``
 is the CPython host (``host.c``) of the op-table interpreter (``core.c``, plain C99 that
-needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``). Besides
-the extension ``hierhand._native``
-the build links two plain shared libraries from the same C sources,
-``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so``, that ``hierhand fmu export`` copies
-into FMUs, so exporting needs no compiler. They link libc and libm only; their FMI
-headers come from fmpy (a build requirement), the headers an importer builds against too.
+needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``); the
+hand's, ``hierhand._native``, binds its C core. Besides the extensions the build links
+plain shared libraries that an FMU export copies into FMUs, so exporting needs no
+compiler: ``blocks/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the op-table core, the
+library's kernels and an FMI wrapper: any diagram of library blocks) and
+``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the same with the hand's kernels). They
+link libc and libm only; their FMI headers come from fmpy (a build requirement), the
+headers an importer builds against too. The file lists are ``blocks/native_sources.py``
+and ``hierhand/native_sources.py``, which the exporter reads for an FMU's ``sources/``.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import os
-import sys
 from pathlib import Path
 
 from setuptools import Extension, setup
@@ -24,39 +27,48 @@ from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
 
 ROOT = Path(__file__).resolve().parent
-sys.path.insert(0, str(ROOT / "hierhand"))
-from native_sources import (  # noqa: E402 - the source lists live in the package, for the exporter
-    CFLAGS,
-    EXTENSION_DEPENDS,
-    EXTENSION_SOURCES,
-    FMI_DEPENDS,
-    FMI_LIBRARIES,
-    fmi_headers,
-    sources_digest,
-)
 
-sys.path.pop(0)
+
+def _module(name: str, path: Path):
+    """A source-list module read from its file, before any package is importable."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+framework = _module("blocks_native_sources", ROOT / "blocks" / "native_sources.py")
+hand = _module("hierhand_native_sources", ROOT / "hierhand" / "native_sources.py")
+
+FMU_BINARIES = {
+    package: {fmi: sources for fmi in framework.FMI_WRAPPERS
+              for sources in [framework.fmu_sources(fmi) + [f"{framework.CSRC}/{framework.KERNEL_SET}"]
+                              if package == "blocks" else hand.fmu_sources(framework.fmu_sources(fmi))]}
+    for package in ("blocks", "hierhand")
+}
+"""Per package and FMI version, every file of its FMU binary (C files and headers)."""
 
 
 class BuildNative(build_ext):
-    """build_ext that also links the FMU libraries next to the extension."""
+    """build_ext that also links the FMU binaries next to the extensions."""
 
     def run(self) -> None:
         super().run()
-        for fmi, sources in FMI_LIBRARIES.items():
-            self._link_fmi_library(fmi, sources)
+        for package, versions in FMU_BINARIES.items():
+            for fmi, files in versions.items():
+                self._link_fmu_binary(package, fmi, files)
 
-    def _link_fmi_library(self, fmi: int, sources: list[str]) -> None:
-        relative = Path("hierhand", "fmu_binaries", f"fmi{fmi}.so")
+    def _link_fmu_binary(self, package: str, fmi: int, files: list[str]) -> None:
+        relative = Path(package, "fmu_binaries", f"fmi{fmi}.so")
         targets = [Path(self.build_lib) / relative]
         if self.inplace or getattr(self, "editable_mode", False):
             targets.append(ROOT / relative)
         objects = self.compiler.compile(
-            sources,
-            output_dir=os.path.join(self.build_temp, f"fmi{fmi}"),
-            include_dirs=[fmi_headers()],
-            depends=FMI_DEPENDS,
-            extra_postargs=CFLAGS + ["-std=c99", "-g0"],  # no debug info in what FMUs carry
+            [f for f in files if f.endswith(".c")],
+            output_dir=os.path.join(self.build_temp, package, f"fmi{fmi}"),
+            include_dirs=[framework.fmi_headers(), framework.CSRC, hand.CSRC],
+            depends=[f for f in files if f.endswith(".h")],
+            extra_postargs=framework.CFLAGS + ["-std=c99", "-g0"],  # no debug info in what FMUs carry
         )
         for target in targets:
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -64,8 +76,9 @@ class BuildNative(build_ext):
 
     def get_outputs(self) -> list[str]:
         outputs = super().get_outputs()
-        for fmi in FMI_LIBRARIES:
-            outputs.append(str(Path(self.build_lib, "hierhand", "fmu_binaries", f"fmi{fmi}.so")))
+        for package, versions in FMU_BINARIES.items():
+            for fmi in versions:
+                outputs.append(str(Path(self.build_lib, package, "fmu_binaries", f"fmi{fmi}.so")))
         return outputs
 
 
@@ -89,27 +102,23 @@ class BuildPy(build_py):
 
 
 SHIPPED_DIAGRAMS = Path("hierhand", "diagrams")
-BLOCKS_CSRC = "blocks/csrc"
 
 setup(
     ext_modules=[
         Extension(
             "blocks._native",
-            sources=[f"{BLOCKS_CSRC}/{name}.c"
-                     for name in ("host", "core", "library", "lib_math", "lib_dynamic", "lib_sources", "fmu", "fmu_me",
-                                  "fmu_host")],
-            depends=[f"{BLOCKS_CSRC}/{name}.h" for name in ("blocks_kernel", "core", "library", "lib_common", "fmu",
-                                                             "fmu_me", "fmu_calls", "fmu_host")],
-            extra_compile_args=CFLAGS + ["-std=c11"],
+            sources=framework.EXTENSION_SOURCES,
+            depends=framework.EXTENSION_DEPENDS,
+            extra_compile_args=framework.CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),
         Extension(
             "hierhand._native",
-            sources=EXTENSION_SOURCES,
-            depends=EXTENSION_DEPENDS,
-            define_macros=[("HH_SOURCES_DIGEST", f'"{sources_digest(ROOT)}"')],
-            include_dirs=[BLOCKS_CSRC],
-            extra_compile_args=CFLAGS + ["-std=c11"],
+            sources=hand.EXTENSION_SOURCES,
+            depends=hand.EXTENSION_DEPENDS,
+            define_macros=[("HH_SOURCES_DIGEST", f'"{hand.sources_digest(ROOT)}"')],
+            include_dirs=[framework.CSRC],
+            extra_compile_args=framework.CFLAGS + ["-std=c11"],
             libraries=["m"],
         )
     ],

@@ -1,5 +1,5 @@
-"""The re-grasp task with the native plant and with the plant as an exported FMU, in the
-run's process and in a process of its own.
+"""The re-grasp task with the native plant, with the plant as an exported FMU (in the run's
+process and in a process of its own), and as one exported closed-loop FMU stepped by fmpy.
 
 Wall time per simulated second of diagrams/regrasp.yaml (native HandPlant) and of
 diagrams/regrasp_fmu.yaml (the same plant exported with `hierhand fmu export`, FMI 2
@@ -11,7 +11,14 @@ inputs, doStep, get outputs) every millisecond, the isolation a round trip to th
 process. The first isolated run of a process also starts the process that forks the FMU
 processes; that start-up is printed apart.
 
-Target: the FMU plant at most 1.3x the native run.
+The whole closed loop exported (`hierhand fmu export diagrams/regrasp.yaml`, FMI 2 and 3)
+is run by fmpy from its unpacked folder, instantiation included: its low-level slave
+stepped at 1 ms (the native run's log interval), without and with reading every output
+(the signals the native run logs) after each step, and ``simulate_fmu`` recording them.
+The FMU's own C time is the native run's; what the lines add is fmpy's Python per call.
+
+Targets: the FMU plant at most 1.3x the native run; the closed-loop FMU stepped by fmpy at
+most 1.2x.
 
     python benchmarks/fmu.py [--repeat 5]
 """
@@ -24,11 +31,16 @@ import tempfile
 import time
 from pathlib import Path
 
+from fmpy import extract, read_model_description, simulate_fmu
+from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
+
 import blocks
-from hierhand.fmu_export import export_plant_fmu
+from hierhand.fmu_export import export_diagram_fmu, export_plant_fmu
 
 ROOT = Path(__file__).resolve().parent.parent
 TARGET_RATIO = 1.3
+LOOP_TARGET_RATIO = 1.2
 
 
 def per_simulated_second(diagram, repeat: int) -> tuple[float, float]:
@@ -43,6 +55,53 @@ def per_simulated_second(diagram, repeat: int) -> tuple[float, float]:
         blocks.simulate(diagram)
         times.append(time.perf_counter() - t0)
     return statistics.median(times) / float(diagram.t_end), first
+
+
+def fmpy_walls(fmu: Path, folder: Path, repeat: int) -> dict[str, float]:
+    """Median wall times per simulated second of the closed-loop FMU run by fmpy three ways
+    (the first run of each, a warm-up, not counted): its low-level FMU2Slave/FMU3Slave
+    stepped at 1 ms without and with reading every output after each step, and
+    ``simulate_fmu`` recording every output at 1 ms."""
+    md = read_model_description(str(fmu))
+    unzipped = extract(str(fmu), folder)
+    outputs = [v for v in md.modelVariables if v.causality == "output"]
+    refs = [v.valueReference for v in outputs]
+    stop = float(md.defaultExperiment.stopTime)
+    n = int(round(stop / 1e-3))
+
+    def stepped(read: bool) -> float:
+        slave_class = FMU2Slave if md.fmiVersion.startswith("2") else FMU3Slave
+        fmu_slave = slave_class(guid=md.guid, unzipDirectory=unzipped,
+                                modelIdentifier=md.coSimulation.modelIdentifier, instanceName="bench")
+        get = fmu_slave.getReal if md.fmiVersion.startswith("2") else fmu_slave.getFloat64
+        t0 = time.perf_counter()
+        fmu_slave.instantiate()
+        if md.fmiVersion.startswith("2"):
+            fmu_slave.setupExperiment(startTime=0.0)
+        fmu_slave.enterInitializationMode()
+        fmu_slave.exitInitializationMode()
+        for k in range(n):
+            fmu_slave.doStep(k * 1e-3, 1e-3)
+            if read:
+                get(refs)
+        get(refs)
+        wall = time.perf_counter() - t0
+        fmu_slave.terminate()
+        fmu_slave.freeInstance()
+        return wall
+
+    def recorded() -> float:
+        t0 = time.perf_counter()
+        simulate_fmu(unzipped, model_description=md, output=[v.name for v in outputs], output_interval=1e-3)
+        return time.perf_counter() - t0
+
+    ways = {"fmpy doStep 1 ms": lambda: stepped(False), "fmpy doStep 1 ms + read outputs": lambda: stepped(True),
+            "fmpy simulate_fmu, 1 ms record": recorded}
+    walls = {}
+    for name, way in ways.items():
+        way()
+        walls[name] = statistics.median(way() for _ in range(repeat)) / stop
+    return walls
 
 
 def main() -> None:
@@ -68,6 +127,14 @@ def main() -> None:
                     line += f"   target <= {TARGET_RATIO}: {'met' if ratio <= TARGET_RATIO else 'MISSED'}"
                 print(line + f"   (first run {1000 * first:.0f} ms)")
             print(f"  {f'isolated / in-process (FMI {fmi})':<36}: {walls['process'] / walls['none']:7.2f}")
+        loop = blocks.load_diagram(ROOT / "diagrams" / "regrasp.yaml")
+        for fmi in (2, 3):
+            fmu = export_diagram_fmu(loop, Path(tmp) / f"loop{fmi}.fmu", fmi)
+            for way, wall in fmpy_walls(fmu, Path(tmp) / f"loop{fmi}", args.repeat).items():
+                ratio = wall / native
+                print(f"  {f'loop FMU {fmi}, {way}':<44}: {1000 * wall:7.2f} ms per simulated s"
+                      f"   ratio to native {ratio:5.2f}   target <= {LOOP_TARGET_RATIO}: "
+                      f"{'met' if ratio <= LOOP_TARGET_RATIO else 'MISSED'}")
 
 
 if __name__ == "__main__":

@@ -6,32 +6,56 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 ``Results.load``, and the ``Block`` base class for new block types.
 """
 
-from .block import Block, BlockError, EndRun, ParameterError
-from .builder import DiagramBuilder
-from .diagram import Diagram
-from .issues import DiagramError, Issue
-from .load import load_diagram, loads_diagram
-from .loader import read_builder
-from .results import Results, ResultsError
-from .schedule import Schedule, build_schedule
-from .simulate import SimulationError, StopRequest, simulate
-from .timebase import parse_duration
-from .yamlwriter import WriteError, dump_diagram, save_diagram
+import importlib
+import sys
+import types
+from typing import Any
+
+_EXPORTS = {
+    ".block": ("Block", "BlockError", "EndRun", "ParameterError"),
+    ".builder": ("DiagramBuilder",),
+    ".diagram": ("Diagram",),
+    ".issues": ("DiagramError", "Issue"),
+    ".load": ("load_diagram", "loads_diagram"),
+    ".loader": ("read_builder",),
+    ".results": ("Results", "ResultsError"),
+    ".schedule": ("Schedule", "build_schedule"),
+    ".simulate": ("SimulationError", "simulate"),
+    ".stop": ("StopRequest",),
+    ".timebase": ("parse_duration",),
+    ".yamlwriter": ("WriteError", "dump_diagram", "save_diagram"),
+}
+"""Where each public name lives. They are imported when first used (PEP 562), so that
+importing a light part of the package (``blocks.stop``, which a command line installs its
+signal handlers from before anything else) does not import numpy and the rest."""
+
+_HOME = {name: module for module, names in _EXPORTS.items() for name in names}
+
+__all__ = sorted(_HOME)
 
 
+class _Package(types.ModuleType):
+    """The package, whose function ``simulate`` shares its name with its module: importing
+    the module ``blocks.simulate`` sets the package's attribute to the module, which would
+    hide the function; the function stays."""
 
-def _wiring_svg(diagram: Diagram) -> str:
-    """Jupyter's view of a Diagram: its wiring graph (``blocks.graph``, a layer above the
-    diagram's data, so attached here, where both are known, and imported when first shown)."""
-    from .graph import svg_text
-
-    return svg_text(diagram)
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, types.ModuleType) and name in _HOME and hasattr(value, name):
+            value = getattr(value, name)
+        super().__setattr__(name, value)
 
 
-Diagram._repr_svg_ = _wiring_svg
+sys.modules[__name__].__class__ = _Package
 
-__all__ = [
-    "Block", "BlockError", "Diagram", "DiagramBuilder", "DiagramError", "EndRun", "Issue", "ParameterError",
-    "Results", "ResultsError", "Schedule", "SimulationError", "StopRequest", "WriteError", "build_schedule",
-    "dump_diagram", "load_diagram", "loads_diagram", "parse_duration", "read_builder", "save_diagram", "simulate",
-]
+
+def __getattr__(name: str) -> Any:
+    module = _HOME.get(name)
+    if module is None:
+        raise AttributeError(f"module 'blocks' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_HOME))

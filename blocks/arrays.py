@@ -31,6 +31,9 @@ def float_array(value: Any, name: str, *, ndim: int | None = None, width: int | 
     - ``what``: the word before the name in messages (``parameter``, ``input``, ``argument``).
     """
     label = f"{what} '{name}'"
+    if _holds_bool(value):
+        raise ValueError(f"{label} must be numeric, got {reprlib.repr(value)} (true/false, and YAML's "
+                         "yes/no/on/off, are booleans, not numbers: write 1 or 0)")
     try:
         arr = np.array(value, dtype=np.float64, order="C")
     except (TypeError, ValueError):
@@ -54,6 +57,18 @@ def float_array(value: Any, name: str, *, ndim: int | None = None, width: int | 
         if bad.any():
             raise ValueError(f"{label} must be {'not NaN' if allow_inf else 'finite'}")
     return arr
+
+
+def _holds_bool(value: Any) -> bool:
+    """Whether ``value`` is a boolean or a (nested) list or array of them anywhere: numpy
+    would read True as 1.0, and a gain written as YAML's ``yes`` is a mistake, not a 1."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype == np.bool_
+    if isinstance(value, (list, tuple)):
+        return any(_holds_bool(v) for v in value)
+    return False
 
 
 def flat_float64(value: Any) -> np.ndarray:

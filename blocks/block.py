@@ -278,6 +278,14 @@ class Block:
         return copy.deepcopy(default) if isinstance(default, (list, Mapping)) else None
 
     @classmethod
+    def override_path(cls, parts: list[str]) -> list[str]:
+        """Where a ``--set block.<parts>`` path leads in the block's parameters: here the
+        path itself. A block whose parameters hold named values of their own (an FMU's
+        variables in ``start_values``) may lead a path that names none of its parameters
+        there, so that ``--set plant.k=2`` sets what the block calls ``k``."""
+        return parts
+
+    @classmethod
     def registered_name(cls) -> str:
         return cls.type_name or cls.__name__
 
@@ -297,6 +305,12 @@ class Block:
     def accepts_any_parameter(cls) -> bool:
         """True when ``__init__`` takes ``**kwargs`` (parameters are then not checked by name)."""
         return _accepts_any(cls.__init__)
+
+    def finish(self, state: Any) -> None:
+        """Called once after a run's last tick (complete, failed or interrupted), before
+        its results are made, with the block's last state: let go of what the state holds
+        for the run (an FMU block terminates its instance here). A BlockError raised here
+        fails a run that was complete, at the time it ended."""
 
     def is_stateful(self) -> bool:
         return self.initial_state() is not None

@@ -309,6 +309,7 @@ class Constructor:
                 ov.report(self.ctx, "expected --set block.param=value")
                 ok = False
                 continue
+            parts = cls.override_path(parts)
             if parts[0] not in declared and not accepts_any:
                 ov.report(self.ctx, f"block '{name}' ({cls.registered_name()}) has no parameter {parts[0]!r}",
                           suggest(parts[0], declared) or f"parameters: {known(declared)}")

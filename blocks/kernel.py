@@ -54,6 +54,68 @@ def address(array: np.ndarray) -> int:
 
 
 @dataclass(frozen=True)
+class Tunable:
+    """A parameter of a block that an exported FMU lets an importer set: its ``name`` as a
+    path inside the block (``ki``, ``object.mass``, ``kp[3]``), the slot of the record it
+    is written to, what it is and its unit (None: none known)."""
+
+    name: str
+    slot: int
+    description: str = ""
+    unit: str | None = None
+    finite: bool = False
+    """The value must be finite, the block's one check of it (the kind's constructor
+    checks the others)."""
+
+
+@dataclass(frozen=True)
+class Link:
+    """``length`` slots of a record, from ``slot`` on, that are ``source_slot``... of the
+    record of the block ``source`` (a Block object): a value a block takes from another
+    (a controller's hand from its plant), which an exported FMU copies over when it
+    rebuilds the contexts, after its parameters are written, so that the copy follows
+    them. A source that is no block of the exported diagram leaves the slots as they are."""
+
+    slot: int
+    length: int
+    source: Any = field(repr=False)
+    source_slot: int
+
+
+@dataclass(frozen=True)
+class Follow:
+    """A flag slot that an exported FMU sets to 1 when its importer sets any of the
+    tunables ``when_set`` and none of ``unless_set`` (names as ``Tunable.name``): how a
+    derived value follows the values it derives from (an object's inertia its mass and
+    size, unless the inertia itself is set), for the kind's constructor to read."""
+
+    slot: int
+    when_set: tuple[str, ...]
+    unless_set: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class KernelRecord:
+    """What a program without Python (an exported FMU) rebuilds a block's kernel from: the
+    name of a kernel type (``blk_kernel_type`` in ``blocks/csrc/blocks_kernel.h``: ``gain``,
+    ``HandPlant``) and the numbers its constructor reads, the block's parameters in the
+    type's order. ``tunables`` are the slots an importer may set, ``links`` and
+    ``follows`` how slots follow others. The same constructor builds the context a native
+    run uses where the block's Python side asks it to (the hand's blocks), or the record is
+    the context itself (the library's)."""
+
+    kind: str
+    values: np.ndarray = field(repr=False)
+    tunables: tuple[Tunable, ...] = ()
+    links: tuple[Link, ...] = ()
+    follows: tuple[Follow, ...] = ()
+    builds_state: bool = False
+    """Whether the kind's constructor also makes the block's initial state (so that a
+    parameter the state starts from, or whose value sizes it, follows); else the FMU keeps
+    the state the block's ``initial_state`` gives."""
+
+
+@dataclass(frozen=True)
 class Kernel:
     """The addresses of a block's C functions and of the constants they read.
 
@@ -68,7 +130,9 @@ class Kernel:
     the other for all of a block's hits). ``error`` makes the exception for a failure
     code, and the ``EndRun`` for ``END_RUN`` (None: ``blocks.compiled.failure``, a
     message with the code). ``nogil``: the functions may run without the GIL (see the
-    module's docstring; what a bound kernel says is what counts).
+    module's docstring; what a bound kernel says is what counts). ``record``: how an
+    exported FMU rebuilds the context (None: the kernel cannot leave Python, like the FMU
+    block's, which calls back into it).
     """
 
     context: int
@@ -79,3 +143,4 @@ class Kernel:
     error: ErrorFactory | None = field(default=None, repr=False)
     bind: Callable[[Any], Kernel] | None = field(default=None, repr=False)
     nogil: bool = False
+    record: KernelRecord | None = field(default=None, repr=False)

@@ -27,6 +27,32 @@ an anchored value. An alias repeats its anchor's whole value, so ten levels of t
 make 10^10 values from 1 KB of text (the 'billion laughs'); a diagram that shares a
 matrix or a block's settings repeats a few hundred."""
 
+MAX_NUMBER_CHARS = 100
+"""Longest number a YAML value may write, in characters (digits, sign, point, exponent).
+A float64 holds 17 significant digits and the largest integer a parameter takes (a
+seed below 2^64) has 20; Python refuses to read integers of over 4300 digits at all, and a
+5000-digit integer in a file would otherwise surface as an error deep inside a block."""
+
+MAX_SWEEP_POINTS = 1_000_000
+"""Most points one sweep may have, counted before any is made: a grid's axes multiply
+(three axes of 1000 values are 10^9 points, gigabytes before the first run), and each
+point is held with its hash while the sweep runs. A million re-grasp points take about
+2.5 hours of one core; a bigger study is several sweeps (a points file each)."""
+
+MAX_RESULTS_BYTES = 64 * 1024**3
+"""Largest ``signals.npz`` a results folder may hold (64 GiB): a run writes what it logs,
+so this is only a bound against a file that is not one; what bounds a hostile file is
+that its arrays may hold at most 200 times its size once decompressed, checked from each
+array's header before anything is allocated (``blocks.npzfile``)."""
+
+MAX_PLOT_AXES = 120
+"""Most axes one ``plot`` (or ``run --plot``) draws: 20 pages of six. A run that logs more
+is plotted a selection at a time (``-s``); drawing 100 000 axes would take hours."""
+
+MAX_PLOT_LINES = 5_000
+"""Most lines (signal elements) one plot draws in all: a legend stops naming them at 24
+per axis, and a port of a million elements drawn line by line would not finish."""
+
 MAX_PORT_WIDTH = 1_000_000
 """Widest port a block may declare: a signal is copied at every hit, so a width beyond
 this is a mistake in a block's parameters rather than a signal anyone logs."""

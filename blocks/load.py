@@ -14,12 +14,14 @@ from typing import Any, Mapping
 
 from .diagram import Diagram
 from .loader import parse_builder, read_builder
+from .ssp.package import is_ssp
+from .ssp.reader import read_ssp
 
 
 def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
                  trust: bool = False, origins: Mapping[str, str] | None = None,
-                 files: Mapping[str, str | Path] | None = None) -> Diagram:
-    """Load and validate a diagram file; ``overrides`` maps ``block.param[.key]`` to a value
+                 files: Mapping[str, str | Path] | None = None, step: Any = None) -> Diagram:
+    """Load and validate a diagram file (YAML, or an SSP: ``blocks.ssp``); ``overrides`` maps ``block.param[.key]`` to a value
     (inside a subsystem ``ctrl.block.param``).
 
     ``origins`` says how the user gave an override, for the messages about it: by key, the
@@ -29,8 +31,16 @@ def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
     files the diagram names, by the reference it makes (the keys of ``Diagram.files``;
     ``"."``: the folder where ``python:`` modules are looked for): a diagram whose files
     were copied elsewhere reads the copies, while its parameters and messages still name
-    the paths it gives.
+    the paths it gives. ``step``: for an SSP, the communication step of the components
+    its SSD gives none.
     """
+    if is_ssp(path):
+        return read_ssp(path, trust=trust, step=step).build(overrides, origins=origins)
+    if step is not None:
+        from .issues import DiagramError, Issue
+
+        raise DiagramError([Issue(str(path), None, "a step (--step) is for the components of an SSP",
+                                  "a YAML diagram gives each block its period")])
     return read_builder(path, trust=trust, files=files).build(overrides, origins=origins)
 
 

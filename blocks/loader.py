@@ -15,8 +15,11 @@ trusted, inside it (as a params file must be). It is read when the build reaches
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any, Mapping
+
+from .api_args import boolean
 
 from .builder import DiagramBuilder, Site
 from .diagram import FileScope
@@ -42,7 +45,11 @@ def read_builder(path: str | Path, trust: bool = False, files: Mapping[str, str 
     """The builder of the diagram file ``path``, not built yet: a diagram to use as a
     subsystem from Python (``DiagramBuilder.add_subsystem``), or to build with overrides.
     ``trust`` and ``files`` as for ``blocks.load_diagram``. DiagramError if the file
-    cannot be read as a diagram."""
+    cannot be read as a diagram; TypeError for a ``trust`` that is not True or False, or
+    a path that is not text or a path object."""
+    boolean("trust", trust)
+    if not isinstance(path, (str, os.PathLike)) or isinstance(os.fspath(path), bytes):
+        raise TypeError(f"path must be a str or a pathlib.Path, got {type(path).__name__}")
     path = Path(path)
     reading = _Reading({k: Path(v) for k, v in (files or {}).items()})
     try:
@@ -61,6 +68,9 @@ def parse_builder(text: str, filename: str = "<diagram>", base_dir: str | Path |
                   files: Mapping[str, str | Path] | None = None) -> DiagramBuilder:
     """The builder of a diagram's YAML text (``base_dir``: where its relative paths lead,
     default the current folder)."""
+    boolean("trust", trust)
+    if not isinstance(text, str):
+        raise TypeError(f"text must be a str of YAML, got {type(text).__name__}")
     reading = _Reading({k: Path(v) for k, v in (files or {}).items()})
     return _FrontEnd(reading, filename, Path(base_dir) if base_dir is not None else Path.cwd(), trust).parse(text)
 

@@ -173,6 +173,17 @@ def op_table(diagram: Diagram, schedule: Schedule) -> OpTable:
     return table
 
 
+def stepping_table(diagram: Diagram, schedule: Schedule, extra: tuple[EventProgram, ...],
+                   n_ticks: int) -> tuple[OpTable, list[int]]:
+    """The op table of a run stepped in parts by a program of its own (an exported FMU):
+    without logs, every event program with a final one (the outputs of a communication
+    point at that event), ``extra`` programs after the others (their indices returned),
+    and ``n_ticks`` in its header. Not cached: an export builds it once."""
+    compiler = _Compiler(diagram, schedule, logs=False)
+    table = compiler.table(extra=extra, every_final=True, n_ticks=n_ticks)
+    return table, compiler.extra_programs
+
+
 def _frozen(rows: list, width: int) -> np.ndarray:
     array = np.array(rows, dtype=np.int64).reshape(-1, width) if width > 1 else np.array(rows, dtype=np.int64)
     array.setflags(write=False)
@@ -182,8 +193,9 @@ def _frozen(rows: list, width: int) -> np.ndarray:
 class _Compiler:
     """Lays out the arena and writes the programs of a Schedule as ops."""
 
-    def __init__(self, diagram: Diagram, schedule: Schedule):
+    def __init__(self, diagram: Diagram, schedule: Schedule, logs: bool = True):
         self.d, self.s = diagram, schedule
+        self.logs = logs
         self.names = list(diagram.blocks)
         self.index = {n: i for i, n in enumerate(self.names)}
         self.size = 0
@@ -205,7 +217,8 @@ class _Compiler:
             self.values.append((offset, values))
         return offset
 
-    def table(self) -> OpTable:
+    def table(self, extra: tuple[EventProgram, ...] = (), every_final: bool = False,
+              n_ticks: int | None = None) -> OpTable:
         d, s = self.d, self.s
         if s.n_ticks is None or s.final is None:
             raise ValueError("an op table needs a plan with an end time")
@@ -241,14 +254,15 @@ class _Compiler:
         for tick, j in zip(s.event_ticks.tolist(), s.event_programs):
             first_tick.setdefault(j, tick)
         for j, p in enumerate(s.programs):
-            if p.update:
+            if p.update or every_final:
                 programs[event_program[j]][PR_FINAL] = add(final_program(d, s, first_tick[j]),
                                                            f"the end asked by a block, at an event of program {j + 1}")
+        self.extra_programs = [add(p, "outputs of a communication point") for p in extra]
         events = [[tick, event_program[j]] for tick, j in zip(s.event_ticks.tolist(), s.event_programs)]
         num, den = s.base_tick.numerator, s.base_tick.denominator
         if max(num, den) >= 2**63:
             num = den = 0
-        header = [s.hyperperiod, s.n_ticks, num, den, 0, final, self.size]
+        header = [s.hyperperiod, s.n_ticks if n_ticks is None else n_ticks, num, den, 0, final, self.size]
         initial = np.zeros(self.size)
         for offset, values in self.values:
             initial[offset:offset + len(values)] = values
@@ -336,6 +350,8 @@ class _Compiler:
     def lay_out_logs(self):
         """The log table, a block's entries side by side (so an op logs a range of them)."""
         d, s = self.d, self.s
+        if not self.logs:
+            return [], (), (), {}
         order = sorted(range(len(d.log)), key=lambda j: self.index[d.log[j].block])
         rows, block_logs = [], {}
         for j in order:

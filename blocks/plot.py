@@ -15,6 +15,7 @@ from typing import Sequence
 
 import numpy as np
 
+from .limits import MAX_PLOT_AXES, MAX_PLOT_LINES
 from .plot_markers import Marker, markers as run_markers
 from .plot_select import Trace, by_unit, select
 from .results import Results
@@ -59,7 +60,10 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
     selections = list(signals) if signals else list(results)
     if not selections:
         raise ValueError("no signals to plot: the run logged none (add a 'log:' list to the diagram)")
+    if len(selections) > MAX_PLOT_AXES:
+        check_plot_size(len(selections), 0)
     axes = [axis for s in selections for axis in by_unit(results, select(results, s))]
+    check_plot_size(len(axes), sum(len(tr.columns) for traces in axes for tr in traces))
     events = run_markers(results.info)[0] if markers is True else list(markers or [])
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -84,6 +88,19 @@ def balanced(items: list, most: int) -> list[list]:
         pages.append(items[start:stop])
         start = stop
     return pages
+
+
+class PlotSizeError(ValueError):
+    """More axes or lines than one plot draws (``limits.MAX_PLOT_AXES``, ``MAX_PLOT_LINES``)."""
+
+
+def check_plot_size(axes: int, lines: int) -> None:
+    """Refuse a plot of more than MAX_PLOT_AXES axes or MAX_PLOT_LINES lines before any is drawn."""
+    if axes > MAX_PLOT_AXES or lines > MAX_PLOT_LINES:
+        what = f"{axes} axes" if axes > MAX_PLOT_AXES else f"{lines} lines"
+        raise PlotSizeError(f"a plot of {what} is more than one plot draws ({MAX_PLOT_AXES} axes, "
+                            f"{MAX_PLOT_LINES} lines) (hint: choose what to draw with -s SIGNAL, or "
+                            "elements with -s 'SIGNAL[0:10]')")
 
 
 def figure(results: Results, selections: Sequence[str | list[Trace]], title: str | None = None,

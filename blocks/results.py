@@ -11,12 +11,16 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
 import re
 from pathlib import Path
 from typing import Iterator
 
 import numpy as np
 
+from .api_args import boolean
+from .limits import MAX_RESULTS_BYTES
+from .npzfile import read_npz
 from .results_folder import RUN_JSON, SIGNALS_CSV, SIGNALS_MAT, SIGNALS_NPZ, reading, writing
 
 TIME_PREFIX = "time:"
@@ -156,7 +160,11 @@ class Results:
     def save(self, directory: str | Path, csv: bool = False, mat: bool = False,
              csv_digits: int | None = None) -> Path:
         """Write signals.npz and run.json (and signals.csv, signals.mat) into ``directory``,
-        replacing the result files of the run saved there before as one set."""
+        replacing the result files of the run saved there before as one set (a complete
+        run's kept in ``previous-complete-run`` when this one is not complete:
+        ``results_folder``)."""
+        boolean("csv", csv)
+        boolean("mat", mat)
         with writing(directory) as staged:
             self.write_files(staged, csv, mat=mat, csv_digits=csv_digits)
         return Path(directory)
@@ -256,20 +264,112 @@ class Results:
 
     @classmethod
     def load(cls, directory: str | Path) -> "Results":
-        """Read a results folder written by ``save`` (or ``hierhand run``)."""
+        """Read a results folder written by ``save`` (or ``hierhand run``).
+
+        The folder may have been changed since (or come from someone else), so its files
+        are read as data under limits: ``run.json`` as a JSON object of at most
+        MAX_YAML_BYTES whose fields have the types a run writes, ``signals.npz`` through
+        ``npzfile`` (sizes checked before anything is allocated), each signal a 2-D array
+        with a 1-D time array of its length. Anything else is a ResultsError naming the
+        file and what is wrong with it."""
         directory = Path(directory)
         npz, meta = directory / SIGNALS_NPZ, directory / RUN_JSON
         with reading(directory):
-            if not npz.is_file():
+            if not os.path.lexists(npz):
                 raise ResultsError(f"{directory}: no {SIGNALS_NPZ} here; is this the -o folder of a run?")
-            if not meta.is_file():
+            if not os.path.lexists(meta):
                 raise ResultsError(f"{directory}: no {RUN_JSON} beside {SIGNALS_NPZ}: the results were "
                                    "being replaced when their run stopped; run it again")
+            info = _read_info(meta)
             try:
-                info = json.loads(meta.read_text(encoding="utf-8"))
-                with np.load(npz, allow_pickle=False) as data:
-                    signals = {k: (data[TIME_PREFIX + k], data[k]) for k in data.files
-                               if not k.startswith(TIME_PREFIX)}
-            except (OSError, ValueError, KeyError) as exc:
-                raise ResultsError(f"{directory}: cannot read results: {exc}") from None
-        return cls(signals, info)
+                arrays = read_npz(npz, str(npz), MAX_RESULTS_BYTES, inflation=MAX_INFLATION)
+            except ValueError as exc:
+                raise ResultsError(f"{exc}") from None
+        return cls(_signals(arrays, npz), info)
+
+
+MAX_INFLATION = 200
+"""How many times its size on disk a results file's arrays may hold (``np.savez`` stores
+them uncompressed, so a real file holds about its size; a 'zip bomb' thousands of times)."""
+
+_INFO_TYPES = {"status": str, "diagram": str, "t_stop": (int, float, type(None)), "t_end": (int, float, type(None)),
+               "wall_time_s": (int, float), "real_time_factor": (int, float, type(None)), "ended_by": (dict, type(None)),
+               "element_labels": (dict, type(None)), "units": (dict, type(None)), "parameters": dict,
+               "block_types": dict}
+"""The fields of run.json that readers use, and the JSON types a run writes them as."""
+_ENDED_BY_TYPES = {"block": str, "type": str, "reason": str, "time": (int, float), "tick_time": (int, float)}
+
+
+def _read_info(meta: Path) -> dict:
+    """run.json as a dict whose used fields have their types; ResultsError otherwise."""
+    from .yamlsource import YamlSourceError, read_yaml_file
+
+    try:
+        info = json.loads(read_yaml_file(meta, "JSON"))
+    except FileNotFoundError:
+        raise ResultsError(f"{meta}: no such file") from None
+    except YamlSourceError as exc:
+        raise ResultsError(f"{meta}{f':{exc.line}' if exc.line else ''}: {exc.message}") from None
+    except json.JSONDecodeError as exc:
+        raise ResultsError(f"{meta}:{exc.lineno}: not JSON: {exc.msg}") from None
+    except RecursionError:
+        raise ResultsError(f"{meta}: JSON nested too deeply to be a run's record") from None
+    if not isinstance(info, dict):
+        raise ResultsError(f"{meta}: a run's record is a JSON object, not {_json_kind(info)}")
+    _check_fields(meta, info, _INFO_TYPES, "")
+    if isinstance(info.get("ended_by"), dict):
+        _check_fields(meta, info["ended_by"], _ENDED_BY_TYPES, "ended_by.", required=True)
+    for field in ("element_labels", "units"):
+        for name, value in (info.get(field) or {}).items():
+            if not (isinstance(value, str) and field == "units") and not (
+                    isinstance(value, list) and all(isinstance(v, (str, int, float)) for v in value)):
+                raise ResultsError(f"{meta}: field '{field}.{name}' must be a list of names"
+                                   f"{' or one unit' if field == 'units' else ''}, not {_json_kind(value)}")
+    status = info.get("status", "complete")
+    if not status.startswith(("complete", "failed", "interrupted")):
+        raise ResultsError(f"{meta}: field 'status' is {status[:60]!r}, not a run's status (complete, failed "
+                           "at ..., interrupted at ...)")
+    return info
+
+
+def _check_fields(meta: Path, info: dict, types: dict, prefix: str, required: bool = False) -> None:
+    for field, kind in types.items():
+        if field not in info:
+            if required:
+                raise ResultsError(f"{meta}: field '{prefix}{field}' is missing")
+            continue
+        value = info[field]
+        if isinstance(value, bool) or not isinstance(value, kind):
+            raise ResultsError(f"{meta}: field '{prefix}{field}' must be {_kinds(kind)}, not {_json_kind(value)}")
+
+
+def _kinds(kind) -> str:
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    return " or ".join(dict.fromkeys(_json_kind(k()) if k is not type(None) else "null" for k in kinds))
+
+
+def _json_kind(value) -> str:
+    return {dict: "an object", list: "a list", str: "text", bool: "true/false", int: "a number",
+            float: "a number", type(None): "null"}.get(type(value), type(value).__name__)
+
+
+def _signals(arrays: dict[str, np.ndarray], npz: Path) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """The signals of a results file's arrays: each ``name`` (samples x width) with its
+    ``time:name`` (samples); ResultsError for arrays that do not pair up so."""
+    signals = {}
+    for name, values in arrays.items():
+        if name.startswith(TIME_PREFIX):
+            if name[len(TIME_PREFIX):] not in arrays:
+                raise ResultsError(f"{npz}: array '{name}' has no signal '{name[len(TIME_PREFIX):]}' beside it")
+            continue
+        t = arrays.get(TIME_PREFIX + name)
+        if t is None:
+            raise ResultsError(f"{npz}: signal '{name}' has no times (array '{TIME_PREFIX}{name}')")
+        for key, arr in ((TIME_PREFIX + name, t), (name, values)):
+            if arr.dtype.kind not in "fiu":
+                raise ResultsError(f"{npz}: array '{key}' must hold real numbers, not {arr.dtype}")
+        if t.ndim != 1 or values.ndim != 2 or values.shape[0] != t.shape[0]:
+            raise ResultsError(f"{npz}: signal '{name}' must be samples x width with one time per sample, "
+                               f"got values of shape {values.shape} and times of shape {t.shape}")
+        signals[name] = (t.astype(float, copy=False), values.astype(float, copy=False))
+    return signals

@@ -18,6 +18,8 @@ on the folder; where there is none (Windows), writers are not serialised.
 from __future__ import annotations
 
 import contextlib
+import itertools
+import json
 import os
 import shutil
 import tempfile
@@ -35,8 +37,15 @@ SIGNALS_MAT = "signals.mat"
 RUN_JSON = "run.json"
 PLOTS = "plots"
 PLOT_PATTERN = "signals*.png"
-STAGING_PREFIX = ".staging-"
+STAGING_PREFIX = ".blocks-staging-"
 """Prefix of the private folders that runs write into before their files replace the old ones."""
+STAGING_MARK = ".blocks-staging"
+"""The file inside each staging folder that makes it one: only folders with the prefix and
+this file are ever removed as a dead writer's, so a user's ``.staging-notes/`` (or even a
+``.blocks-staging-x/`` of their own) stays."""
+KEPT_PREFIX = "previous-complete-run"
+"""Name (``-2``, ``-3``, ... when taken) of the folder that keeps a complete run's files when
+a failed or interrupted run replaces them."""
 
 
 class OutputFolderError(OSError):
@@ -70,23 +79,61 @@ def prepare(directory: str | Path) -> Path:
     return directory
 
 
+def check_links(directory: str | Path, plots: bool) -> None:
+    """OutputFolderError if the run would write through a link out of ``directory``: a
+    ``plots`` that links elsewhere, when the run is to draw plots."""
+    from .safepath import link_out_of
+
+    link = link_out_of(directory, PLOTS) if plots else None
+    if link is not None:
+        raise OutputFolderError(Path(directory), f"holds {PLOTS}, a symbolic link out of it: plots are written "
+                                "only inside the output folder (hint: remove the link, or choose another -o)")
+
+
 @contextlib.contextmanager
-def writing(directory: str | Path) -> Iterator[Path]:
+def writing(directory: str | Path, kept: list[Path] | None = None) -> Iterator[Path]:
     """A fresh staging folder for one run's files; when the block ends without an error,
     they replace the result files in ``directory`` as one set (see the module's note).
-    On an error the staging folder goes and the folder is left as it was."""
+    On an error the staging folder goes and the folder is left as it was.
+
+    Files of a complete run are never replaced by those of a failed or interrupted one:
+    they move into a new folder ``previous-complete-run`` (``-2``, ...) inside
+    ``directory``, which the new run.json names (``previous_complete_run``) and which is
+    appended to ``kept``."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     with _locked(directory, exclusive=True) as locked:
         if locked:
             for stale in directory.glob(STAGING_PREFIX + "*"):
-                shutil.rmtree(stale, ignore_errors=True)  # a writer that died: only writers hold the lock
+                if (stale / STAGING_MARK).is_file() and not stale.is_symlink():
+                    shutil.rmtree(stale, ignore_errors=True)  # a writer that died: only writers hold the lock
         staged = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=directory))
         try:
+            (staged / STAGING_MARK).touch()
             yield staged
-            _replace(directory, staged)
+            folder = _replace(directory, staged)
+            if folder is not None and kept is not None:
+                kept.append(folder)
         finally:
             shutil.rmtree(staged, ignore_errors=True)
+
+
+@contextlib.contextmanager
+def replacing_plots(directory: str | Path) -> Iterator[Path]:
+    """A fresh staging folder for a run's plots; when the block ends without an error they
+    replace the ``plots/signals*.png`` in ``directory``; otherwise they go, and nothing
+    else changes. A ``plots`` linking out of ``directory`` is refused (OutputFolderError)."""
+    directory = Path(directory)
+    check_links(directory, plots=True)
+    staged = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=directory))
+    try:
+        (staged / STAGING_MARK).touch()
+        yield staged
+        with _locked(directory, exclusive=True):
+            check_links(directory, plots=True)
+            _replace_plots(directory / PLOTS, staged)
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
 
 
 @contextlib.contextmanager
@@ -96,18 +143,70 @@ def reading(directory: str | Path) -> Iterator[None]:
         yield
 
 
-def _replace(directory: Path, staged: Path) -> None:
-    """Put the staged files in place of the folder's result files, run.json last."""
+def _replace(directory: Path, staged: Path) -> Path | None:
+    """Put the staged files in place of the folder's result files, run.json last; returns
+    the folder that keeps a complete run's files the staged ones would have replaced."""
+    from .safepath import link_out_of
+
+    plots_link = link_out_of(directory, PLOTS) is not None
+    if plots_link and (staged / PLOTS).is_dir():
+        check_links(directory, plots=True)
     marker = directory / RUN_JSON
+    kept = None
+    if _status(marker) == "complete" and _status(staged / RUN_JSON) not in (None, "complete"):
+        kept = _keep(directory, plots_link)
+        _note_kept(staged / RUN_JSON, kept.name)
     marker.unlink(missing_ok=True)
     for name in (SIGNALS_NPZ, SIGNALS_CSV, SIGNALS_MAT):
         if (staged / name).exists():
             os.replace(staged / name, directory / name)
         else:
             (directory / name).unlink(missing_ok=True)
-    _replace_plots(directory / PLOTS, staged / PLOTS)
+    if not plots_link:
+        _replace_plots(directory / PLOTS, staged / PLOTS)
     if (staged / RUN_JSON).exists():
         os.replace(staged / RUN_JSON, marker)
+    return kept
+
+
+def _status(run_json: Path) -> str | None:
+    """The status a run.json records (None for none, or one that is not a run's record)."""
+    try:
+        if not run_json.is_file() or run_json.stat().st_size > 1 << 24:
+            return None
+        info = json.loads(run_json.read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return None
+    status = info.get("status", "complete") if isinstance(info, dict) else None
+    return status if isinstance(status, str) else None
+
+
+def _keep(directory: Path, plots_link: bool) -> Path:
+    """Move the folder's result files (a complete run's) into a new folder inside it."""
+    for n in itertools.count(1):
+        kept = directory / (KEPT_PREFIX if n == 1 else f"{KEPT_PREFIX}-{n}")
+        try:
+            kept.mkdir()
+            break
+        except FileExistsError:
+            continue
+    for name in (SIGNALS_NPZ, SIGNALS_CSV, SIGNALS_MAT, RUN_JSON):
+        if os.path.lexists(directory / name):
+            os.replace(directory / name, kept / name)
+    plots = directory / PLOTS
+    if not plots_link and plots.is_dir():
+        old = sorted(plots.glob(PLOT_PATTERN))
+        if old:
+            (kept / PLOTS).mkdir()
+        for path in old:
+            os.replace(path, kept / PLOTS / path.name)
+    return kept
+
+
+def _note_kept(run_json: Path, name: str) -> None:
+    info = json.loads(run_json.read_text(encoding="utf-8"))
+    info["previous_complete_run"] = name
+    run_json.write_text(json.dumps(info, indent=2, default=str) + "\n", encoding="utf-8")
 
 
 def _replace_plots(plots: Path, staged: Path) -> None:

@@ -22,16 +22,8 @@ from .diagram import Diagram
 from .outcome import Failure, Outcome
 from .results import Results
 from .schedule import Schedule
+from .stop import StopRequest
 from .timebase import format_duration
-
-
-class StopRequest(KeyboardInterrupt):
-    """A request to stop a run early, like Ctrl-C, with a ``reason`` for the status
-    (a program that turns SIGTERM into a stop raises ``StopRequest("SIGTERM")``)."""
-
-    def __init__(self, reason: str):
-        super().__init__(reason)
-        self.reason = reason
 
 
 class PortInfoFailure(Exception):

@@ -28,6 +28,17 @@ def inside(path: str | Path, folder: str | Path) -> bool:
         return False
 
 
+def link_out_of(folder: str | Path, *names: str) -> Path | None:
+    """The first of ``folder/name`` that is a symbolic link leading out of ``folder`` (or
+    nowhere), or None: a results folder writes into its own entries (``plots/``,
+    ``sweep.csv``, ``runs/``), and a link there must not carry its files elsewhere."""
+    for name in names:
+        entry = Path(folder) / name
+        if entry.is_symlink() and not inside(entry, folder):
+            return entry
+    return None
+
+
 def folder_name(name: str, default: str = "diagram") -> str:
     """``name`` as one folder name that stays where it is put: each run of unsafe characters
     (``_UNSAFE``) becomes '_', leading dots and dashes go (no hidden folder, nothing that

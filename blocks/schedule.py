@@ -178,6 +178,36 @@ def final_program(diagram: Diagram, schedule: Schedule, tick: int) -> EventProgr
     return _Planner(diagram).program(firing, schedule.lazy, schedule.advanced, final=True)
 
 
+def initial_outputs_program(diagram: Diagram, schedule: Schedule) -> EventProgram:
+    """The outputs at t = 0 alone, without the initial program's updates: what an exported
+    FMU's outputs are before its first step."""
+    firing0 = frozenset(n for n in diagram.blocks
+                        if n not in schedule.lazy and (schedule.masks[n][0] or schedule.fires_at_zero[n]))
+    return _Planner(diagram).program(firing0, schedule.lazy, schedule.advanced, final=True, initial=True)
+
+
+def between_program(diagram: Diagram, schedule: Schedule) -> EventProgram:
+    """The outputs at a tick between events where every advanced block has a hit (their
+    advances stop and start again there, as a communication point of an exported FMU):
+    the lazy blocks those read."""
+    return _Planner(diagram).program(schedule.advanced, schedule.lazy, schedule.advanced, final=True)
+
+
+def lazy_outputs_program(diagram: Diagram, schedule: Schedule, blocks: set[str]) -> EventProgram:
+    """The outputs of the lazy blocks among ``blocks`` and of the lazy blocks they read:
+    their values at any tick, computed when something outside the diagram reads them."""
+    planner = _Planner(diagram)
+    demanded: set[str] = set()
+    stack = [b for b in blocks if b in schedule.lazy]
+    while stack:
+        b = stack.pop()
+        if b not in demanded:
+            demanded.add(b)
+            stack.extend(s for s in planner.sources[b] if s in schedule.lazy)
+    evaluate, _ = planner.order_outputs(demanded)
+    return EventProgram(frozenset(), evaluate, (), (), (), final=True)
+
+
 def _firing_at(masks: dict[str, np.ndarray], lazy: frozenset[str], tick: int) -> frozenset[str]:
     """The blocks other than lazy ones whose periodic firing includes ``tick`` (so not the
     blocks that fire at t = 0 only)."""

@@ -21,7 +21,9 @@ import time
 from typing import Any, Callable
 
 from .binding import Binding
+from .block import Block
 from . import compiled
+from .api_args import boolean
 from .diagram import Diagram
 from .host import run_native
 from .issues import DiagramError
@@ -70,6 +72,7 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     the run at its first hit, naming block, port, element and time (``blocks.finite``),
     unless ``check_finite`` is False.
     """
+    boolean("raise_on_failure", raise_on_failure)
     t_end = _end_time(diagram, t_end)
     refused = diagram.open_issue()
     if refused is not None:
@@ -104,6 +107,7 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
         outcome = Outcome(None, 0, exc.failure)
     except KeyboardInterrupt as exc:
         outcome = Outcome(None, 0, interrupt=exc)
+    outcome = _finish(binding, outcome)
     wall = time.perf_counter() - wall0
     if progress is not None and outcome.end is not None:
         progress(outcome.end / total, wall)
@@ -113,6 +117,25 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
         raise SimulationError(results.status, results, f.block, float(f.tick * schedule.base_tick),
                               getattr(f.error, "port", None))
     return results
+
+
+def _finish(binding: Binding, outcome: Outcome) -> Outcome:
+    """Each block's ``finish`` after the run; the first that fails fails a complete run at
+    its end tick, and a stop request there makes it interrupted there."""
+    for name, blk, state in zip(binding.table.names.blocks, binding.blocks, binding.states):
+        if type(blk).finish is Block.finish:
+            continue
+        try:
+            blk.finish(state)
+        except (Exception, KeyboardInterrupt) as exc:
+            if outcome.end is None:
+                continue  # the run has failed or stopped already; that is what it reports
+            if isinstance(exc, KeyboardInterrupt):
+                outcome = Outcome(None, outcome.end, interrupt=exc, end_request=outcome.end_request)
+            else:
+                outcome = Outcome(None, outcome.end, Failure(name, "finish", outcome.end, exc),
+                                  end_request=outcome.end_request)
+    return outcome
 
 
 def _end_time(diagram: Diagram, t_end: Any):

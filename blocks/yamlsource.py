@@ -13,14 +13,16 @@ composes, whose recursion would overflow the C stack) and the values aliases may
 
 from __future__ import annotations
 
+import bisect
 import os
+import reprlib
 import stat
 from pathlib import Path
 from typing import Any, Sequence
 
 import yaml
 
-from .limits import MAX_ALIAS_VALUES, MAX_YAML_BYTES, MAX_YAML_DEPTH
+from .limits import MAX_ALIAS_VALUES, MAX_NUMBER_CHARS, MAX_YAML_BYTES, MAX_YAML_DEPTH
 
 
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -30,6 +32,9 @@ _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 _SEQ_TAG = "tag:yaml.org,2002:seq"
 _MAP_TAG = "tag:yaml.org,2002:map"
 _MERGE_TAG = "tag:yaml.org,2002:merge"
+_NUMBER_TAGS = {"tag:yaml.org,2002:int": "an integer", "tag:yaml.org,2002:float": "a number"}
+_SCALAR_TAGS = {"tag:yaml.org,2002:str", "tag:yaml.org,2002:bool", "tag:yaml.org,2002:null", *_NUMBER_TAGS}
+_TIMESTAMP_TAG = "tag:yaml.org,2002:timestamp"
 
 
 class YamlSourceError(Exception):
@@ -120,6 +125,7 @@ def read_yaml_file(path: str | Path, kind: str = "YAML") -> str:
         raise YamlSourceError(f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at column {column}",
                               raw.count(b"\n", 0, exc.start) + 1,
                               f"save the file as UTF-8; a binary file is not {kind}") from None
+    text = text.removeprefix("\ufeff")  # a byte order mark, which some editors write first
     if "\x00" in text:
         line, column = _position(text, text.index("\x00"))
         raise YamlSourceError(f"NUL byte at column {column}: a binary file, not {kind} text", line,
@@ -133,12 +139,13 @@ def load_yaml(text: str) -> Any:
     Refuses (YamlSourceError) nesting deeper than MAX_YAML_DEPTH and aliases or merge keys
     that repeat more than MAX_ALIAS_VALUES values.
     """
+    lines = _Lines(text)
     try:
-        _check_depth(text)
+        _check_depth(text, lines)
         loader = _Loader(text)
         try:
             node = loader.get_single_node()
-            return None if node is None else _Builder(loader).build(node, 1, node.start_mark.line + 1)
+            return None if node is None else _Builder(loader, lines).build(node, 1, lines.of(node.start_mark))
         finally:
             loader.dispose()
     except yaml.MarkedYAMLError as exc:
@@ -146,8 +153,8 @@ def load_yaml(text: str) -> Any:
         problem = exc.problem or exc.context or "invalid YAML"
         if "maximum nesting depth" in problem:  # libyaml's own limit, met while it scans ahead of our count
             raise YamlSourceError(f"YAML lists and mappings nested deeper than {MAX_YAML_DEPTH} levels",
-                                  mark.line + 1 if mark else None, "a diagram needs about 8 levels") from None
-        raise YamlSourceError(f"YAML syntax error: {problem}", mark.line + 1 if mark else None,
+                                  lines.of(mark), "a diagram needs about 8 levels") from None
+        raise YamlSourceError(f"YAML syntax error: {problem}", lines.of(mark),
                               "check indentation, colons and brackets near that line") from None
     except yaml.reader.ReaderError as exc:
         line, column = _position(text, text.find(chr(exc.character)))
@@ -157,12 +164,48 @@ def load_yaml(text: str) -> Any:
         raise YamlSourceError(f"YAML error: {' '.join(str(exc).split())}", None) from None
 
 
+def load_yaml_value(text: str, where: str) -> Any:
+    """A value given on the command line (``--set``, ``--grid``, a points file's cell) read
+    as YAML under the limits of a file's text (depth, aliases, numbers, tags), as plain
+    dicts, lists and scalars; ValueError naming ``where`` for anything else."""
+    try:
+        return _plain(load_yaml(text))
+    except YamlSourceError as exc:
+        raise ValueError(f"{where}: {exc.message}" + (f" (hint: {exc.hint})" if exc.hint else "")) from None
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    return value
+
+
+class _Lines:
+    """Line numbers of a text's marks counted at its newlines only: YAML also breaks lines at
+    NEL, LS and PS (U+0085, U+2028, U+2029), which editors do not, so its own line numbers
+    would drift past such a character."""
+
+    def __init__(self, text: str):
+        self.newlines: list[int] | None = None
+        if any(c in text for c in "\x85\u2028\u2029"):
+            self.newlines = [i for i, c in enumerate(text) if c == "\n"]
+
+    def of(self, mark: Any) -> int | None:
+        if mark is None:
+            return None
+        if self.newlines is None or getattr(mark, "index", None) is None:
+            return mark.line + 1
+        return bisect.bisect_left(self.newlines, mark.index) + 1
+
+
 def _position(text: str, index: int) -> tuple[int, int]:
     """1-based (line, column) of ``text[index]``."""
     return text.count("\n", 0, index) + 1, index - (text.rfind("\n", 0, index) + 1) + 1
 
 
-def _check_depth(text: str) -> None:
+def _check_depth(text: str, lines: _Lines) -> None:
     """Refuse nesting deeper than MAX_YAML_DEPTH, from the parser's events (no recursion),
     stopping at the first level too deep."""
     depth = 0
@@ -171,7 +214,7 @@ def _check_depth(text: str) -> None:
             depth += 1
             if depth > MAX_YAML_DEPTH:
                 raise YamlSourceError(f"YAML lists and mappings nested deeper than {MAX_YAML_DEPTH} levels",
-                                      event.start_mark.line + 1, "a diagram needs about 8 levels")
+                                      lines.of(event.start_mark), "a diagram needs about 8 levels")
         elif isinstance(event, yaml.CollectionEndEvent):
             depth -= 1
 
@@ -185,14 +228,15 @@ class _Builder:
     repetition, where the alias that repeats it is).
     """
 
-    def __init__(self, loader: yaml.SafeLoader):
+    def __init__(self, loader: yaml.SafeLoader, lines: _Lines):
         self.loader = loader
+        self.lines = lines
         self.active: set[int] = set()
         self.seen: set[int] = set()
         self.repeated = 0
 
     def build(self, node: yaml.Node, depth: int, site: int) -> Any:
-        line = node.start_mark.line + 1
+        line = self.lines.of(node.start_mark)
         fresh = id(node) not in self.seen
         if not fresh:
             self.repeated += 1
@@ -204,7 +248,7 @@ class _Builder:
             self.seen.add(id(node))
             site = line
         if isinstance(node, yaml.ScalarNode):
-            return self.loader.construct_object(node, deep=True)
+            return self.scalar(node, line)
         if depth > MAX_YAML_DEPTH:
             raise YamlSourceError(f"YAML lists and mappings nested deeper than {MAX_YAML_DEPTH} levels "
                                   "through aliases", site, "a diagram needs about 8 levels")
@@ -217,11 +261,35 @@ class _Builder:
             if isinstance(node, yaml.SequenceNode):
                 out = LineList(self.build(item, depth + 1, site) for item in node.value)
                 out.line = line
-                out.item_lines = [item.start_mark.line + 1 for item in node.value]
+                out.item_lines = [self.lines.of(item.start_mark) for item in node.value]
                 return out
             return self.mapping(node, depth, site, fresh)
         finally:
             self.active.discard(id(node))
+
+    def scalar(self, node: yaml.ScalarNode, line: int) -> Any:
+        """A plain value: text, a number of at most MAX_NUMBER_CHARS characters (Python
+        refuses to read integers of over 4300 digits, and no parameter needs more than 17
+        significant digits), a boolean or null; a date stays the text it is written as.
+        Other tags (``!!binary``, ``!!set``, ...) and text that is not what its tag says
+        (``!!float garbage``) are refused at their line."""
+        tag = node.tag
+        if tag == _TIMESTAMP_TAG:
+            return node.value
+        if tag not in _SCALAR_TAGS:
+            raise YamlSourceError(f"unsupported YAML tag {tag!r}", line,
+                                  "values are text, numbers, true/false or null")
+        if tag in _NUMBER_TAGS and len(node.value) > MAX_NUMBER_CHARS:
+            raise YamlSourceError(f"a number written with {len(node.value)} characters (at most "
+                                  f"{MAX_NUMBER_CHARS})", line, "a float64 holds 17 significant digits; "
+                                  "write the value in exponent form, e.g. 1.5e300")
+        try:
+            return self.loader.construct_object(node, deep=True)
+        except (ValueError, KeyError, AttributeError, TypeError, OverflowError, yaml.YAMLError):
+            kind = _NUMBER_TAGS.get(tag, "true or false" if tag.endswith(":bool") else "null")
+            raise YamlSourceError(f"{reprlib.repr(node.value)} is not {kind}, as its tag "
+                                  f"{tag.rsplit(':', 1)[-1]!r} says", line,
+                                  "remove the tag or write a value of that kind") from None
 
     def mapping(self, node: yaml.MappingNode, depth: int, site: int, fresh: bool) -> "LineDict":
         """A mapping; merge keys (``<<: *base`` or ``<<: [*a, *b]``) give the keys it does not
@@ -231,10 +299,10 @@ class _Builder:
         written at its key's line, in a repetition at ``site``."""
         merged: dict[Any, tuple[Any, int]] = {}
         out = LineDict()
-        out.line = node.start_mark.line + 1
+        out.line = self.lines.of(node.start_mark)
         out.key_lines = {}
         for key_node, value_node in node.value:
-            key_line = key_node.start_mark.line + 1
+            key_line = self.lines.of(key_node.start_mark)
             if key_node.tag == _MERGE_TAG:
                 for source in self.merge_sources(value_node, key_line):
                     built = self.build(source, depth + 1, key_line if fresh else site)

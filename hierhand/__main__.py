@@ -1,5 +1,16 @@
-"""``python -m hierhand`` is the ``hierhand`` command."""
+"""``python -m hierhand`` is the ``hierhand`` command.
 
-from hierhand.cli import entry
+The working folder, which Python puts first on the module path for ``-m``, is taken off it
+before anything else is imported, so that a ``numpy.py`` or ``yaml.py`` there is not
+imported instead of the real one (``python -P -m hierhand`` does the same from the start).
+"""
 
-entry()
+import os
+import sys
+
+if sys.path and sys.path[0] in ("", os.getcwd()) and not sys.flags.safe_path:
+    del sys.path[0]
+
+from hierhand.start import main  # noqa: E402  (after the path is safe)
+
+main()

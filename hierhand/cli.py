@@ -3,7 +3,7 @@
 ``blocks.cli`` provides run, validate, graph, plot, fmu info, sweep, sweep-plot and
 blocks, with the exit codes and messages of every command; this module adds what only
 the hand application does: ``animate`` (a GIF of a run), ``reproduce`` (the paper's
-tasks) and ``fmu export`` (the plant as an FMU).
+tasks) and ``fmu export`` (a diagram of library and hand blocks, or the plant, as an FMU).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Sequence
 
 from blocks.cli import EXIT_FAILED, EXIT_OK, Program, UsageError, block_types, entry as run_program
-from blocks.cli import fmu, graph, main as run_main, plot, run, sweep, validate
+from blocks.cli import fmu, graph, main as run_main, plot, run, ssp, sweep, validate
 
 DESCRIPTION = "Multirate block-diagram co-simulation: run YAML diagrams, inspect and plot them."
 MEASURES_HELP = "a hand task measure: separation_time, object_dropped, peak_ratio[(T)], recovery_time[(T)]"
@@ -75,16 +75,16 @@ def add_reproduce(sub, program) -> argparse.ArgumentParser:
 
 
 def add_fmu_export(sub, program) -> argparse.ArgumentParser:
-    """The ``fmu export`` command."""
-    export = sub.add_parser("export", help="package the hand plant as an FMI co-simulation FMU",
-                            description="Package the HandPlant as an FMI 2.0 or 3.0 co-simulation FMU: "
-                                        "the plant's C core as a native binary (Linux, no Python needed "
-                                        "at the importer) plus its C sources. Its parameters are the "
-                                        "hand file's values.")
-    export.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default: 2)")
-    export.add_argument("--hand", type=Path, metavar="FILE", help="hand file (default: the shipped hand)")
-    export.add_argument("-o", "--output", type=Path, metavar="PATH",
-                        help="FMU file or folder to write (default: fmu/)")
+    """The ``fmu export`` command: a diagram, or the hand plant alone."""
+    export = sub.add_parser("export", help="export a diagram, or the hand plant, as an FMI co-simulation FMU",
+                            description="Export DIAGRAM (any diagram of library and hand blocks: the controller, "
+                                        "the closed loop) as an FMI 2.0 or 3.0 co-simulation FMU whose binary is "
+                                        "the op-table core and the blocks' C kernels, native on Linux, no Python "
+                                        "at the importer, with its C sources. Without DIAGRAM (or with --hand): "
+                                        "the HandPlant alone, its parameters the hand file's values.")
+    fmu.export_args(export, diagram_required=False)
+    export.add_argument("--hand", type=Path, metavar="FILE",
+                        help="the plant export's hand file (default: the shipped hand); not with DIAGRAM")
     export.set_defaults(handler=cmd_fmu_export)
     return export
 
@@ -129,9 +129,17 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
 
 def cmd_fmu_export(args: argparse.Namespace) -> int:
     from blocks import DiagramError
-    from hierhand.fmu_export import FmuExportError, export_plant_fmu
+    from hierhand.fmu_export import FmuExportError, export_plant_fmu, kernel_set
     from hierhand.model import HandFileError
 
+    if args.diagram is not None:
+        if args.hand is not None:
+            raise UsageError("fmu export: --hand is for the plant export, without DIAGRAM (a diagram gives its "
+                             "plant's hand itself)")
+        print(f"wrote {fmu.export_diagram(args, kernel_set=kernel_set())}")
+        return EXIT_OK
+    if args.overrides or args.step:
+        raise UsageError("fmu export: --set and --step need a DIAGRAM (the plant export takes --hand)")
     if args.hand is not None and not args.hand.exists():
         raise UsageError(f"--hand {args.hand}: hand file not found")
     try:
@@ -147,8 +155,9 @@ def cmd_fmu_export(args: argparse.Namespace) -> int:
 PROGRAM = Program(
     name="hierhand", description=DESCRIPTION, distribution="hierhand", env_prefix="HIERHAND", advice=advice,
     commands=(run.add, validate.add, graph.add, plot.add, add_animate, add_reproduce,
-              fmu.group("export the hand plant as an FMU, or describe an FMU", add_fmu_export, fmu.info),
-              sweep.command(MEASURES_HELP), sweep.plot, block_types.add))
+              fmu.group("export a diagram or the hand plant as an FMU, or describe an FMU", add_fmu_export,
+                        fmu.info),
+              ssp.add, sweep.command(MEASURES_HELP), sweep.plot, block_types.add))
 """The ``hierhand`` command: its commands in the order of its help."""
 
 

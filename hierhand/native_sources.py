@@ -1,30 +1,31 @@
 """The C sources of the hand core and what is built from them (read by setup.py too).
 
-One list, so that the extension, the FMU libraries built at install and the ``sources/``
+One list, so that the extension, the FMU binaries built at install and the ``sources/``
 folder of an exported FMU always hold the same files. Paths are relative to the
-repository root (``CSRC``); the exporter copies ``FMU_SOURCES`` flat into ``sources/``.
+repository root (``CSRC``); an export copies its files flat into ``sources/``. Like
+``blocks.native_sources`` this module imports nothing of the packages, so that setup.py
+can read it before anything is built.
+
+hierhand's FMU binary is the framework's (``blocks.native_sources.fmu_sources``) with the
+hand's kernel types: the plant core and the controllers' laws, their kernels
+(``kernels.c``) and the kernel-set file ``fmu_kernels.c`` that lists them beside the
+library's, so any diagram of library and hand blocks leaves as an FMU.
 """
 
 from __future__ import annotations
 
-import hashlib
-import importlib.util
+import zlib
 from pathlib import Path
 
 CSRC = "hierhand/csrc"
 
 CORE = ["hand_params.c", "contact.c", "plant.c"]
 CORE_HEADERS = ["hand.h", "kinematics.h", "dynamics.h", "contact.h"]
-CONTROL = ["reflex.c", "manipulation.c", "suppresser.c"]
-CONTROL_HEADERS = ["control.h", "float_ops.h"]
+CONTROL = ["reflex.c", "manipulation.c", "suppresser.c", "control_params.c", "kernels.c"]
+CONTROL_HEADERS = ["control.h", "float_ops.h", "kernels.h"]
 BINDING = ["python/module.c", "python/py_common.c", "python/py_model.c", "python/py_plant.c", "python/py_control.c",
            "python/py_kernels.c"]
-FMU_COMMON = ["fmu_instance.c"]
-FMU_HEADERS = ["fmu_instance.h"]
-FMI_WRAPPERS = {2: "fmi2_functions.c", 3: "fmi3_functions.c"}
-
-CFLAGS = ["-O2", "-fvisibility=hidden", "-fno-math-errno", "-ffp-contract=off", "-Wall"]
-"""-ffp-contract=off: no fused multiply-adds, so every build rounds as the reference does."""
+KERNEL_SET = "fmu_kernels.c"
 
 
 def _paths(names: list[str]) -> list[str]:
@@ -32,41 +33,30 @@ def _paths(names: list[str]) -> list[str]:
 
 
 EXTENSION_SOURCES = _paths(CORE + CONTROL + BINDING)
-EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + FMU_HEADERS + ["python/py_common.h"]) + [
-    "blocks/csrc/blocks_kernel.h"  # the calling convention of py_kernels.c
+EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + ["python/py_common.h"]) + [
+    "blocks/csrc/blocks_kernel.h"  # the calling convention of kernels.c
 ]
 """Headers whose change must rebuild the extension."""
-FMI_LIBRARIES = {fmi: _paths(CORE + FMU_COMMON + [wrapper]) for fmi, wrapper in FMI_WRAPPERS.items()}
-FMI_DEPENDS = _paths(CORE_HEADERS + FMU_HEADERS)
 
 
-def fmu_source_files(fmi: int) -> list[str]:
-    """File names (inside ``CSRC``) an FMU of this FMI version carries in ``sources/``."""
-    return CORE + FMU_COMMON + [FMI_WRAPPERS[fmi]] + CORE_HEADERS + FMU_HEADERS
-
-
-def fmu_compiled_files(fmi: int) -> list[str]:
-    """The ``.c`` files among ``fmu_source_files``: what an importer compiles."""
-    return [name for name in fmu_source_files(fmi) if name.endswith(".c")]
-
-
-def fmi_headers() -> str:
-    """The folder of the FMI 2 / 3 headers the libraries are built against (fmpy's copy)."""
-    spec = importlib.util.find_spec("fmpy")
-    if spec is None or not spec.submodule_search_locations:
-        raise RuntimeError("building hierhand needs fmpy (for the FMI headers); pip installs it as a build requirement")
-    folder = Path(list(spec.submodule_search_locations)[0]) / "c-code"
-    if not (folder / "fmi2Functions.h").is_file() or not (folder / "fmi3Functions.h").is_file():
-        raise RuntimeError(f"fmpy's FMI headers are missing from {folder}")
-    return str(folder)
+def fmu_sources(framework: list[str]) -> list[str]:
+    """Every file (repository paths) of hierhand's FMU binary of one FMI version: the
+    framework's (``framework``, from ``blocks.native_sources.fmu_sources``), the hand's
+    kernels and its kernel-set file; C files first, then headers."""
+    c_files = [p for p in framework if p.endswith(".c")] + _paths(CORE + CONTROL + [KERNEL_SET])
+    return c_files + [p for p in framework if not p.endswith(".c")] + _paths(CORE_HEADERS + CONTROL_HEADERS)
 
 
 def sources_digest(root: Path) -> str:
-    """The hash of every C source and header under ``root / CSRC``: the build stamps it into
-    the extension, so that a checkout whose C sources changed since the build says so."""
+    """A checksum of every C source and header under ``root / CSRC``: the build stamps it
+    into the extension, so that a checkout whose C sources changed since the build says so.
+    CRC-32 and Adler-32 of the names and contents (zlib, not hashlib: this runs on every
+    import of hierhand, before the command line can handle Ctrl-C, and OpenSSL takes 10 ms
+    to load; it detects edits, it is not a seal against tampering)."""
     folder = Path(root) / CSRC
-    h = hashlib.sha256()
+    crc, adler, size = 0, 1, 0
     for path in sorted(folder.rglob("*")):
         if path.suffix in (".c", ".h"):
-            h.update(path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0")
-    return h.hexdigest()
+            data = path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0"
+            crc, adler, size = zlib.crc32(data, crc), zlib.adler32(data, adler), size + len(data)
+    return f"{crc:08x}{adler:08x}{size:x}"

@@ -1,10 +1,10 @@
 """The framework's command line: generic commands for any diagram, and the program that runs them.
 
 One module per command (or group): ``run``, ``validate``, ``graph``, ``plot``, ``fmu``
-(the group, with ``info``), ``sweep`` (``sweep`` and ``sweep-plot``) and
+(the group, with ``export`` and ``info``), ``sweep`` (``sweep`` and ``sweep-plot``) and
 ``block_types`` (``blocks``); ``options`` holds the diagram options they share,
-``program`` the parser, the error handling and the exit codes, ``run_output`` and
-``stop_signals`` what ``run`` needs to save its results whatever happens.
+``program`` the parser, the error handling and the exit codes, ``run_output`` what
+``run`` needs to save its results whatever happens (and ``blocks.stop`` the signals).
 
 ``python -m blocks`` runs ``PROGRAM``, the generic commands alone; an application builds
 its own ``Program`` from ``GENERIC_COMMANDS``' members and its commands (``hierhand`` does).
@@ -12,12 +12,13 @@ its own ``Program`` from ``GENERIC_COMMANDS``' members and its commands (``hierh
 
 from __future__ import annotations
 
-from . import block_types, fmu, graph, plot, run, sweep, validate
+from . import block_types, fmu, graph, plot, run, ssp, sweep, validate
 from .program import (EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, Command, Program, UsageError,
                       build_parser, entry, main)
 
 GENERIC_COMMANDS: tuple[Command, ...] = (run.add, validate.add, graph.add, plot.add,
-                                         fmu.group("describe an FMU", fmu.info), sweep.command(), sweep.plot,
+                                         fmu.group("export a diagram as an FMU, or describe an FMU", fmu.export,
+                                                   fmu.info), ssp.add, sweep.command(), sweep.plot,
                                          block_types.add)
 """Every generic command, in the order of the help."""
 

@@ -1,4 +1,4 @@
-"""``fmu``: the group of FMU commands, and ``fmu info``, which describes any FMU.
+"""``fmu``: the group of FMU commands: ``fmu export`` (a diagram as an FMU) and ``fmu info``.
 
 The group takes its subcommands as arguments, so that an application can add its own
 (an exporter of its models) beside ``info``.
@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from .options import parse_overrides, trust_arg
 from .program import EXIT_OK, Command, UsageError
 
 
@@ -43,3 +44,52 @@ def cmd_fmu_info(args: argparse.Namespace) -> int:
     except FMUInfoError as exc:
         raise UsageError(str(exc)) from None
     return EXIT_OK
+
+
+def export_args(parser: argparse.ArgumentParser, diagram_required: bool = True) -> None:
+    """DIAGRAM, --set, --trust, --fmi, --step and -o of ``fmu export``."""
+    parser.add_argument("diagram", type=Path, metavar="DIAGRAM", nargs=None if diagram_required else "?",
+                        help="YAML diagram file whose blocks all have compiled kernels")
+    parser.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
+                        help="override a parameter before exporting (value read as YAML; repeatable)")
+    trust_arg(parser)
+    parser.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default: 2)")
+    parser.add_argument("--step", metavar="T",
+                        help="the default communication step, a multiple of the internal step (default: it)")
+    parser.add_argument("-o", "--output", type=Path, metavar="PATH",
+                        help="FMU file or folder to write (default: fmu/<name>_fmi<N>.fmu)")
+
+
+def export(sub, program) -> argparse.ArgumentParser:
+    """The ``fmu export`` command (any diagram of compiled blocks)."""
+    parser = sub.add_parser("export", help="export a diagram as an FMI co-simulation FMU",
+                            description="Export DIAGRAM as an FMI 2.0 or 3.0 co-simulation FMU whose binary is "
+                                        "the op-table core and the blocks' compiled kernels: it runs without "
+                                        "Python at the importer. Its inputs and outputs are the diagram's own "
+                                        "(a diagram without outputs exports its logged signals), its parameters "
+                                        "the blocks' tunable ones.")
+    export_args(parser)
+    parser.set_defaults(handler=cmd_fmu_export)
+    return parser
+
+
+def cmd_fmu_export(args: argparse.Namespace) -> int:
+    """Write the FMU of the diagram the arguments name."""
+    print(f"wrote {export_diagram(args)}")
+    return EXIT_OK
+
+
+def export_diagram(args: argparse.Namespace, **options) -> Path:
+    """The FMU of ``args``' diagram, written: its path. ``options`` go to ``export_fmu``."""
+    from blocks import load_diagram
+    from blocks.fmu_export import FmuExportError, export_fmu
+
+    diagram = load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
+    name = f"{diagram.name}_fmi{args.fmi}.fmu"
+    out = args.output if args.output is not None else Path("fmu") / name
+    if out.suffix.lower() != ".fmu":
+        out = out / name
+    try:
+        return export_fmu(diagram, out, args.fmi, step=args.step, **options)
+    except (FmuExportError, OSError) as exc:
+        raise UsageError(f"fmu export: {exc}") from None

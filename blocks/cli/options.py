@@ -11,18 +11,20 @@ import argparse
 from pathlib import Path
 from typing import Any, Sequence
 
-import yaml
-
+from ..yamlsource import load_yaml_value
 from .program import UsageError
 
 
 def diagram_args(p: argparse.ArgumentParser) -> None:
-    """Add DIAGRAM, --set, --t-end (alias --stop-time) and --trust to a command's parser."""
-    p.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file")
+    """Add DIAGRAM, --set, --t-end (alias --stop-time), --step and --trust to a command's parser."""
+    p.add_argument("diagram", type=Path, metavar="DIAGRAM",
+                   help="YAML diagram file, or an SSP (.ssp archive, or a folder with SystemStructure.ssd)")
     p.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
                    help="override a parameter (value read as YAML; repeatable), e.g. --set prop.k=2")
     p.add_argument("--t-end", "--stop-time", dest="t_end", metavar="T",
                    help="end time, e.g. 2, '0.5 s' or '300 ms' (default: the diagram's time.t_end)")
+    p.add_argument("--step", metavar="T",
+                   help="SSP only: the communication step of the components whose SSD gives none, e.g. '1 ms'")
     trust_arg(p)
 
 
@@ -41,10 +43,9 @@ def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
         if not eq or "." not in key or not all(key.split(".")):
             raise UsageError(f"--set {item!r}: expected BLOCK.PARAM=VALUE, e.g. --set prop.k=2")
         try:
-            overrides[key] = yaml.safe_load(text) if text.strip() else None
-        except yaml.YAMLError as exc:
-            first = str(exc).splitlines()[0]
-            raise UsageError(f"--set {item!r}: the value is not valid YAML ({first})") from None
+            overrides[key] = load_yaml_value(text, f"--set {key}") if text.strip() else None
+        except ValueError as exc:
+            raise UsageError(str(exc)) from None
         if overrides[key] is None:
             raise UsageError(f"--set {item!r}: no value after '='")
     return overrides
@@ -54,7 +55,8 @@ def load(args: argparse.Namespace):
     """The diagram the arguments name, with their overrides."""
     from blocks import load_diagram
 
-    return load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
+    return load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust,
+                        step=getattr(args, "step", None))
 
 
 def end_time(args: argparse.Namespace, diagram):

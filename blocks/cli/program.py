@@ -19,6 +19,7 @@ what it computed, marked interrupted).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import os
 import sys
@@ -116,7 +117,7 @@ def main(program: Program, argv: Sequence[str] | None = None) -> int:
         print(f"{program.name}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt as exc:
-        from .stop_signals import exit_code
+        from blocks.stop import exit_code
 
         print(f"{program.name}: interrupted", file=sys.stderr)
         return exit_code(exc)
@@ -129,6 +130,9 @@ def entry(program: Program) -> None:
     error, gets one line naming the environment variable that shows its traceback.
     """
     debug = program.env("DEBUG")
+    for stream in (sys.stdout, sys.stderr):  # a name in any script, on a terminal that shows only ASCII
+        with contextlib.suppress(AttributeError, ValueError):
+            stream.reconfigure(errors="backslashreplace")
     if os.environ.get(debug):
         sys.exit(main(program))
     try:

@@ -82,16 +82,21 @@ def check_mat_names(diagram) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Simulate and save. The output folder is checked before the run; Ctrl-C or SIGTERM
-    stops the run and its results so far are saved, and no signal cuts the saving short
-    (``stop_signals``); after an interrupt the plots are skipped, to stop soon. A run that
-    a block ends early (``EndRun``) is complete: it says where and why, even with -q."""
+    """Simulate and save. The output folder is checked before the run (plots included);
+    Ctrl-C or SIGTERM stops the run and its results so far are saved, and no signal cuts
+    the saving short (``blocks.stop``). Plots are drawn once the files are saved: a signal
+    then stops the drawing (the results stay), and after an interrupt they are skipped. A
+    signal that comes while a complete run is saved ends the command with its exit code
+    once the files are written. A run that a block ends early (``EndRun``) is complete: it
+    says where and why, even with -q. A failed or interrupted run that replaces a complete
+    one says where the complete one's files went."""
     from blocks import DiagramError, simulate
+    from blocks.plot import PlotSizeError, check_plot_size
     from blocks.results_folder import OutputFolderError
     from blocks.safepath import folder_name
+    from blocks.stop import StopSignals, exit_code
 
-    from .run_output import check_output, remove_if_empty, save_run
-    from .stop_signals import StopSignals, exit_code
+    from .run_output import check_output, remove_if_empty, save_plots, save_run
 
     prog = args.program.name
     check_formats(args)
@@ -102,11 +107,17 @@ def cmd_run(args: argparse.Namespace) -> int:
         check_mat_names(diagram)
     t_end = end_time(args, diagram)
     out = args.output or Path("runs") / folder_name(diagram.name)
+    if args.plot:
+        try:
+            check_plot_size(len(diagram.log), sum(diagram.width(e.signal) for e in diagram.log))
+        except PlotSizeError as exc:
+            raise UsageError(f"--plot: the diagram logs {len(diagram.log)} signals: {exc}") from None
     try:
-        created = check_output(out)
+        created = check_output(out, plot=args.plot)
     except OutputFolderError as exc:
         raise UsageError(f"output folder {exc}") from None
     bar = ProgressBar(float(t_end), enabled=not args.quiet)
+    plots_note = ""
     with StopSignals(prog) as stops:
         try:
             results = simulate(diagram, t_end=t_end, progress=bar, check_finite=not args.allow_nonfinite)
@@ -117,20 +128,34 @@ def cmd_run(args: argparse.Namespace) -> int:
         finally:
             bar.close()
         with stops.held():
-            saved = save_run(results, out, csv=args.csv, plot=args.plot and not results.interrupted,
-                             mat=args.mat, csv_digits=args.csv_digits, temp_prefix=f"{prog}-results-")
+            saved = save_run(results, out, csv=args.csv, mat=args.mat, csv_digits=args.csv_digits,
+                             temp_prefix=f"{prog}-results-")
+        if args.plot and saved.folder is not None:
+            if stops.received is None:
+                try:
+                    save_plots(results, saved)
+                except KeyboardInterrupt:
+                    plots_note = f"; plots stopped by {stops.received or 'SIGINT'}"
+            else:
+                plots_note = f"; plots skipped after the {stops.received}"
+            if plots_note:
+                plots_note += f" ('{prog} plot {saved.folder}' draws them)"
+    stopped = stops.received
     if not results.complete:
         print(f"{prog}: {diagram.file}: {results.status}", file=sys.stderr)
+    if saved.kept is not None:
+        print(f"{prog}: the complete run that was in {out} is kept in {saved.kept}", file=sys.stderr)
     if saved.problem:
         print(f"{prog}: {saved.problem}", file=sys.stderr)
         return EXIT_FAILED
     if not results.complete:
-        skipped = (f"; plots skipped after the interrupt ('{prog} plot {out}' draws them)"
-                   if args.plot and results.interrupted else "")
-        print(f"{prog}: partial results (marked incomplete) saved in {out}{skipped}", file=sys.stderr)
-        return exit_code(stops.received) if results.interrupted else EXIT_FAILED
+        print(f"{prog}: partial results (marked incomplete) saved in {out}{plots_note}", file=sys.stderr)
+        return exit_code(stopped) if results.interrupted else EXIT_FAILED
     if results.ended_by is not None:
         print(f"{diagram.name}: {results.end_note}")
+    if stopped is not None:
+        print(f"{prog}: {stopped} after the run: its results are complete in {out}{plots_note}", file=sys.stderr)
+        return exit_code(stopped)
     if not args.quiet:
         info = results.info
         rtf = info.get("real_time_factor")

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from blocks import Results
-from blocks.results_folder import PLOTS, prepare, writing
+from blocks.results_folder import PLOTS, check_links, prepare, replacing_plots, writing
 
 
 @dataclass
@@ -27,13 +27,17 @@ class Saved:
     folder: Path | None
     plots: list[Path] = field(default_factory=list)
     problem: str | None = None
+    kept: Path | None = None
+    """Where the complete run that was in the folder went, when these results replaced it."""
 
 
-def check_output(out: Path) -> bool:
-    """Make sure ``out`` can take the results (``OutputFolderError`` if not); returns
-    whether it had to be created, so that a run refused later can take it away again."""
+def check_output(out: Path, plot: bool = False) -> bool:
+    """Make sure ``out`` can take the results (``OutputFolderError`` if not), plots too
+    with ``plot``; returns whether it had to be created, so that a run refused later can
+    take it away again."""
     created = not out.exists()
     prepare(out)
+    check_links(out, plot)
     return created
 
 
@@ -43,39 +47,44 @@ def remove_if_empty(out: Path) -> None:
         out.rmdir()
 
 
-def save_run(results: Results, out: Path, csv: bool, plot: bool, temp_prefix: str = "results-",
-             mat: bool = False, csv_digits: int | None = None) -> Saved:
+def save_run(results: Results, out: Path, csv: bool, temp_prefix: str = "results-", mat: bool = False,
+             csv_digits: int | None = None) -> Saved:
     """Write the results (signals.csv with ``csv``, at ``csv_digits``, signals.mat with
-    ``mat``, plots with ``plot``) into ``out``, or failing that into a new temporary folder
-    whose name starts with ``temp_prefix``."""
-    def write(folder: Path) -> list[Path]:
-        return write_set(results, folder, csv, plot, mat=mat, csv_digits=csv_digits)
-
+    ``mat``) into ``out``, or failing that into a new temporary folder whose name starts
+    with ``temp_prefix``."""
+    kept: list[Path] = []
     try:
-        return Saved(out, write(out))
+        with writing(out, kept) as staged:
+            results.write_files(staged, csv, mat=mat, csv_digits=csv_digits)
+        return Saved(out, kept=kept[0] if kept else None)
     except OSError as exc:
         reason = describe(exc)
     spare = None
     try:
         spare = Path(tempfile.mkdtemp(prefix=temp_prefix))
-        plots = write(spare)
+        results.save(spare, csv, mat=mat, csv_digits=csv_digits)
     except OSError as exc:
         if spare is not None:
             shutil.rmtree(spare, ignore_errors=True)
         return Saved(None, problem=f"cannot save the results in {out} ({reason}) nor in a temporary "
                                    f"folder ({describe(exc)}): they are lost")
-    return Saved(spare, plots, f"cannot save the results in {out}: {reason}; saved them in {spare} instead")
+    return Saved(spare, problem=f"cannot save the results in {out}: {reason}; saved them in {spare} instead")
 
 
-def write_set(results: Results, folder: Path, csv: bool, plot: bool, mat: bool = False,
-              csv_digits: int | None = None) -> list[Path]:
-    """The run's files, and its plots, into ``folder`` as one set; returns the plots."""
+def save_plots(results: Results, saved: Saved) -> None:
+    """Draw the saved results' plots into their folder's ``plots/`` (replacing the earlier
+    run's as a set); a stop request ends the drawing and leaves no plot of this run. A
+    folder that cannot take them sets ``saved.problem``."""
     from blocks.plot import plot_signals
 
-    with writing(folder) as staged:
-        results.write_files(staged, csv, mat=mat, csv_digits=csv_digits)
-        made = plot_signals(results, staged / PLOTS / "signals.png") if plot and len(results) else []
-    return [folder / PLOTS / p.name for p in made]
+    if not len(results):
+        return
+    try:
+        with replacing_plots(saved.folder) as staged:
+            made = plot_signals(results, staged / "signals.png")
+        saved.plots = [saved.folder / PLOTS / p.name for p in made]
+    except OSError as exc:
+        saved.problem = f"the results are saved in {saved.folder}, but not their plots: {describe(exc)}"
 
 
 def describe(exc: OSError) -> str:

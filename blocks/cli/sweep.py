@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from .options import end_time, trust_arg
-from .program import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, Command, UsageError
+from .program import EXIT_FAILED, EXIT_OK, Command, UsageError
 
 REDUCERS_HELP = ("a column per run (repeatable): REDUCER(BLOCK.PORT[i]) with final, max, min, mean, "
                  "first_time_above(BLOCK.PORT[i], X), first_time_below(BLOCK.PORT[i], X)")
@@ -131,9 +131,11 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                                 axes=axes, origins=origins(args.grid, args.random, args.points, points),
                                 start_method=method, keep_results=args.keep_results)
         except SweepInterrupted as stop:
+            from blocks.stop import exit_code
+
             print(f"{prog}: sweep interrupted: {stop.stored} of {stop.total} points are in {stop.csv} "
                   "(hint: run the same command again to run the rest)", file=sys.stderr)
-            return EXIT_INTERRUPTED
+            return exit_code(stop)
     except SweepError as exc:
         raise UsageError(str(exc)) from None
     report = summary.report

@@ -61,4 +61,44 @@ typedef int (*blk_update_fn)(const void *ctx, double t, double *state, const dou
 typedef int (*blk_advance_fn)(const void *ctx, double t, double *state, const double *const *inputs, int n,
                               double *rows, int *done, int *which);
 
+/* Kernel types: a kernel that a program without Python (an exported FMU) rebuilds.
+ *
+ * Python describes a block's kernel by a record (blocks.kernel.KernelRecord): the name of
+ * its type and a flat array of doubles, the block's parameters in the type's own order,
+ * which the type's construct turns into a context, checking them as the block does when it
+ * is made (the checks are the type's, so one definition serves the block and the FMU). An
+ * exported FMU keeps the records in its resources and rebuilds every context when it is
+ * initialised, from the records with its tunable parameters written into them.
+ *
+ * construct: from the record (n doubles) fills built (its context, which it allocates;
+ *            the summed width of the outputs its functions write; its state's size, or -1
+ *            when the record's block keeps the state Python gave it) and returns 0; or a
+ *            nonzero code with one line in message (size bytes) saying which parameter is
+ *            wrong and why, named as in the record (its slots' names).
+ * destroy:   frees a built context (NULL: nothing to free beyond construct's malloc, which
+ *            free releases).
+ * initial:   the initial state of a built context (state_size values), NULL when
+ *            construct gives -1.
+ * failure:   one line saying what a failure code of the kernel's functions means (NULL:
+ *            the program says the code), for the phase ("output", "update", "advance")
+ *            and the time of the hit that failed: the words the block's Python side uses. */
+typedef struct {
+    void *ctx;
+    long outputs;
+    long state_size;
+} blk_built;
+
+typedef int (*blk_construct_fn)(const double *record, long n, blk_built *built, char *message, long size);
+
+typedef struct blk_kernel_type {
+    const char *name; /* NULL ends a table of types */
+    blk_construct_fn construct;
+    void (*destroy)(void *ctx);
+    void (*initial)(const void *ctx, double *state);
+    blk_output_fn output;
+    blk_update_fn update;
+    blk_advance_fn advance;
+    void (*failure)(const void *ctx, int code, int which, const char *phase, double t, char *message, long size);
+} blk_kernel_type;
+
 #endif

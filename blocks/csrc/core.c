@@ -156,36 +156,22 @@ const char *blk_table_unpack(const void *data, size_t size, blk_table *t, const 
 
 /* -- running --------------------------------------------------------------------------- */
 
-/* The position of an event: the hyperperiod it falls in and its row. */
-typedef struct {
-    int64_t cycle, row;
-} cursor;
-
-typedef struct {
-    blk_run *run;
-    const blk_table *t;
-    const double **pointers; /* per input port, where it reads */
-    int64_t end, end_program;
-    cursor after; /* the first event after the program running now */
-} interp;
-
 static double tick_time(const blk_table *t, int64_t k)
 {
     return (double)(k * t->header[BLK_H_TICK_NUM]) / (double)t->header[BLK_H_TICK_DEN];
 }
 
-static int64_t event_tick(const blk_table *t, cursor c)
+static int64_t event_tick(const blk_table *t, const blk_position *c)
 {
-    return c.cycle * t->header[BLK_H_HYPERPERIOD] + t->events[c.row * BLK_E_N + BLK_E_TICK];
+    return c->cycle * t->header[BLK_H_HYPERPERIOD] + t->events[c->row * BLK_E_N + BLK_E_TICK];
 }
 
-static cursor following(const blk_table *t, cursor c)
+static void following(const blk_table *t, blk_position *c)
 {
-    if (++c.row == t->n_events) {
-        c.row = 0;
-        c.cycle++;
+    if (++c->row == t->n_events) {
+        c->row = 0;
+        c->cycle++;
     }
-    return c;
 }
 
 static void log_row(blk_run *r, int64_t e, const double *outputs)
@@ -230,21 +216,21 @@ static int stopped(blk_run *r)
 /* The next hit of block b after the program running now: the first event (within one
    hyperperiod) whose program updates it. An update that asks to end the run is a hit of a
    block the program updates, and that block is updated at every hit it has. */
-static void end_at_next_hit(interp *x, int64_t block)
+static void end_at_next_hit(blk_run *r, int64_t block)
 {
-    const blk_table *t = x->t;
-    cursor c = x->after;
-    for (int64_t n = 0; n < t->n_events; n++, c = following(t, c)) {
-        int64_t k = event_tick(t, c);
-        if (k >= x->end)
+    const blk_table *t = r->table;
+    blk_position c = r->at;
+    for (int64_t n = 0; n < t->n_events; n++, following(t, &c)) {
+        int64_t k = event_tick(t, &c);
+        if (k >= r->at.end)
             return;
         int64_t program = t->events[c.row * BLK_E_N + BLK_E_PROGRAM];
         const int64_t *p = t->programs + program * BLK_PR_N;
         for (int64_t i = p[BLK_PR_FIRST]; i < p[BLK_PR_END]; i++) {
             const int64_t *op = t->ops + i * BLK_OP_N;
             if (op[BLK_OP_CODE] == BLK_UPDATE && op[BLK_OP_A] == block) {
-                x->end = k;
-                x->end_program = p[BLK_PR_FINAL];
+                r->at.end = k;
+                r->at.end_program = p[BLK_PR_FINAL];
                 return;
             }
         }
@@ -252,13 +238,12 @@ static void end_at_next_hit(interp *x, int64_t block)
 }
 
 /* A block's output (into the arena) or update at tick ke: its kernel, or the host's call hook. */
-static int step(interp *x, int64_t index, const int64_t *op, int64_t ke, int *which)
+static int step(blk_run *r, int64_t index, const int64_t *op, int64_t ke, int *which)
 {
-    blk_run *r = x->run;
-    const int64_t *b = x->t->blocks + op[BLK_OP_A] * BLK_B_N;
+    const int64_t *b = r->table->blocks + op[BLK_OP_A] * BLK_B_N;
     const blk_kernel *k = r->kernels + op[BLK_OP_A];
-    const double *const *inputs = x->pointers + b[BLK_B_FIRST_INPUT];
-    double t = tick_time(x->t, ke);
+    const double *const *inputs = r->pointers + b[BLK_B_FIRST_INPUT];
+    double t = tick_time(r->table, ke);
     int done = 0;
     lock_for(r, k);
     if (k->output == NULL)
@@ -294,11 +279,11 @@ static int64_t first_nonfinite(const double *v, int64_t n)
 
 /* The index among its block's outputs of the first value an output op computed (the ports
    of its selection) that is not finite, or -1. */
-static int64_t nonfinite_output(const interp *x, const int64_t *op)
+static int64_t nonfinite_output(const blk_run *r, const int64_t *op)
 {
-    const blk_table *t = x->t;
+    const blk_table *t = r->table;
     const int64_t *b = t->blocks + op[BLK_OP_A] * BLK_B_N, s = op[BLK_OP_D];
-    const double *arena = x->run->arena;
+    const double *arena = r->arena;
     if (s < 0)
         return first_nonfinite(arena + b[BLK_B_OUT], b[BLK_B_WIDTH]);
     for (int64_t i = 0; i < t->selections[s]; i++) {
@@ -310,24 +295,23 @@ static int64_t nonfinite_output(const interp *x, const int64_t *op)
     return -1;
 }
 
-static int output(interp *x, int64_t index, const int64_t *op, int64_t ke)
+static int output(blk_run *r, int64_t index, const int64_t *op, int64_t ke)
 {
-    int which = 0, code = step(x, index, op, ke, &which);
+    int which = 0, code = step(r, index, op, ke, &which);
     if (code)
-        return fail(x->run, index, ke, code, which);
-    int64_t bad = x->run->allow_nonfinite ? -1 : nonfinite_output(x, op);
+        return fail(r, index, ke, code, which);
+    int64_t bad = r->allow_nonfinite ? -1 : nonfinite_output(r, op);
     if (bad >= 0)
-        return fail(x->run, index, ke, BLK_NONFINITE, (int)bad);
-    const double *out = x->run->arena + x->t->blocks[op[BLK_OP_A] * BLK_B_N + BLK_B_OUT];
+        return fail(r, index, ke, BLK_NONFINITE, (int)bad);
+    const double *out = r->arena + r->table->blocks[op[BLK_OP_A] * BLK_B_N + BLK_B_OUT];
     for (int64_t e = op[BLK_OP_B]; e < op[BLK_OP_C]; e++)
-        log_row(x->run, e, out);
+        log_row(r, e, out);
     return 0;
 }
 
-static int update(interp *x, int64_t index, const int64_t *op, int64_t ke)
+static int update(blk_run *r, int64_t index, const int64_t *op, int64_t ke)
 {
-    blk_run *r = x->run;
-    int which = 0, code = step(x, index, op, ke, &which);
+    int which = 0, code = step(r, index, op, ke, &which);
     if (code == BLK_END_RUN) {
         if (r->hooks.end && r->hooks.end(r->hooks.host, index, which, ke))
             return fail(r, index, ke, code, which);
@@ -335,7 +319,7 @@ static int update(interp *x, int64_t index, const int64_t *op, int64_t ke)
             r->outcome.end_op = index;
             r->outcome.end_asked = ke;
         }
-        end_at_next_hit(x, op[BLK_OP_A]);
+        end_at_next_hit(r, op[BLK_OP_A]);
         return 0;
     }
     return code ? fail(r, index, ke, code, which) : 0;
@@ -343,11 +327,10 @@ static int update(interp *x, int64_t index, const int64_t *op, int64_t ke)
 
 /* Step a block from tick ke to tick next in chunks of at most its rows' capacity, each
    from the time of its first tick. */
-static int advance(interp *x, int64_t index, const int64_t *op, int64_t ke, int64_t next)
+static int advance(blk_run *r, int64_t index, const int64_t *op, int64_t ke, int64_t next)
 {
-    blk_run *r = x->run;
     int64_t block = op[BLK_OP_A];
-    const int64_t *b = x->t->blocks + block * BLK_B_N;
+    const int64_t *b = r->table->blocks + block * BLK_B_N;
     const blk_kernel *k = r->kernels + block;
     double *rows = r->arena + b[BLK_B_ROWS], *out = r->arena + b[BLK_B_OUT];
     int64_t width = b[BLK_B_WIDTH], period = b[BLK_B_PERIOD], capacity = b[BLK_B_ROWS_CAPACITY];
@@ -355,12 +338,12 @@ static int advance(interp *x, int64_t index, const int64_t *op, int64_t ke, int6
     while (n > 0) {
         int m = (int)(n < capacity ? n : capacity), done = 0, which = 0, code;
         int64_t first = ke + stepped * period;
-        double t = tick_time(x->t, first);
+        double t = tick_time(r->table, first);
         lock_for(r, k);
         if (k->output == NULL)
             code = r->hooks.call(r->hooks.host, index, first, t, m, rows, &done, &which);
         else
-            code = k->advance(k->ctx, t, k->state, x->pointers + b[BLK_B_FIRST_INPUT], m, rows, &done, &which);
+            code = k->advance(k->ctx, t, k->state, r->pointers + b[BLK_B_FIRST_INPUT], m, rows, &done, &which);
         int logged = code ? (done < 0 ? 0 : done > m ? m : done) : m;
         int64_t bad = r->allow_nonfinite || width == 0 ? -1 : first_nonfinite(rows, logged * width);
         if (bad >= 0) { /* the row that has it becomes the outputs, those before it are logged */
@@ -386,35 +369,59 @@ static int advance(interp *x, int64_t index, const int64_t *op, int64_t ke, int6
     return 0;
 }
 
-/* One program at tick ke, its advances stepping to tick next; nonzero: the run stops. */
-static int program(interp *x, int64_t p, int64_t ke, int64_t next)
+static void copy(blk_run *r, const int64_t *op)
 {
-    const blk_table *t = x->t;
-    blk_run *r = x->run;
+    const int64_t *c = r->table->copies + op[BLK_OP_A] * BLK_C_N;
+    memcpy(r->arena + c[BLK_C_DST], r->arena + c[BLK_C_SRC], (size_t)c[BLK_C_WIDTH] * sizeof(double));
+}
+
+/* A program's ops at tick ke up to its first advance (all of them for a final program);
+   nonzero: the run stops. *tail: where its advances begin. */
+static int head(blk_run *r, int64_t p, int64_t ke, int64_t *tail)
+{
+    const blk_table *t = r->table;
     const int64_t *row = t->programs + p * BLK_PR_N;
     r->outcome.reached = ke;
-    for (int64_t i = row[BLK_PR_FIRST]; i < row[BLK_PR_END]; i++) {
+    int64_t i = row[BLK_PR_FIRST];
+    for (; i < row[BLK_PR_END]; i++) {
         const int64_t *op = t->ops + i * BLK_OP_N;
         int stop = 0;
         switch (op[BLK_OP_CODE]) {
         case BLK_OUTPUT:
-            stop = output(x, i, op, ke);
+            stop = output(r, i, op, ke);
             break;
         case BLK_UPDATE:
-            stop = update(x, i, op, ke);
+            stop = update(r, i, op, ke);
             break;
         case BLK_ADVANCE:
-            stop = advance(x, i, op, ke, next);
-            break;
-        default: {
-            const int64_t *c = t->copies + op[BLK_OP_A] * BLK_C_N;
-            memcpy(r->arena + c[BLK_C_DST], r->arena + c[BLK_C_SRC], (size_t)c[BLK_C_WIDTH] * sizeof(double));
-        }
+            *tail = i;
+            return 0;
+        default:
+            copy(r, op);
         }
         if (stop)
             return 1;
     }
-    r->outcome.reached = next;
+    *tail = i;
+    return 0;
+}
+
+/* The advances of program p (its ops from tail on: advances and copies), stepping the
+   advanced blocks from tick from to tick to; nonzero: the run stops. */
+static int tail(blk_run *r, int64_t p, int64_t tail_at, int64_t from, int64_t to)
+{
+    const blk_table *t = r->table;
+    const int64_t *row = t->programs + p * BLK_PR_N;
+    for (int64_t i = tail_at; i < row[BLK_PR_END]; i++) {
+        const int64_t *op = t->ops + i * BLK_OP_N;
+        if (op[BLK_OP_CODE] == BLK_ADVANCE) {
+            if (advance(r, i, op, from, to))
+                return 1;
+        } else {
+            copy(r, op);
+        }
+    }
+    r->outcome.reached = to;
     return 0;
 }
 
@@ -430,12 +437,13 @@ static int bad(blk_run *r, const char *message)
     return BLK_RUN_BAD;
 }
 
-int blk_run_table(blk_run *r)
+int blk_run_begin(blk_run *r)
 {
     const blk_table *t = r->table;
     blk_outcome *o = &r->outcome;
     memset(o, 0, sizeof *o);
     o->end_op = o->end_asked = o->op = -1;
+    r->pointers = NULL;
     for (int64_t i = 0; i < t->n_ops; i++) {
         const int64_t *op = t->ops + i * BLK_OP_N;
         if (op[BLK_OP_CODE] == BLK_COPY)
@@ -446,29 +454,87 @@ int blk_run_table(blk_run *r)
                                     (op[BLK_OP_CODE] == BLK_ADVANCE && k->advance == NULL))
             return bad(r, "a block's op has neither a kernel function nor the host's call hook");
     }
-    interp x = {r, t, malloc((size_t)(t->n_inputs > 0 ? t->n_inputs : 1) * sizeof(const double *)),
-                t->header[BLK_H_N_TICKS], t->header[BLK_H_FINAL], {0, 0}};
-    if (x.pointers == NULL)
+    r->pointers = malloc((size_t)(t->n_inputs > 0 ? t->n_inputs : 1) * sizeof(const double *));
+    if (r->pointers == NULL)
         return bad(r, "no memory for the input pointers");
     for (int64_t i = 0; i < t->n_inputs; i++)
-        x.pointers[i] = r->arena + t->inputs[i * BLK_I_N + BLK_I_OFFSET];
+        r->pointers[i] = r->arena + t->inputs[i * BLK_I_N + BLK_I_OFFSET];
+    blk_position *at = &r->at;
+    memset(at, 0, sizeof *at);
+    at->pending = -1;
+    at->end = t->header[BLK_H_N_TICKS];
+    at->end_program = -1;
     if (t->n_events > 0 && t->events[BLK_E_TICK] == 0)
-        x.after = following(t, x.after); /* the event at tick 0 is the initial program's */
-    int64_t next = t->n_events > 0 ? earlier(event_tick(t, x.after), x.end) : x.end;
-    int stop = program(&x, t->header[BLK_H_INITIAL], 0, next) || stopped(r);
-    while (!stop && t->n_events > 0) {
-        int64_t k = event_tick(t, x.after);
-        if (k >= x.end)
-            break;
-        int64_t p = t->events[x.after.row * BLK_E_N + BLK_E_PROGRAM];
-        x.after = following(t, x.after);
-        stop = program(&x, p, k, earlier(event_tick(t, x.after), x.end)) || stopped(r);
+        following(t, at); /* the event at tick 0 is the initial program's */
+    return 0;
+}
+
+int blk_run_until(blk_run *r, int64_t stop)
+{
+    const blk_table *t = r->table;
+    blk_position *at = &r->at;
+    if (r->outcome.status != BLK_RUN_COMPLETE)
+        return r->outcome.status; /* failed or stopped before: the run cannot go on */
+    for (;;) {
+        int64_t limit = earlier(stop, at->end);
+        if (at->pending >= 0) {
+            int64_t to = earlier(at->span_end, limit);
+            if (to >= at->tick && tail(r, at->pending, at->tail, at->tick, to))
+                return r->outcome.status;
+            at->tick = to;
+            if (to < at->span_end)
+                return 0; /* stopped inside the span */
+            at->pending = -1;
+            if (stopped(r))
+                return r->outcome.status;
+            continue;
+        }
+        if (at->tick >= limit)
+            return 0;
+        int64_t p;
+        if (!at->started) {
+            p = t->header[BLK_H_INITIAL];
+            at->started = 1;
+        } else {
+            p = t->events[at->row * BLK_E_N + BLK_E_PROGRAM];
+            following(t, at);
+        }
+        int64_t next = t->n_events > 0 ? event_tick(t, at) : INT64_MAX;
+        at->span_end = earlier(next, at->end);
+        if (head(r, p, at->tick, &at->tail))
+            return r->outcome.status;
+        at->pending = p;
     }
-    if (!stop && !program(&x, x.end == t->header[BLK_H_N_TICKS] ? t->header[BLK_H_FINAL] : x.end_program, x.end,
-                          x.end)) {
-        o->status = BLK_RUN_COMPLETE;
-        o->end = x.end;
+}
+
+int blk_run_outputs(blk_run *r, int64_t program)
+{
+    int64_t unused;
+    if (head(r, program, r->at.tick, &unused))
+        return r->outcome.status;
+    return 0;
+}
+
+void blk_run_release(blk_run *r)
+{
+    free(r->pointers);
+    r->pointers = NULL;
+}
+
+int blk_run_table(blk_run *r)
+{
+    if (blk_run_begin(r) != 0)
+        return r->outcome.status;
+    const blk_table *t = r->table;
+    blk_outcome *o = &r->outcome;
+    if (blk_run_until(r, t->header[BLK_H_N_TICKS]) == 0) {
+        blk_position *at = &r->at;
+        int64_t final = at->end == t->header[BLK_H_N_TICKS] ? t->header[BLK_H_FINAL] : at->end_program;
+        if (blk_run_outputs(r, final) == 0) {
+            o->status = BLK_RUN_COMPLETE;
+            o->end = at->end;
+        }
     }
-    free(x.pointers);
+    blk_run_release(r);
     return o->status;
 }

@@ -148,11 +148,26 @@ typedef struct {
     const char *message;
 } blk_outcome;
 
+/* Where a run is, between the calls of a run in parts (blk_run_until): every op of the
+   ticks before tick is done; pending >= 0: the advances of that program, which ran its
+   other ops at an earlier event, still step from tick to span_end (the next event, or
+   the end); pending < 0: tick is the next event's (or the end). after: the first event
+   after the program running now; end and end_program: the tick the run ends at and the
+   program it ends with there (-1: the header's final program, the end not asked for);
+   tail: where pending's advances start among the ops. Plain numbers (and the input
+   pointers, into the arena), so a host can save and restore a position. */
+typedef struct {
+    int64_t cycle, row; /* after: its hyperperiod and its row of the events */
+    int64_t tick, pending, span_end, tail, end, end_program;
+    int started; /* the initial program has run */
+} blk_position;
+
 /* One run: the table, the arena (header[BLK_H_ARENA] values, holding the table's initial
    values), one kernel per block, per log entry its buffer (capacity x width values) and
    counters (BLK_LC_N each, zero), the hooks. stop: any thread or a signal handler may set
    it; the run stops at the next check, after an event or a chunk. allow_nonfinite: zero
-   (the default) fails an op whose outputs are not finite (BLK_NONFINITE). */
+   (the default) fails an op whose outputs are not finite (BLK_NONFINITE). at and pointers
+   belong to the core (blk_run_begin sets them). */
 typedef struct {
     const blk_table *table;
     double *arena;
@@ -163,9 +178,24 @@ typedef struct {
     volatile int stop;
     blk_outcome outcome;
     int allow_nonfinite;
+    blk_position at;
+    const double **pointers; /* per input port, where it reads */
 } blk_run;
 
 /* Run the table from tick 0 to its end; returns run->outcome.status. */
 int blk_run_table(blk_run *run);
+
+/* A run in parts, as an exported FMU steps one (blk_run_table is these four):
+   blk_run_begin checks the kernels against the ops and prepares a run at tick 0, nothing
+   run (BLK_RUN_BAD, or 0). blk_run_until runs every op of the ticks before stop (the
+   initial program first) and the advances up to stop, which must be a hit of every
+   advanced block; it stops earlier at the run's end (at.end) and returns 0 while the run
+   goes on, or the outcome's status (failed, stopped: the run cannot go on).
+   blk_run_outputs runs program (one of outputs only: a final program) at at.tick.
+   blk_run_release frees what begin took. */
+int blk_run_begin(blk_run *run);
+int blk_run_until(blk_run *run, int64_t stop);
+int blk_run_outputs(blk_run *run, int64_t program);
+void blk_run_release(blk_run *run);
 
 #endif

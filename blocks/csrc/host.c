@@ -33,6 +33,7 @@
 
 #include "blocks_kernel.h"
 #include "core.h"
+#include "export_instance.h"
 #include "fmu.h"
 #include "library.h"
 
@@ -874,17 +875,27 @@ static PyObject *call_kernel(PyObject *module, PyObject *args)
     return result;
 }
 
-/* library(): {name: address} of the library blocks' kernels. */
+/* library(): {name: address} of the library blocks' kernel functions ("gain_output", ...), from
+   the kernel types of library.c. */
 static PyObject *library(PyObject *module, PyObject *unused)
 {
     (void)module;
     (void)unused;
     PyObject *found = PyDict_New();
-    for (const blk_library_entry *e = blk_library; found != NULL && e->name != NULL; e++) {
-        PyObject *address = PyLong_FromVoidPtr((void *)e->function);
-        if (address == NULL || PyDict_SetItemString(found, e->name, address) != 0)
-            Py_CLEAR(found);
-        Py_XDECREF(address);
+    static const char *phases[] = {"output", "update", "advance"};
+    for (const blk_kernel_type *k = blk_library_types; found != NULL && k->name != NULL; k++) {
+        void *functions[] = {(void *)(uintptr_t)k->output, (void *)(uintptr_t)k->update,
+                             (void *)(uintptr_t)k->advance};
+        for (int i = 0; found != NULL && i < 3; i++) {
+            if (functions[i] == NULL)
+                continue;
+            PyObject *address = PyLong_FromVoidPtr(functions[i]);
+            PyObject *name = PyUnicode_FromFormat("%s_%s", k->name, phases[i]);
+            if (address == NULL || name == NULL || PyDict_SetItem(found, name, address) != 0)
+                Py_CLEAR(found);
+            Py_XDECREF(address);
+            Py_XDECREF(name);
+        }
     }
     return found;
 }
@@ -919,7 +930,12 @@ PyMODINIT_FUNC PyInit__native(void)
         return NULL;
     Py_INCREF(&run_type);
     if (PyModule_AddObject(module, "Run", (PyObject *)&run_type) != 0 ||
-        PyModule_AddIntConstant(module, "ABI", BLK_KERNEL_ABI) != 0) {
+        PyModule_AddIntConstant(module, "ABI", BLK_KERNEL_ABI) != 0 ||
+        PyModule_AddStringConstant(module, "EXPORT_RESOURCE", BLK_EXPORT_RESOURCE) != 0 ||
+        PyModule_AddObject(module, "EXPORT_FORMAT", Py_BuildValue("(LL)", (long long)BLK_EXPORT_MAGIC,
+                                                                  (long long)BLK_EXPORT_VERSION)) != 0 ||
+        PyModule_AddObject(module, "EXPORT_LOG_CATEGORIES",
+                           Py_BuildValue("(sss)", BLK_LOG_EVENTS, BLK_LOG_WARNING, BLK_LOG_ERROR)) != 0) {
         Py_DECREF(module);
         return NULL;
     }

@@ -15,11 +15,14 @@
  * ndarray.dot to round-off, not bit for bit (BLAS sums in its own order). That is enough:
  * within a run the executor uses a block's kernel for all of its hits or for none.
  *
- * The table at the end also lists the kernels of the library's signal blocks (lib_math.c,
- * lib_dynamic.c, lib_sources.c; their conventions in lib_common.h).
+ * The table of kernel types at the end (blocks_kernel.h) also lists the kernels of the
+ * library's signal blocks (lib_math.c, lib_dynamic.c, lib_sources.c; their conventions in
+ * lib_common.h). Every library context is a flat array of doubles, so a type's constructor
+ * copies its record.
  */
 #include <math.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -329,61 +332,108 @@ static int lti_advance(const void *ctx, double t, double *state, const double *c
     return 0;
 }
 
-#define ENTRY(f) {#f, (void (*)(void))f}
+/* -- kernel types: a context rebuilt from its record ---------------------------------- */
 
-const blk_library_entry blk_library[] = {
-    ENTRY(constant_output),
-    ENTRY(step_output),
-    ENTRY(ramp_output),
-    ENTRY(gain_output),
-    ENTRY(sum_output),
-    ENTRY(saturation_output),
-    ENTRY(unit_delay_output),
-    ENTRY(unit_delay_update),
-    ENTRY(unit_delay_advance),
-    ENTRY(zero_order_hold_output),
-    ENTRY(lti_output),
-    ENTRY(lti_update),
-    ENTRY(lti_advance),
-    ENTRY(abs_output),
-    ENTRY(sign_output),
-    ENTRY(bias_output),
-    ENTRY(minmax_output),
-    ENTRY(math_output),
-    ENTRY(relational_output),
-    ENTRY(compare_output),
-    ENTRY(logic_output),
-    ENTRY(dead_zone_output),
-    ENTRY(quantizer_output),
-    ENTRY(product_output),
-    ENTRY(threshold_switch_output),
-    ENTRY(multiport_switch_output),
-    ENTRY(lookup1d_output),
-    ENTRY(lookup2d_output),
-    ENTRY(concatenate_output),
-    ENTRY(selector_output),
-    ENTRY(integrator_output),
-    ENTRY(integrator_update),
-    ENTRY(integrator_advance),
-    ENTRY(derivative_output),
-    ENTRY(derivative_update),
-    ENTRY(moving_average_output),
-    ENTRY(moving_average_update),
-    ENTRY(pid_output),
-    ENTRY(pid_update),
-    ENTRY(pid_advance),
-    ENTRY(rate_limiter_output),
-    ENTRY(rate_limiter_update),
-    ENTRY(backlash_output),
-    ENTRY(backlash_update),
-    ENTRY(stop_output),
-    ENTRY(stop_update),
-    ENTRY(sine_output),
-    ENTRY(pulse_output),
-    ENTRY(chirp_output),
-    ENTRY(from_file_output),
-    ENTRY(random_number_output),
-    ENTRY(random_number_update),
-    ENTRY(random_number_advance),
-    {NULL, NULL},
+/* The summed output width a library context makes its kernel write, from its first
+   numbers (the record holds at least `header` of them). */
+typedef long (*width_fn)(const double *c);
+
+static long width_first(const double *c)
+{
+    return (long)c[0];
+}
+
+static long width_gain(const double *c)
+{
+    return (long)(c[0] == 1.0 || c[1] != 1.0 ? c[1] : c[2]);
+}
+
+static long width_lti(const double *c)
+{
+    return (long)c[LTI_P];
+}
+
+/* A library context is its record itself (the numbers blocks/library/_kernels.py packs):
+   construct copies it, after checking that it holds the header its width is read from and
+   that the width is one a kernel can write. */
+static int flat_construct(const double *record, long n, long header, width_fn width, blk_built *built,
+                          char *message, long size)
+{
+    if (n < header || n > 1L << 40) {
+        snprintf(message, (size_t)size, "a record of %ld numbers is too short for its kernel (at least %ld)", n,
+                 header);
+        return 1;
+    }
+    long w = width(record);
+    if (!(w >= 0 && w <= n * 64 + 64)) {
+        snprintf(message, (size_t)size, "the record gives an output width of %ld", w);
+        return 1;
+    }
+    double *copy = malloc((size_t)(n > 0 ? n : 1) * sizeof(double));
+    if (copy == NULL) {
+        snprintf(message, (size_t)size, "no memory for a context of %ld numbers", n);
+        return 1;
+    }
+    memcpy(copy, record, (size_t)n * sizeof(double));
+    built->ctx = copy;
+    built->outputs = w;
+    built->state_size = -1;
+    return 0;
+}
+
+#define CONSTRUCT(kind, header, width)                                                                         \
+    static int kind##_construct(const double *record, long n, blk_built *built, char *message, long size)     \
+    {                                                                                                          \
+        return flat_construct(record, n, header, width, built, message, size);                                \
+    }
+
+CONSTRUCT(first, 1, width_first)
+CONSTRUCT(gain, 3, width_gain)
+CONSTRUCT(lti, LTI_HEADER, width_lti)
+
+#define TYPE(kind, construct, out, upd, adv) {#kind, construct##_construct, free, NULL, out, upd, adv, NULL}
+#define SIGNAL(kind) TYPE(kind, first, kind##_output, NULL, NULL)
+#define STATEFUL(kind) TYPE(kind, first, kind##_output, kind##_update, NULL)
+#define ADVANCING(kind) TYPE(kind, first, kind##_output, kind##_update, kind##_advance)
+
+const blk_kernel_type blk_library_types[] = {
+    SIGNAL(constant),
+    SIGNAL(step),
+    SIGNAL(ramp),
+    TYPE(gain, gain, gain_output, NULL, NULL),
+    SIGNAL(sum),
+    SIGNAL(saturation),
+    ADVANCING(unit_delay),
+    SIGNAL(zero_order_hold),
+    TYPE(lti, lti, lti_output, lti_update, lti_advance),
+    SIGNAL(abs),
+    SIGNAL(sign),
+    SIGNAL(bias),
+    SIGNAL(minmax),
+    SIGNAL(math),
+    SIGNAL(relational),
+    SIGNAL(compare),
+    SIGNAL(logic),
+    SIGNAL(dead_zone),
+    SIGNAL(quantizer),
+    SIGNAL(product),
+    SIGNAL(threshold_switch),
+    SIGNAL(multiport_switch),
+    SIGNAL(lookup1d),
+    SIGNAL(lookup2d),
+    SIGNAL(concatenate),
+    SIGNAL(selector),
+    ADVANCING(integrator),
+    STATEFUL(derivative),
+    STATEFUL(moving_average),
+    ADVANCING(pid),
+    STATEFUL(rate_limiter),
+    STATEFUL(backlash),
+    STATEFUL(stop),
+    SIGNAL(sine),
+    SIGNAL(pulse),
+    SIGNAL(chirp),
+    SIGNAL(from_file),
+    ADVANCING(random_number),
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
 };

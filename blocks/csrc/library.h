@@ -1,14 +1,12 @@
-/* The kernels of the framework's library blocks (library.c), by name, for blocks._native. */
+/* The kernel types of the framework's library blocks (library.c), for blocks._native and
+   for the binaries of exported FMUs. Plain C: no Python. */
 #ifndef BLOCKS_LIBRARY_H
 #define BLOCKS_LIBRARY_H
 
 #include "blocks_kernel.h"
 
-typedef struct blk_library_entry {
-    const char *name; /* e.g. "gain_output" */
-    void (*function)(void); /* one of the blk_*_fn types, cast */
-} blk_library_entry;
-
-extern const blk_library_entry blk_library[]; /* ends with {NULL, NULL} */
+/* {"gain", ...}: each library kernel as a type (its functions gain_output, ...), the
+   table ending with a NULL name. */
+extern const blk_kernel_type blk_library_types[];
 
 #endif

@@ -75,6 +75,13 @@ class FMUState:
         if self._release is not None:
             self._release()
 
+    def finish(self) -> None:
+        """Give the instance back at the end of its run, terminate (and, in a process of
+        its own, freeInstance) included: their failure raises, to fail the run."""
+        if self._release is not None and self._release.alive:
+            self._release.detach()
+            self.model.release(self.instance, report=True)
+
     def __deepcopy__(self, memo):
         raise TypeError("the state of an FMU block is a live FMU instance and cannot be copied")
 
@@ -107,6 +114,12 @@ class FMU(Block):
     substep : duration
         'solver: euler' only: the sub-step, which must divide the period; default: the
         FMU's DefaultExperiment stepSize (made to divide the period), else the period
+    feedthrough : bool
+        co-simulation only: true reads the outputs at a hit after setting that hit's
+        inputs, for the outputs the FMU declares dependent on them (its ModelStructure),
+        so a loop through it is evaluated in order as one through native blocks is (an
+        exported controller); false (the default): the outputs of the previous step, no
+        feedthrough
     isolation : str
         'process': each instance runs in a process of its own, so that a crash, an exit()
         or a hang in the FMU fails the run (with its results so far) instead of ending it;
@@ -121,7 +134,8 @@ class FMU(Block):
 
     def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
                  tolerance: float | None = None, interface: str | None = None, solver: str | None = None,
-                 substep: Any = None, isolation: str | None = None, call_timeout: Any = None):
+                 substep: Any = None, feedthrough: bool = False, isolation: str | None = None,
+                 call_timeout: Any = None):
         if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
             raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
         file = Path(path).expanduser()
@@ -168,11 +182,25 @@ class FMU(Block):
         self.outputs = {p.name: p.width for p in model.outputs.values()}
         self.input_defaults = input_starts(model, self._assignments)
         self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
-        self.feedthrough = False
+        if not isinstance(feedthrough, bool):
+            raise ValueError(f"parameter 'feedthrough' must be true or false, got {feedthrough!r}")
+        if feedthrough and model.exchange:
+            raise ValueError(f"parameter 'feedthrough' is for co-simulation FMUs; {shown} runs as model exchange")
+        self._direct = feedthrough and any(model.direct_reads.values())
+        self.feedthrough = model.direct_reads if self._direct else False
         self.initial_feedthrough = model.initial_reads
         self._step = 0.0
         self.integration: Integration | None = None
         """How a model-exchange FMU is integrated between the hits, once the block has its period."""
+
+    @classmethod
+    def override_path(cls, parts: list[str]) -> list[str]:
+        """``--set plant.k=2`` sets the FMU variable ``k`` (``start_values.k``) when ``k`` is
+        not a parameter of the block; the rest of the path is the variable's name, dots
+        and all (``--set plant.body.m=2``: the variable ``body.m``)."""
+        if parts[0] in cls.parameters():
+            return parts
+        return ["start_values", ".".join(parts)]
 
     @property
     def fmi_version(self) -> str:
@@ -249,6 +277,24 @@ class FMU(Block):
         why = self._model.not_ports.get(port)
         return f"{why} ({self._model.shown})" if why else None
 
+    def element_variables(self, port: str) -> list[str] | None:
+        """The FMU variable behind each element of a port (``q[1]``, ``q[2]``, ...; a scalar's
+        own name), as other tools name them (an SSD's connectors); None for an FMI 3
+        array, whose elements are one variable."""
+        spec = self._model.inputs.get(port) or self._model.outputs.get(port)
+        if spec is None:
+            raise KeyError(port)
+        if len(spec.vrs) != spec.width:
+            return None
+        if spec.labels is None:
+            return [spec.source]
+        base = spec.source[:-len("[...]")] if spec.source.endswith("[...]") else spec.source
+        return [f"{base}[{label}]" for label in spec.labels]
+
+    def assigned_values(self) -> list[tuple[str, str, list]]:
+        """The start values the block sets: (variable, FMI type, values), in the order given."""
+        return [(a.name, a.kind, list(a.values)) for a in self._assignments]
+
     def variable_of(self, port: str) -> str:
         """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""
         spec = self._model.inputs.get(port) or self._model.outputs.get(port)
@@ -324,7 +370,15 @@ class FMU(Block):
     def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
         if state.time is None:
             self._start(t, state, inputs)
+        elif self._direct and state.ended is None:
+            inst = state.instance
+            self.step_calls(inst, t, self._read_through, t, state, inst, inputs)
         return state.outputs
+
+    def _read_through(self, t: float, state: FMUState, inst: Instance, inputs: Mapping[str, Signal]) -> None:
+        """``feedthrough``: the outputs at ``t`` once the inputs of ``t`` are set."""
+        inst.write(inputs, t)
+        state.outputs = inst.read(t)
 
     def update(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> FMUState:
         if state.time is None:
@@ -378,8 +432,8 @@ class FMU(Block):
 
     def kernel(self) -> Kernel | None:
         """The steady step in C (``blocks.fmu.kernel``) when every port is Float64; an FMU
-        with ports of other types runs in Python."""
-        return fmu_kernel(self)
+        with ports of other types, or read with ``feedthrough``, runs in Python."""
+        return None if self._direct else fmu_kernel(self)
 
     def _failure(self, inst: Instance, what: str) -> BlockError:
         """The error of a failed call into the FMU, which breaks the instance: ``what`` with
@@ -388,6 +442,10 @@ class FMU(Block):
         inst.broken = True
         interrupt.check()
         return BlockError(f"{self._model.shown}: {what}{inst.log_text()}")
+
+    def finish(self, state: FMUState) -> None:
+        """The run is over: terminate its instance now, so that a crash there fails it."""
+        state.finish()
 
     def close(self) -> None:
         """Free the pooled FMU instances and, once no run holds one, the extracted files."""

@@ -15,7 +15,8 @@ checks and messages), so results are the same to the last bit; what it adds is:
   the channel's values, and comes back here only for a step that was not a plain success.
 
 Requests are the messages of ``channel``: ``("instantiate", binary, inputs, outputs)``,
-``("start", t, assignments, tolerance)``, ``("read", t)``, ``("stop",)``, ``("free",)``;
+``("start", t, assignments, tolerance)``, ``("write", t)`` (set the channel's inputs: an FMU
+read with ``feedthrough``), ``("read", t)``, ``("stop",)``, ``("free",)``;
 a step is the channel's HOST_STEP. Every answer is ``("ok", value)``, ``("error",
 exception)`` or, for a step, ``("outcome", outcome, read error)``.
 """
@@ -132,7 +133,7 @@ class Host:
 
     # -- requests -------------------------------------------------------------------------
 
-    REQUESTS = ("instantiate", "start", "read", "stop", "free")
+    REQUESTS = ("instantiate", "start", "write", "read", "stop", "free")
     """The messages the run sends, each answered by the method of its name."""
 
     def handle(self, request: tuple) -> tuple:
@@ -161,6 +162,9 @@ class Host:
         error = self._read(t)
         self.ready(error is None)
         return error
+
+    def write(self, t: float) -> None:
+        self.inst.write(self.input_views, t)
 
     def read(self, t: float) -> tuple | None:
         return self._read(t)

@@ -1,7 +1,7 @@
 """An FMU instance hosted in a process of its own, seen from the run that uses it.
 
 ``HostedInstance`` has the surface of ``instance.Instance`` that the block, its kernel and
-the pool use (``start``, ``read``, ``step``, ``stop``, ``free``, ``log_text``, ``broken``),
+the pool use (``start``, ``write``, ``read``, ``step``, ``stop``, ``free``, ``log_text``, ``broken``),
 and does each through the channel (``channel``) to its host (``host``), forked by the
 launcher (``launcher``). A steady step is one round trip through shared memory (the
 inputs and outputs stay there); everything else is a message.
@@ -14,9 +14,12 @@ that names the FMU, the FMU function it was in (traced by the host), the time, a
 signal, exit code or timeout, with the FMU's last log messages; the run fails there with
 its results so far. A signal that stops the run (Ctrl-C, SIGTERM) while it waits for the
 host is raised as it came; the host, left inside a call, is killed when the instance is
-next touched or freed. Terminate and freeInstance run when a run gives its instance back,
-after its results are complete: a host that dies there is reported on the ``blocks.fmu``
-logger as a warning, and the results stand.
+next touched or freed. Terminate runs when a run gives its instance back at its end
+(``FMU.finish``), before its results are made: a host that dies there fails the run at its
+end time, naming the call. FreeInstance runs when the block frees its pooled instances
+(``close``, or at exit), after every run: a host that dies there is reported on the
+``blocks.fmu`` logger as a warning, as is a terminate for a run's state given back only
+when it is dropped.
 """
 
 from __future__ import annotations
@@ -125,6 +128,13 @@ class HostedInstance:
         self.started = True
         self._outputs(t, error)
 
+    def write(self, inputs: Mapping[str, Signal], t: float) -> None:
+        """Set the inputs at ``t`` (an FMU read with ``feedthrough``): the outputs then read afresh."""
+        self._usable()
+        put_ports(self.region.inputs, self.model.in_ports, inputs)
+        self._outputs_at = None
+        self._message(("write", t), f"setting its inputs at t={t:.9g} s")
+
     def read(self, t: float) -> dict[str, Signal]:
         """The outputs at ``t``: those the last step or start left in the channel, else read."""
         if self._outputs_at != t:
@@ -173,9 +183,11 @@ class HostedInstance:
             self._outputs(last if terminate else t + h, error)
         return terminate, early, last
 
-    def stop(self) -> None:
+    def stop(self, report: bool = False) -> None:
         """End a started run's simulation (terminate); an instance that fails to is broken.
-        Called when a run gives the instance back, after its results are complete."""
+        Called when a run gives the instance back: with ``report`` (at the end of the run,
+        before its results are made) a host that dies there raises its HostFailure, else
+        (a run's state dropped later) it is a warning."""
         if not self.started or self.broken or self.inherited:
             return
         self.started = False
@@ -188,6 +200,9 @@ class HostedInstance:
         try:
             self.broken = bool(self._message(("stop",), "terminating it after its run"))
         except HostFailure as exc:
+            self.broken = True
+            if report:
+                raise
             log.warning("%s (after the run; its results are complete)", exc)
         except KeyboardInterrupt as exc:
             interrupt.note(exc)
@@ -196,7 +211,8 @@ class HostedInstance:
             self.broken = True
 
     def free(self) -> None:
-        """Free the instance (freeInstance, in its host, which then ends) and its channel."""
+        """Free the instance (freeInstance, in its host, which then ends) and its channel;
+        a host that dies there is a warning: the runs are over."""
         if self.freed:
             return
         self.freed = True

@@ -280,8 +280,9 @@ class Instance:
                              f"t={t:.9g} s; it takes {kind.input_rule()}", port=name)
         return value
 
-    def stop(self) -> None:
-        """End a started run's simulation (terminate); an instance that fails to is broken."""
+    def stop(self, report: bool = False) -> None:
+        """End a started run's simulation (terminate); an instance that fails to is broken
+        (in this process an FMU's crash ends the process, so ``report`` changes nothing)."""
         if self.started and not self.broken:
             self.started = False
             try:

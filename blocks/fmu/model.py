@@ -24,7 +24,7 @@ from ..limits import MAX_PORT_WIDTH
 from ..timebase import parse_duration
 from .description import read_description, shown_text, step_of
 from .port_types import KINDS, NOT_PORTS
-from .ports import group_variables, groups, initial_reads, port_name, variable_width, vectors
+from .ports import direct_reads, group_variables, groups, initial_reads, port_name, variable_width, vectors
 
 
 CO_SIMULATION = "co_simulation"
@@ -36,12 +36,12 @@ in words."""
 ISOLATIONS = {"process": "in a process of its own", "none": "in the run's process"}
 """Where the block's FMU instances run, by the name a diagram's ``isolation`` parameter gives it."""
 
-IN_PROCESS_TOOLS = ("hierhand",)
+IN_PROCESS_TOOLS = ("hierhand", "blocks")
 """The generation tools (the first word of the modelDescription's ``generationTool``) whose
 FMUs run in the run's process unless the diagram says otherwise: this project's own exports
-(``hierhand fmu export``), whose binary is the C core the native blocks run. Every other FMU
-runs in a process of its own by default, so that its crash or hang cannot take the run
-with it. (A modelDescription can claim any tool: this is a choice of speed, not of trust.)"""
+(``fmu export``: ``blocks`` names the diagram exports, ``hierhand`` the earlier plant
+ones), whose binary is the C core the native blocks run. Every other FMU runs in a
+process of its own by default, so that its crash or hang cannot take the run with it. (A modelDescription can claim any tool: this is a choice of speed, not of trust.)"""
 
 PROCESS_ISOLATION = sys.platform.startswith("linux")
 """Whether FMUs can run in processes of their own here (the channel needs Linux)."""
@@ -126,6 +126,7 @@ class Model:
         self.outputs = group_variables(outs, "output", shown, major)
         self.not_ports = self._not_ports(md.modelVariables)
         self.initial_reads = initial_reads(md, self.inputs, self.outputs)
+        self.direct_reads = direct_reads(md, self.inputs, self.outputs)
         self.in_groups = groups(self.inputs)
         self.out_groups = groups(self.outputs)
         self.vectors = vectors(md.modelVariables, self.variables)

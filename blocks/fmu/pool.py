@@ -106,16 +106,20 @@ class PooledModel(Model):
                                      self.timeout)
         return self.binary
 
-    def release(self, inst: Instance) -> None:
-        """Take an instance back from a run: terminate and pool it, or free it if it failed."""
-        inst.stop()
-        with self.lock:
-            self.live -= 1
-            keep = not inst.broken and not self.closed
-            if keep:
-                self.idle.append(inst)
-        if not keep:
-            inst.free()
+    def release(self, inst: Instance, report: bool = False) -> None:
+        """Take an instance back from a run: terminate and pool it, or free it if it failed.
+        With ``report`` (the run's end) a crash in terminate raises its HostFailure, to fail
+        the run; the pooled instance is freed (freeInstance) when the block is closed."""
+        try:
+            inst.stop(report=report)
+        finally:
+            with self.lock:
+                self.live -= 1
+                keep = not inst.broken and not self.closed
+                if keep:
+                    self.idle.append(inst)
+            if not keep:
+                inst.free()
 
     def close(self) -> None:
         with self.lock:

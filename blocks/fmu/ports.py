@@ -64,8 +64,22 @@ def variable_width(v: Any) -> int:
 
 def element_of(v: Any) -> tuple[str, tuple[int, ...]] | None:
     """``("x", (1, 2))`` for a scalar named ``x[1,2]``, None for any other variable."""
-    m = None if v.dimensions else _INDEXED.match(v.name)
+    return None if v.dimensions else indexed_name(v.name)
+
+
+def indexed_name(name: str) -> tuple[str, tuple[int, ...]] | None:
+    """``("x", (1, 2))`` for the name ``x[1,2]``, None for a name without indices."""
+    m = _INDEXED.match(name)
     return (m.group("base"), tuple(int(i) for i in m.group("index").split(","))) if m else None
+
+
+def port_of(name: str) -> tuple[str, str | None]:
+    """The port a scalar variable named ``name`` is (part of) and its element label there:
+    ``("p_e", "2")`` for ``p.e[2]``, ``("k", None)`` for ``k`` (a whole port)."""
+    element = indexed_name(name)
+    if element is None:
+        return port_name(name), None
+    return port_name(element[0]), ",".join(map(str, element[1]))
 
 
 def group_variables(variables: list, what: str, fmu: str, major: int) -> dict[str, Port]:
@@ -188,3 +202,21 @@ def initial_reads(md: Any, inputs: dict[str, Port], outputs: dict[str, Port]) ->
             break
         reads |= {port_of_vr[d.valueReference] for d in u.dependencies if d.valueReference in port_of_vr}
     return {name: frozenset(reads) for name in outputs}
+
+
+def direct_reads(md: Any, inputs: dict[str, Port], outputs: dict[str, Port]) -> dict[str, frozenset[str]]:
+    """For each output port, the input ports its value depends on at a communication point
+    (the modelDescription's ModelStructure Outputs: all inputs where an output's list is
+    absent, none where it is empty), for the FMU block's ``feedthrough``."""
+    port_of_vr = {vr: p.name for p in inputs.values() for vr in p.vrs}
+    port_of_output = {vr: p.name for p in outputs.values() for vr in p.vrs}
+    reads: dict[str, set[str]] = {name: set() for name in outputs}
+    for u in md.outputs:
+        port = port_of_output.get(getattr(u.variable, "valueReference", None))
+        if port is None:
+            continue
+        if u.dependencies is None:
+            reads[port] |= set(inputs)
+        else:
+            reads[port] |= {port_of_vr[d.valueReference] for d in u.dependencies if d.valueReference in port_of_vr}
+    return {name: frozenset(found) for name, found in reads.items()}

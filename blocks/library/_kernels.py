@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from blocks.compiled import failure
-from blocks.kernel import Kernel, address
+from blocks.kernel import Kernel, KernelRecord, Tunable, address
 
 NOMEM = 1
 """library.c's failure code when a kernel gets no memory for its scratch vectors."""
@@ -36,14 +36,18 @@ def functions() -> dict[str, int]:
 
 
 def make_kernel(context: np.ndarray, output: str | None = None, update: str | None = None,
-                advance: str | None = None, *owners: Any, failures=None) -> Kernel | None:
+                advance: str | None = None, *owners: Any, failures=None,
+                tunables: tuple[Tunable, ...] = ()) -> Kernel | None:
     """A Kernel of the named library functions reading ``context``; None without them.
-    ``failures``: the block's ``Kernel.error`` (default: this module's ``error``)."""
+    ``failures``: the block's ``Kernel.error`` (default: this module's ``error``). Its
+    record is the context itself, of the kernel type the functions are named after
+    (``gain_output``: ``gain``), with the block's ``tunables`` (slots of the context)."""
     table = functions()
     names = [name for name in (output, update, advance) if name is not None]
     if not names or any(name not in table for name in names):
         return None
     context = np.ascontiguousarray(context, dtype=np.float64)
+    kind = names[0].rsplit("_", 1)[0]
     return Kernel(
         context=address(context),
         output=table[output] if output else 0,
@@ -52,7 +56,20 @@ def make_kernel(context: np.ndarray, output: str | None = None, update: str | No
         owners=(context, *owners),
         error=failures or error,
         nogil=True,
+        record=KernelRecord(kind, context, tunables),
     )
+
+
+def tunables(name: str, first: int, shape: tuple[int, ...], description: str) -> tuple[Tunable, ...]:
+    """The elements of a parameter ``name`` (a scalar: ``shape`` (), a vector, a matrix,
+    row-major) at record slots from ``first`` as finite tunables: ``k``, ``k[2]``, ``k[1,2]``."""
+    if not shape:
+        return (Tunable(name, first, description, finite=True),)
+    out = []
+    for i, index in enumerate(np.ndindex(*shape)):
+        label = ",".join(str(j + 1) for j in index)
+        out.append(Tunable(f"{name}[{label}]", first + i, description, finite=True))
+    return tuple(out)
 
 
 def error(code: int, which: int, t: float, phase: str) -> BaseException:

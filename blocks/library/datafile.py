@@ -13,15 +13,13 @@ from __future__ import annotations
 
 import csv
 import io
-import os
-import stat
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from blocks.limits import MAX_DATA_BYTES
+from blocks.npzfile import read_npz
 from blocks.yamlsource import YamlSourceError, read_yaml_file
 
 TIME_PREFIX = "time:"
@@ -103,37 +101,14 @@ def _numeric(row: list[str]) -> bool:
 
 
 def _read_npz(path: Path, signal: str | None, shown: str) -> Series:
-    try:
-        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError as exc:
-        raise ValueError(f"{shown}: cannot open: {exc.strerror or exc}") from None
-    with os.fdopen(fd, "rb") as fh:
-        info = os.fstat(fh.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise ValueError(f"{shown} is not a regular file (a folder, device or pipe)")
-        if info.st_size > MAX_DATA_BYTES:
-            raise ValueError(f"{shown} is larger than {MAX_DATA_BYTES} bytes (the limit guards against hostile files)")
-        raw = fh.read(MAX_DATA_BYTES + 1)
-    try:
-        with zipfile.ZipFile(io.BytesIO(raw)) as archive:
-            members = archive.infolist()
-            if sum(m.file_size for m in members) > MAX_DATA_BYTES:
-                raise ValueError(f"{shown} holds more than {MAX_DATA_BYTES} bytes once decompressed "
-                                 "(the limit guards against hostile files)")
-            names = [m.filename[:-4] for m in members if m.filename.endswith(".npy")]
-            values_key = signal if signal is not None else _only_values(names, shown)
-            time_key = TIME_PREFIX + values_key if TIME_PREFIX + values_key in names else "time"
-            missing = [k for k in (values_key, time_key) if k not in names]
-            if missing:
-                raise ValueError(f"{shown} has no array '{missing[0]}'; arrays: {', '.join(names) or 'none'}")
-            with np.load(io.BytesIO(raw), allow_pickle=False) as data:
-                times, values = np.asarray(data[time_key]), np.asarray(data[values_key])
-    except (zipfile.BadZipFile, OSError, EOFError) as exc:
-        raise ValueError(f"{shown} is not a readable NPZ archive: {exc}") from None
-    except ValueError as exc:
-        if str(exc).startswith(shown):
-            raise
-        raise ValueError(f"{shown}: {exc}") from None
+    arrays = read_npz(path, shown, MAX_DATA_BYTES)
+    names = list(arrays)
+    values_key = signal if signal is not None else _only_values(names, shown)
+    time_key = TIME_PREFIX + values_key if TIME_PREFIX + values_key in names else "time"
+    missing = [k for k in (values_key, time_key) if k not in names]
+    if missing:
+        raise ValueError(f"{shown} has no array '{missing[0]}'; arrays: {', '.join(names) or 'none'}")
+    times, values = arrays[time_key], arrays[values_key]
     for key, arr in ((time_key, times), (values_key, values)):
         if not np.issubdtype(arr.dtype, np.number) or np.issubdtype(arr.dtype, np.complexfloating):
             raise ValueError(f"{shown}: array '{key}' must hold real numbers, got {arr.dtype}")

@@ -58,7 +58,8 @@ class Gain(Block):
             header = (1.0, rows, cols)
         else:
             header = (0.0, self.k.size, width)
-        return _kernels.make_kernel(np.concatenate((header, self.k.ravel())), "gain_output")
+        return _kernels.make_kernel(np.concatenate((header, self.k.ravel())), "gain_output",
+                                    tunables=_kernels.tunables("k", 3, self.k.shape, "gain"))
 
 
 def _sum_p(i: Mapping[str, Signal]) -> Signal:

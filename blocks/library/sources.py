@@ -45,7 +45,11 @@ class Constant(Block):
 
     def kernel(self):
         return _kernels.cached(self, (self.value.tobytes(),), lambda: _kernels.make_kernel(
-            np.concatenate(((self.value.size,), self.value)), "constant_output"))
+            np.concatenate(((self.value.size,), self.value)), "constant_output",
+            tunables=_kernels.tunables("value", 1, self._shape(), "the output value")))
+
+    def _shape(self) -> tuple[int, ...]:
+        return () if self.value.size == 1 else self.value.shape
 
 
 class Step(Block):
@@ -76,8 +80,12 @@ class Step(Block):
     def kernel(self):
         w = self.before.size
         key = (self.time, self.before.tobytes(), self.after.tobytes())
+        shape = () if w == 1 else (w,)
         return _kernels.cached(self, key, lambda: _kernels.make_kernel(
-            np.concatenate(((w, self.time), self.before, self.after)), "step_output"))
+            np.concatenate(((w, self.time), self.before, self.after)), "step_output",
+            tunables=(*_kernels.tunables("time", 1, (), "switching time, s"),
+                      *_kernels.tunables("before", 2, shape, "output before the switching time"),
+                      *_kernels.tunables("after", 2 + w, shape, "output from the switching time on"))))
 
 
 class Ramp(Block):

@@ -106,6 +106,9 @@ def connect(scheduler: str, timeout: float = 20.0):
             client = Client(scheduler, timeout=timeout)
     except (OSError, TimeoutError) as exc:
         raise SweepError(f"--scheduler {scheduler}: cannot connect: {one_line(exc)}") from None
+    except (ValueError, TypeError) as exc:
+        raise SweepError(f"--scheduler {scheduler!r}: not a scheduler's address ({one_line(exc)}) "
+                         "(hint: tcp://HOST:PORT, as the scheduler prints it)") from None
     try:
         client.wait_for_workers(1, timeout=WORKER_WAIT_S)
         check_versions(client, scheduler)

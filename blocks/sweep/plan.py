@@ -16,6 +16,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..api_args import boolean
+from ..safepath import link_out_of
 from .bundle import bundle_for, discard
 from .errors import SweepError
 from .metrics import Metric, parse_metrics
@@ -170,6 +172,9 @@ def keep_run(output: str | Path, h: str, outcome: Outcome) -> None:
     go of them; nothing for an outcome without results."""
     if outcome.results is not None:
         outcome.results.info.setdefault("sweep", {})["point_hash"] = h
+        if link_out_of(Path(output) / RUNS, h) is not None:
+            raise SweepError(f"{Path(output) / RUNS / h} is a symbolic link out of the sweep folder: the sweep "
+                             "writes only inside it (hint: remove the link)")
         outcome.results.save(Path(output) / RUNS / h)
         outcome.results = None
 
@@ -234,6 +239,8 @@ def run_sweep(diagram: str | Path, points: list[Point], metrics: list[str | Metr
     Raises ``DiagramError`` or ``SweepError`` before anything runs when the sweep cannot
     work, and ``SweepInterrupted`` on Ctrl-C, with only whole rows in the file.
     """
+    for name, flag in (("serial", serial), ("trust", trust), ("progress", progress), ("keep_results", keep_results)):
+        boolean(name, flag)
     plan = prepare(diagram, points, parse_metrics(metrics), t_end=None if t_end is None else str(t_end),
                    trust=trust, axes=axes, origins=origins, keep_results=keep_results)
     t0 = time.perf_counter()

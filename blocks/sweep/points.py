@@ -13,14 +13,15 @@ import hashlib
 import io
 import itertools
 import json
+import math
 import re
 from pathlib import Path
 from typing import Any, Sequence
 
 import numpy as np
-import yaml
 
-from blocks.yamlsource import YamlSourceError, read_yaml_file
+from blocks.limits import MAX_SWEEP_POINTS
+from blocks.yamlsource import YamlSourceError, load_yaml_value, read_yaml_file
 
 from .errors import SweepError
 
@@ -45,10 +46,9 @@ def check_key(key: str, option: str) -> str:
 def parse_value(text: str, where: str) -> Any:
     """One value read as YAML (as ``run --set`` does), '1e-3' included as a number."""
     try:
-        value = yaml.safe_load(text) if text.strip() else None
-    except yaml.YAMLError as exc:
-        raise SweepError(f"{where}: {text.strip()!r} is not valid YAML "
-                         f"({str(exc).splitlines()[0]})") from None
+        value = load_yaml_value(text, where) if text.strip() else None
+    except ValueError as exc:
+        raise SweepError(str(exc)) from None
     if value is None:
         raise SweepError(f"{where}: empty value")
     if isinstance(value, str) and _FLOAT.match(value):
@@ -85,12 +85,21 @@ def parse_grid(items: Sequence[str]) -> dict[str, list[Any]]:
         key = check_key(key, f"--grid {item!r}")
         if key in axes:
             raise SweepError(f"--grid {item!r}: {key} is already an axis")
-        axes[key] = [parse_value(v, f"--grid {item!r}") for v in split_top_level(text)]
+        axes[key] = [parse_value(v, f"--grid {key}") for v in split_top_level(text)]
     return axes
 
 
+def check_count(count: int, what: str) -> None:
+    """Refuse a sweep of more than MAX_SWEEP_POINTS points before any is made."""
+    if count > MAX_SWEEP_POINTS:
+        raise SweepError(f"{what} make {count:.4g} points, more than a sweep may have ({MAX_SWEEP_POINTS}) "
+                         "(hint: fewer values per axis, or split the study into several sweeps)")
+
+
 def grid_points(axes: dict[str, list[Any]]) -> list[Point]:
-    """The cartesian product of the axes, the last axis varying fastest."""
+    """The cartesian product of the axes, the last axis varying fastest (at most
+    MAX_SWEEP_POINTS points)."""
+    check_count(math.prod(len(v) for v in axes.values()), f"the --grid axes ({' x '.join(str(len(v)) for v in axes.values())})")
     keys = list(axes)
     return [dict(zip(keys, values)) for values in itertools.product(*(axes[k] for k in keys))]
 
@@ -111,6 +120,9 @@ def parse_random(items: Sequence[str]) -> dict[str, tuple[str, float, float]]:
             a, b = float(m.group(2)), float(m.group(3))
         except ValueError:
             raise SweepError(f"{where}: the distribution's arguments must be numbers") from None
+        if not (math.isfinite(a) and math.isfinite(b)) or (m.group(1) == "uniform" and not math.isfinite(b - a)):
+            raise SweepError(f"{where}: the distribution's arguments must be finite numbers whose difference "
+                             "is finite too")
         if m.group(1) == "uniform" and not a < b:
             raise SweepError(f"{where}: uniform(a,b) needs a < b")
         if m.group(1) == "normal" and not b > 0:
@@ -129,6 +141,9 @@ def random_points(dists: dict[str, tuple[str, float, float]], samples: int, seed
     """
     if samples < 1:
         raise SweepError(f"--samples must be at least 1, got {samples}")
+    check_count(samples, f"--samples {samples}")
+    if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+        raise SweepError(f"--seed must be a whole number of 0 or more, got {seed!r}")
     rng = np.random.default_rng(seed)
     columns = {}
     for key, (kind, a, b) in dists.items():
@@ -140,12 +155,16 @@ def random_points(dists: dict[str, tuple[str, float, float]], samples: int, seed
 def csv_points(path: Path) -> list[Point]:
     """Points from a CSV file whose header names ``block.param`` columns; cells read as YAML."""
     try:
-        rows = list(csv.reader(io.StringIO(read_yaml_file(path, "CSV"), newline="")))
+        reader = csv.reader(io.StringIO(read_yaml_file(path, "CSV"), newline=""))
+        rows = list(reader)
     except FileNotFoundError:
         raise SweepError(f"--points {path}: no such file") from None
     except YamlSourceError as exc:
         where = f"{path}:{exc.line}" if exc.line else str(path)
         raise SweepError(f"--points {where}: {exc.message}" + (f" (hint: {exc.hint})" if exc.hint else "")) from None
+    except csv.Error as exc:
+        raise SweepError(f"--points {path}:{reader.line_num}: not CSV: {exc} (hint: a cell holds one "
+                         "value; quote cells that contain commas)") from None
     if not rows or not any(cell.strip() for cell in rows[0]):
         raise SweepError(f"--points {path}: empty file; the first line names the BLOCK.PARAM columns")
     keys = [check_key(k, f"--points {path}: column") for k in rows[0]]
@@ -157,6 +176,7 @@ def csv_points(path: Path) -> list[Point]:
             continue
         if len(row) != len(keys):
             raise SweepError(f"--points {path}:{n}: {len(row)} values for {len(keys)} columns")
+        check_count(len(points) + 1, f"--points {path}: the rows")
         points.append({k: parse_value(v, f"--points {path}:{n}: column {k}") for k, v in zip(keys, row)})
     if not points:
         raise SweepError(f"--points {path}: no rows after the header")
@@ -180,6 +200,7 @@ def combine(grid: list[Point], sampled: list[Point]) -> list[Point]:
         return sampled
     if not sampled:
         return grid
+    check_count(len(grid) * len(sampled), f"{len(grid)} grid points crossed with {len(sampled)} samples")
     return [{**g, **s} for g in grid for s in sampled]
 
 

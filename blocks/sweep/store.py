@@ -28,6 +28,25 @@ FIXED_COLUMNS = ("point_hash", "status", "error", "wall_s")
 OK, FAILED = "ok", "failed"
 
 
+def check_folder(directory: Path) -> None:
+    """SweepError unless ``directory`` can hold a sweep's files, all of them inside it."""
+    from ..results_folder import OutputFolderError, prepare
+    from ..safepath import link_out_of
+
+    try:
+        prepare(directory)
+    except OutputFolderError as exc:
+        raise SweepError(f"sweep folder {exc}") from None
+    link = link_out_of(directory, SWEEP_CSV, SWEEP_JSON, RUNS)
+    if link is not None:
+        raise SweepError(f"{link} is a symbolic link out of the sweep folder: the sweep writes only inside "
+                         f"{directory} (hint: remove the link, or choose another -o folder)")
+    for name in (SWEEP_CSV, SWEEP_JSON):
+        entry = directory / name
+        if entry.exists() and not entry.is_file():
+            raise SweepError(f"{entry} is not a regular file (hint: move it away, or choose another -o folder)")
+
+
 def columns(parameters: Sequence[str], metrics: Sequence[str]) -> list[str]:
     """The header: the fixed columns, then the parameters, then the metrics."""
     return [*FIXED_COLUMNS, *parameters, *metrics]
@@ -47,9 +66,11 @@ class SweepStore:
         """Prepare the file (header if new, torn tail cut) and return {hash: status} of the rows in it.
 
         A file written by a different sweep (other parameters or metrics) is refused rather
-        than mixed, with a message naming both headers.
+        than mixed, with a message naming both headers. A folder that cannot take the
+        sweep (a file, not writable), and a ``sweep.csv``, ``sweep.json`` or ``runs`` in it
+        that links out of it or is no regular file, are refused before anything is written.
         """
-        self.directory.mkdir(parents=True, exist_ok=True)
+        check_folder(self.directory)
         if not self.path.exists() or self.path.stat().st_size == 0:
             self._append_text(_csv_line(self.header))
             return {}

@@ -60,18 +60,33 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
-from blocks.kernel import Kernel, address
+from blocks.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS, context, model_address
+from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
 from ..model.hand_source import ModelsTheHand, hand_of
 from ..model.port_info import DescribesHandPorts
+from .internal_forces import _COINCIDENT_RTOL
 from .reflex_kernel import (
+    G_APPROACH,
+    G_COINCIDENT_RTOL,
+    G_FOLLOW,
+    G_GRASP,
+    G_HOLD_SHARE,
+    G_KI,
+    G_MARGIN,
+    G_MAX_FORCE,
+    G_MIN_FORCE,
+    G_RELEASE_SHARE,
+    G_SAFETY_RATIO,
+    G_THRESHOLD,
+    N_GIVEN,
     N_OUT,
     WHOLE_SHARE,
     O_ACTIVE,
     O_FORCE,
     O_TAU,
     P_DT,
+    P_RATIO,
     pack_params,
     reflex_directions,
     reflex_failure,
@@ -136,31 +151,31 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                  approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.5,
                  hold_share: float = 0.9, follow_suppression: bool = True):
         self.hand = hand_of(hand)
+        self._links = hand_link(hand)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
-                            ("max_force", max_force), ("contact_threshold", contact_threshold)):
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
-                raise ValueError(f"parameter '{name}' must be a positive number, got {value!r}")
-        if not (isinstance(release_share, (int, float)) and isinstance(hold_share, (int, float))
-                and 0 <= release_share < hold_share <= 1):
-            raise ValueError(f"parameters 'release_share' and 'hold_share' must satisfy 0 <= release_share < "
-                             f"hold_share <= 1, got {release_share!r} and {hold_share!r}")
-        if not 0 <= margin < 1:
-            raise ValueError(f"parameter 'margin' must be in [0, 1), got {margin!r}")
-        if not 0 <= approach_force <= max_force:
-            raise ValueError("parameter 'approach_force' must be in [0, max_force]")
-        if min_force > max_force:
-            raise ValueError("parameter 'min_force' must not exceed 'max_force'")
+                            ("max_force", max_force), ("contact_threshold", contact_threshold),
+                            ("margin", margin), ("approach_force", approach_force),
+                            ("release_share", release_share), ("hold_share", hold_share)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ValueError(f"parameter '{name}' must be a number, got {value!r}")
+        given = np.empty(N_GIVEN)
+        given[G_KI], given[G_SAFETY_RATIO], given[G_MARGIN] = ki, safety_ratio, margin
+        given[G_MIN_FORCE], given[G_MAX_FORCE], given[G_APPROACH] = min_force, max_force, approach_force
+        given[G_THRESHOLD], given[G_RELEASE_SHARE], given[G_HOLD_SHARE] = contact_threshold, release_share, hold_share
+        given[G_FOLLOW] = 1.0 if follow_suppression else 0.0
+        given[G_GRASP:G_GRASP + 3] = self.initial
+        given[G_COINCIDENT_RTOL] = _COINCIDENT_RTOL
+        self._given = given
+        # the native calls' flat parameter array, its checks and derived values in C; the
+        # period (P_DT) is set by bind
+        self._params = pack_params(given, self.hand.vector, np.nan)
         self.ki, self.min_force, self.max_force = float(ki), float(min_force), float(max_force)
-        self.ratio_target = float(safety_ratio) / (1.0 + float(margin))
+        self.ratio_target = float(self._params[P_RATIO])
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
         self.release_share = float(release_share)
         self.hold_share = float(hold_share)
         self.follow_suppression = bool(follow_suppression)
-        # the native calls' flat parameter array; the period (P_DT) is set by bind
-        self._params = pack_params(self.threshold, self.approach_force, self.ki, np.nan, self.min_force,
-                                   self.ratio_target, self.max_force, self.initial, self.release_share,
-                                   self.hand.tip_radius, self.follow_suppression, self.hold_share)
         self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6, "share": 3}
         self.input_defaults = {"share": WHOLE_SHARE}
         self.outputs = {"tau_g": 9, "force": 3, "active": 3}
@@ -173,22 +188,24 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         super().bind(period)
         self.dt = float(period)
         self._params[P_DT] = self.dt
+        self._kernel = None
 
     def kernel(self) -> Kernel | None:
-        """``output`` and ``update`` in C (the same reflex law, hierhand/csrc/reflex.c),
-        reading the hand's model and the packed parameters; None before ``bind``."""
+        """``output`` and ``update`` in C (kernel type ``GraspReflex``: the same reflex
+        law, hierhand/csrc/reflex.c), in a context its constructor builds from the record
+        ``[hand segment, dt, given]``; None before ``bind``. In an exported FMU the
+        gains, forces and shares are tunable, and the hand follows the plant's."""
         if not self._params[P_DT] > 0:
             return None
-        model, params = self.hand.native, self._params
-        ctx = context(model_address(model), address(params))
-        return Kernel(
-            context=address(ctx),
-            output=KERNELS["GraspReflex.output"],
-            update=KERNELS["GraspReflex.update"],
-            owners=(ctx, model, params),
-            error=_kernel_error,
-            nogil=True,
-        )
+        held = getattr(self, "_kernel", None)
+        if held is None:
+            rec = record("GraspReflex", hand_segment(self.hand, False), [self.dt], self._given,
+                         tunables=_TUNABLES, links=self._links)
+            ctx = context_of(rec)
+            held = self._kernel = Kernel(context=ctx.address, output=KERNELS["GraspReflex.output"],
+                                         update=KERNELS["GraspReflex.update"], owners=(ctx,), error=_kernel_error,
+                                         nogil=True, record=rec)
+        return held
 
     def initial_state(self) -> np.ndarray:
         """[grasp force scale s (N), per finger 1 where voluntary motion had taken it over when it
@@ -227,6 +244,21 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         """The integral step of the grasp force scale and the hand-over scales (a fresh array)."""
         return reflex_update(self._params, state, inputs["tip"], inputs["normal"], inputs["fn"], inputs["ft"],
                              inputs.get("share", WHOLE_SHARE))
+
+
+_GIVEN_AT = SEGMENT + 1
+"""Where the kernel record's given parameters start (after the hand segment and dt)."""
+_TUNABLES = tuple(Tunable(name, _GIVEN_AT + slot, text, unit) for name, slot, text, unit in (
+    ("ki", G_KI, "integral gain of the fingertip force loop", "1/s"),
+    ("safety_ratio", G_SAFETY_RATIO, "largest |f_t|/f_n the reflex allows", "1"),
+    ("margin", G_MARGIN, "the loop aims at safety_ratio / (1 + margin)", "1"),
+    ("min_force", G_MIN_FORCE, "smallest normal force per contact", "N"),
+    ("max_force", G_MAX_FORCE, "largest commanded force per fingertip", "N"),
+    ("approach_force", G_APPROACH, "force pushing a 'grasp' finger towards the others", "N"),
+    ("contact_threshold", G_THRESHOLD, "normal force above which a finger counts as in contact", "N"),
+    ("release_share", G_RELEASE_SHARE, "share at which a third touching finger is wholly handed over", "1"),
+    ("hold_share", G_HOLD_SHARE, "share down to which a third touching finger is held whole", "1")))
+"""GraspReflex's parameters an exported FMU lets an importer set."""
 
 
 def _kernel_error(code: int, which: int, t: float, phase: str) -> BaseException:

@@ -20,7 +20,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from .. import _native
-from .inverse_kinematics import _REACH_RTOL
 from .trajectory import INTERPOLATIONS
 
 _L = _native.LAYOUT
@@ -68,26 +67,22 @@ period needs to give a joint of that inertia the closed-loop poles of the contin
 (pole matching under a zero-order hold; hierhand/csrc/control.h)."""
 
 
-def pack_params(q0, kp, kd, gravity, weight, threshold: float, gravity_compensation: bool,
-                load_compensation: bool, step: float, matched: bool = True, period: float = np.nan,
-                contact_compensation: bool = True) -> np.ndarray:
-    """The ``params`` vector of ``manipulation_output`` (``period`` is set again by the
-    block's ``bind``)."""
-    p = np.zeros(N_PARAMS)
-    p[P_Q0:P_Q0 + 9] = q0
-    p[P_KP:P_KP + 9] = kp
-    p[P_KD:P_KD + 9] = kd
-    p[P_GX], p[P_GY] = gravity
-    p[P_WX], p[P_WY] = weight
-    p[P_THRESHOLD] = threshold
-    p[P_GRAVITY_COMP] = 1.0 if gravity_compensation else 0.0
-    p[P_LOAD_COMP] = 1.0 if load_compensation else 0.0
-    p[P_STEP] = step
-    p[P_REACH_RTOL] = _REACH_RTOL
-    p[P_MATCHED] = 1.0 if matched else 0.0
-    p[P_CONTACT_COMP] = 1.0 if contact_compensation else 0.0
-    p[P_DT] = period
-    return p
+G_KP: int = _L["MANIP_G_KP"]  # -- the block's parameters as given: given[G_*] (control.h); nine
+G_KD: int = _L["MANIP_G_KD"]  # nine
+G_THRESHOLD: int = _L["MANIP_G_THRESHOLD"]
+G_GRAVITY_COMP: int = _L["MANIP_G_GRAVITY_COMP"]
+G_LOAD_COMP: int = _L["MANIP_G_LOAD_COMP"]
+G_MATCHED: int = _L["MANIP_G_MATCHED"]  # discretization 'matched'
+G_CONTACT_COMP: int = _L["MANIP_G_CONTACT_COMP"]
+G_STEP: int = _L["MANIP_G_STEP"]  # manipulation_pd.DERIVATIVE_STEP
+G_REACH_RTOL: int = _L["MANIP_G_REACH_RTOL"]  # inverse_kinematics._REACH_RTOL
+N_GIVEN: int = _L["MANIP_N_GIVEN"]
+
+pack_params = _native.manip_pack
+"""``pack_params(given, hand_vector, dt) -> params``: the block's parameters (``G_*``)
+checked and packed into ``manipulation_output``'s vector (``P_*``: q0 and gravity from the
+hand, the weight its object's mass times gravity, the period ``dt``, NaN for none, set
+again by the block's ``bind``); ValueError naming a bad parameter (control_params.c)."""
 
 
 def pack_trajectories(trajectories: Sequence) -> tuple[np.ndarray, np.ndarray]:

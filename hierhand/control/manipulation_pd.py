@@ -43,13 +43,34 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
-from blocks.kernel import Kernel, address
+from blocks.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS, context, model_address
+from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
 from ..model.hand_source import ModelsTheHand, hand_of
 from ..model.port_info import DescribesHandPorts
 from .inverse_kinematics import UnreachableError, finger_ik_near
-from .manipulation_kernel import NO_PERIOD, OK, P_DT, UNREACHABLE, manipulation_output, pack_params, pack_trajectories
+from .inverse_kinematics import _REACH_RTOL
+from .manipulation_kernel import (
+    G_CONTACT_COMP,
+    G_GRAVITY_COMP,
+    G_KD,
+    G_KP,
+    G_LOAD_COMP,
+    G_MATCHED,
+    G_REACH_RTOL,
+    G_STEP,
+    G_THRESHOLD,
+    N_GIVEN,
+    NO_PERIOD,
+    OK,
+    P_DT,
+    P_WX,
+    P_WY,
+    UNREACHABLE,
+    manipulation_output,
+    pack_params,
+    pack_trajectories,
+)
 from .trajectory import Trajectory
 
 DERIVATIVE_STEP = 1e-3
@@ -111,18 +132,24 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
                              f"got {discretization!r}")
         self.discretization = discretization
         self.contact_compensation = bool(contact_compensation)
-        self.weight = self.hand.params.object.mass * self.hand.gravity
+        self._links = hand_link(hand)
         self.trajectories = self.parse_trajectories(trajectories or {})
         self.inputs = {"q": 9, "qd": 9, "fn": 3, "support": 3, "normal": 6, "obj": 3}
         self.input_defaults = {"support": np.zeros(3)}
         self.outputs = {"tau_m": 9, "tau_ff": 9, "q_ref": 9}
         self.feedthrough = True
-        # the native output's flat arrays (built from the attributes above, once)
+        # the native output's flat arrays (built from the attributes above, once; the
+        # checks and the values taken from the hand in C)
         self._model = self.hand.native
-        self._params = pack_params(self.hand.q0, self.kp, self.kd, self.hand.gravity, self.weight, self.threshold,
-                                   self.gravity_compensation, self.load_compensation, DERIVATIVE_STEP,
-                                   matched=discretization == "matched",
-                                   contact_compensation=self.contact_compensation)
+        given = np.empty(N_GIVEN)
+        given[G_KP:G_KP + 9], given[G_KD:G_KD + 9] = self.kp, self.kd
+        given[G_THRESHOLD] = self.threshold
+        given[G_GRAVITY_COMP], given[G_LOAD_COMP] = self.gravity_compensation, self.load_compensation
+        given[G_MATCHED], given[G_CONTACT_COMP] = discretization == "matched", self.contact_compensation
+        given[G_STEP], given[G_REACH_RTOL] = DERIVATIVE_STEP, _REACH_RTOL
+        self._given = given
+        self._params = pack_params(given, self.hand.vector, np.nan)
+        self.weight = self._params[P_WX:P_WY + 1].copy()
         self._waypoints, self._meta = pack_trajectories(self.trajectories)
 
     def parse_trajectories(self, config: Mapping[str, Any]) -> list[Trajectory | None]:
@@ -158,6 +185,7 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
                              "for it; or give discretization: held")
         super().bind(period)
         self._params[P_DT] = float(period) if period is not None else np.nan
+        self._kernel = None
 
     def joint_targets_for(self, finger: int, point: np.ndarray) -> np.ndarray:
         """Joint angles (3,) of one finger for a tip target, on the branch nearest q0."""
@@ -182,18 +210,19 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         return {"tau_m": out[0], "tau_ff": out[1], "q_ref": out[2]}
 
     def kernel(self) -> Kernel | None:
-        """``output`` in C: the same native call on the arrays packed in ``__init__``
-        and ``bind`` (stateless)."""
-        model, params, waypoints, meta = self._model, self._params, self._waypoints, self._meta
-        ctx = context(model_address(model), address(params), address(waypoints), address(meta),
-                      waypoints.shape[1])
-        return Kernel(
-            context=address(ctx),
-            output=KERNELS["ManipulationPD.output"],
-            owners=(ctx, model, params, waypoints, meta),
-            error=self._kernel_error,
-            nogil=True,
-        )
+        """``output`` in C (kernel type ``ManipulationPD``: the same native call), in a
+        context its constructor builds from the record ``[hand segment, dt, given,
+        waypoint rows, waypoints, meta]`` (stateless). In an exported FMU the gains and
+        the contact threshold are tunable, and the hand follows the plant's."""
+        held = getattr(self, "_kernel", None)
+        if held is None:
+            waypoints, meta = self._waypoints, self._meta
+            rec = record("ManipulationPD", hand_segment(self.hand, False), [self._params[P_DT]], self._given,
+                         [waypoints.shape[1]], waypoints, meta, tunables=_TUNABLES, links=self._links)
+            ctx = context_of(rec)
+            held = self._kernel = Kernel(context=ctx.address, output=KERNELS["ManipulationPD.output"], owners=(ctx,),
+                                         error=self._kernel_error, nogil=True, record=rec)
+        return held
 
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BaseException:
         """A failure of the native output (a target out of reach, no period to match the gains
@@ -214,3 +243,14 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
                 return err
         raise RuntimeError(f"ManipulationPD: finger '{self.hand.names[finger]}' was found out of reach at "
                            f"t = {t:g} s, but none of its targets is")
+
+
+_GIVEN_AT = SEGMENT + 1
+"""Where the kernel record's given parameters start (after the hand segment and dt)."""
+_TUNABLES = (
+    *(Tunable(f"kp[{j + 1}]", _GIVEN_AT + G_KP + j, f"joint {j + 1} stiffness", "N m/rad") for j in range(9)),
+    *(Tunable(f"kd[{j + 1}]", _GIVEN_AT + G_KD + j, f"joint {j + 1} damping", "N m s/rad") for j in range(9)),
+    Tunable("contact_threshold", _GIVEN_AT + G_THRESHOLD, "normal force above which a finger carries the object",
+            "N"),
+)
+"""ManipulationPD's parameters an exported FMU lets an importer set."""

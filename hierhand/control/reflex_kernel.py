@@ -22,7 +22,6 @@ import numpy as np
 from blocks.arrays import flat_float64
 
 from .. import _native
-from .internal_forces import _COINCIDENT_RTOL
 
 _L = _native.LAYOUT
 
@@ -63,27 +62,26 @@ WHOLE_SHARE = np.ones(3)
 """The ``share`` input when nothing overrides the reflex: every finger's command keeps its whole grasping torque."""
 
 
-def pack_params(threshold: float, approach_force: float, ki: float, dt: float, min_force: float,
-                ratio_target: float, max_force: float, initial, release_share: float = 0.5,
-                tip_radius=(0.0, 0.0, 0.0), follow_suppression: bool = True,
-                hold_share: float = 0.9) -> np.ndarray:
-    """The reflex parameters as the native calls' flat array (``initial``: 3 booleans,
-    ``tip_radius``: the hand's three fingertip radii)."""
-    p = np.empty(N_PARAMS)
-    p[P_THRESHOLD] = threshold
-    p[P_APPROACH] = approach_force
-    p[P_KI] = ki
-    p[P_DT] = dt
-    p[P_MIN_FORCE] = min_force
-    p[P_RATIO] = ratio_target
-    p[P_MAX_FORCE] = max_force
-    p[P_INITIAL : P_INITIAL + 3] = np.asarray(initial, dtype=bool)
-    p[P_COINCIDENT_RTOL] = _COINCIDENT_RTOL
-    p[P_RELEASE_SHARE] = release_share
-    p[P_TIP_RADIUS : P_TIP_RADIUS + 3] = tip_radius
-    p[P_FOLLOW] = 1.0 if follow_suppression else 0.0
-    p[P_HOLD_SHARE] = hold_share
-    return p
+G_KI: int = _L["REFLEX_G_KI"]  # -- the block's parameters as given: given[G_*] (control.h)
+G_SAFETY_RATIO: int = _L["REFLEX_G_SAFETY_RATIO"]
+G_MARGIN: int = _L["REFLEX_G_MARGIN"]
+G_MIN_FORCE: int = _L["REFLEX_G_MIN_FORCE"]
+G_MAX_FORCE: int = _L["REFLEX_G_MAX_FORCE"]
+G_APPROACH: int = _L["REFLEX_G_APPROACH"]
+G_THRESHOLD: int = _L["REFLEX_G_THRESHOLD"]
+G_RELEASE_SHARE: int = _L["REFLEX_G_RELEASE_SHARE"]
+G_HOLD_SHARE: int = _L["REFLEX_G_HOLD_SHARE"]
+G_FOLLOW: int = _L["REFLEX_G_FOLLOW"]
+G_GRASP: int = _L["REFLEX_G_GRASP"]  # three: 1.0 for the fingers listed in 'grasp'
+G_COINCIDENT_RTOL: int = _L["REFLEX_G_COINCIDENT_RTOL"]
+N_GIVEN: int = _L["REFLEX_N_GIVEN"]
+
+pack_params = _native.reflex_pack
+"""``pack_params(given, hand_vector, dt) -> params``: the block's parameters (``G_*``)
+checked and packed into the native calls' flat array (``P_*``: the ratio target
+``safety_ratio / (1 + margin)``, the hand's tip radii, the period ``dt``); ValueError
+naming a bad parameter. The checks are hierhand/csrc/control_params.c's, which an exported
+FMU applies too."""
 
 
 def reflex_directions(params, state, tip, normal, fn) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -5,25 +5,28 @@ Its law is ``suppresser_kernel`` (compiled, ``hierhand/csrc/suppresser.c``).
 
 from __future__ import annotations
 
-import math
 from typing import Any, Mapping
 
 import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
-from blocks.kernel import Kernel, address
+from blocks.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS
+from ..kernels import KERNELS, context_of, record
 from ..model.port_info import DescribesHandPorts
 
 from .suppresser_kernel import (
+    G_ENABLED,
+    G_MODE,
+    G_S_A,
+    G_S_B,
+    G_TIME_CONSTANT,
+    N_GIVEN,
     N_OUT,
     O_SHARE,
     O_TAU,
     O_TAU_G_EFF,
-    P_ALPHA,
-    PASS,
     check_steepness,
     mode_code,
     pack_params,
@@ -84,8 +87,7 @@ class Suppresser(DescribesHandPorts, Block):
         self.S_a = float_array(S_a, "S_a", ndim=1, width=9, broadcast=True)
         self.S_b = float_array(S_b, "S_b", ndim=1, width=9, broadcast=True)
         check_steepness(self.S_a)
-        if isinstance(time_constant, bool) or not isinstance(time_constant, (int, float)) or not (
-                math.isfinite(time_constant) and time_constant >= 0):
+        if isinstance(time_constant, bool) or not isinstance(time_constant, (int, float)):
             raise ValueError(f"parameter 'time_constant' must be a time >= 0 in seconds, got {time_constant!r}")
         self.mode = mode
         self.enabled = bool(enabled)
@@ -95,7 +97,12 @@ class Suppresser(DescribesHandPorts, Block):
         self.outputs = {"tau": 9, "tau_g_eff": 9, "share": 3}
         self.feedthrough = (True if not self.filtered else
                             {"tau": {"tau_g", "tau_m", "tau_ff"}, "tau_g_eff": {"tau_g"}, "share": {"tau_g"}})
-        self._params = pack_params(self.S_a, self.S_b, code if self.enabled else PASS)
+        given = np.empty(N_GIVEN)
+        given[G_S_A:G_S_A + 9], given[G_S_B:G_S_B + 9] = self.S_a, self.S_b
+        given[G_MODE], given[G_ENABLED], given[G_TIME_CONSTANT] = code, self.enabled, self.time_constant
+        self._given = given
+        # the native calls' parameters, checked and packed in C (the filter's step by bind)
+        self._params = pack_params(given, None, np.nan)
 
     @property
     def filtered(self) -> bool:
@@ -108,8 +115,9 @@ class Suppresser(DescribesHandPorts, Block):
             if period is None:
                 raise ValueError("a Suppresser with a time_constant needs an explicit period (its filter's step), "
                                  "e.g. the reflex's 1 ms")
-            self._params[P_ALPHA] = -math.expm1(-float(period) / self.time_constant)
+            self._params = pack_params(self._given, None, float(period))
         super().bind(period)
+        self._kernel = None
 
     def initial_state(self) -> np.ndarray | None:
         """The low-passed suppression inputs (9, zero at the start), or None for the static law."""
@@ -138,8 +146,26 @@ class Suppresser(DescribesHandPorts, Block):
         return nxt
 
     def kernel(self) -> Kernel | None:
-        """``output`` (and, when filtered, ``update``) in C: the same native law on the
-        parameters packed in ``__init__`` and ``bind``."""
-        return Kernel(context=address(self._params), output=KERNELS["Suppresser.output"],
-                      update=KERNELS["Suppresser.update"] if self.filtered else 0, owners=(self._params,),
-                      nogil=True)
+        """``output`` (and, when filtered, ``update``) in C (kernel type ``Suppresser``:
+        the same native law), in a context its constructor builds from the record
+        ``[given, period]``. In an exported FMU ``S_a``, ``S_b`` and (for a filtered one)
+        ``time_constant`` are tunable."""
+        held = getattr(self, "_kernel", None)
+        if held is None:
+            period = float(self.period) if self.period is not None else 0.0
+            rec = record("Suppresser", self._given, [period], tunables=_TUNABLES if self.filtered else _TUNABLES[:18])
+            ctx = context_of(rec)
+            held = self._kernel = Kernel(context=ctx.address, output=KERNELS["Suppresser.output"],
+                                         update=KERNELS["Suppresser.update"] if self.filtered else 0, owners=(ctx,),
+                                         nogil=True, record=rec)
+        return held
+
+
+_TUNABLES = (
+    *(Tunable(f"S_a[{j + 1}]", G_S_A + j, f"joint {j + 1} sigmoid steepness", "1/(N m)") for j in range(9)),
+    *(Tunable(f"S_b[{j + 1}]", G_S_B + j, f"joint {j + 1} manipulation torque halving the grasping torque", "N m")
+      for j in range(9)),
+    Tunable("time_constant", G_TIME_CONSTANT, "time constant of the low-pass before the sigmoid (> 0)", "s"),
+)
+"""Suppresser's parameters an exported FMU lets an importer set (time_constant only when
+it filters: 0 would change the block's state and feedthrough)."""

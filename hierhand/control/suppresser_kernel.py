@@ -81,17 +81,22 @@ def check_steepness(S_a: Any) -> None:
         raise ValueError(f"S_a must be >= 0, got {S_a!r}")
 
 
-def pack_params(S_a: np.ndarray, S_b: np.ndarray, mode: int, alpha: float = 1.0) -> np.ndarray:
-    """The ``params`` vector of ``suppress_output``: 9 values each of S_a and S_b, a mode, the
-    low-pass step (set again by the block's ``bind``)."""
-    if mode not in (PASS, MAGNITUDE, SIGNED):
-        raise ValueError(f"mode must be PASS, MAGNITUDE or SIGNED ({PASS}, {MAGNITUDE}, {SIGNED}), got {mode!r}")
-    p = np.empty(N_PARAMS)
-    p[P_S_A:P_S_A + 9] = S_a
-    p[P_S_B:P_S_B + 9] = S_b
-    p[P_MODE] = mode
-    p[P_ALPHA] = alpha
-    return p
+G_S_A: int = _L["SUPPRESS_G_S_A"]  # -- the block's parameters as given: given[G_*] (control.h); nine
+G_S_B: int = _L["SUPPRESS_G_S_B"]  # nine
+G_MODE: int = _L["SUPPRESS_G_MODE"]  # MAGNITUDE or SIGNED
+G_ENABLED: int = _L["SUPPRESS_G_ENABLED"]
+G_TIME_CONSTANT: int = _L["SUPPRESS_G_TIME_CONSTANT"]
+N_GIVEN: int = _L["SUPPRESS_N_GIVEN"]
+
+_pack = _native.suppress_pack
+
+
+def pack_params(given: np.ndarray, hand: None, period: float) -> np.ndarray:
+    """The ``params`` vector of ``suppress_output`` from the block's parameters (``G_*``),
+    checked (hierhand/csrc/control_params.c): mode ``PASS`` when not enabled, the low-pass
+    step ``1 - exp(-period / time_constant)`` for a filtered block with a period (else 1);
+    ValueError naming a bad parameter."""
+    return _pack(given, hand, period)
 
 
 def _shaped(out: np.ndarray, shape: tuple[int, ...]) -> Any:

@@ -304,4 +304,67 @@ double hh_suppressed(double tau_g, double g, double s_a, double s_b, double mode
  * that name when it does suppress. */
 void hh_finger_shares(const double *tau_g, const double *tau_g_eff, double share[3]);
 
+/* == the blocks' parameters (control_params.c) ============================================
+ *
+ * Each controller block's numbers as the block is given them ("given", slots *_G_*),
+ * checked and packed into its law's parameter vector: the one definition of the checks
+ * and of the values derived from them, which the blocks call when they are made and an
+ * exported FMU calls when it rebuilds them (kernels.h). Each returns 0, or 1 with one
+ * line in message saying which parameter is wrong and why (numbers written as Python
+ * writes them), the vector then incomplete. A hand is a hand vector (HH_HAND_PARAMS). */
+
+/* Write x as Python's repr of a float does (shortest round trip; "3.0", "nan", "inf"). */
+void hh_number_text(double x, char *out, size_t size);
+
+enum {
+    HH_REFLEX_G_KI = 0,
+    HH_REFLEX_G_SAFETY_RATIO = 1,
+    HH_REFLEX_G_MARGIN = 2,
+    HH_REFLEX_G_MIN_FORCE = 3,
+    HH_REFLEX_G_MAX_FORCE = 4,
+    HH_REFLEX_G_APPROACH = 5,
+    HH_REFLEX_G_THRESHOLD = 6,
+    HH_REFLEX_G_RELEASE_SHARE = 7,
+    HH_REFLEX_G_HOLD_SHARE = 8,
+    HH_REFLEX_G_FOLLOW = 9, /* follow_suppression, 0 or 1 */
+    HH_REFLEX_G_GRASP = 10, /* three: 1 for the fingers listed in 'grasp' */
+    HH_REFLEX_G_COINCIDENT_RTOL = 13, /* Python's internal_forces._COINCIDENT_RTOL */
+    HH_REFLEX_N_GIVEN = 14
+};
+/* params (HH_REFLEX_N_PARAMS) of GraspReflex: the ratio target safety_ratio / (1 + margin),
+ * the hand's tip radii, the period dt (NaN: not bound yet). */
+int hh_reflex_pack(const double *given, const double *hand, double dt, double *params, char *message, size_t size);
+
+enum {
+    HH_MANIP_G_KP = 0, /* nine */
+    HH_MANIP_G_KD = 9, /* nine */
+    HH_MANIP_G_THRESHOLD = 18,
+    HH_MANIP_G_GRAVITY_COMP = 19,
+    HH_MANIP_G_LOAD_COMP = 20,
+    HH_MANIP_G_MATCHED = 21, /* discretization 'matched' */
+    HH_MANIP_G_CONTACT_COMP = 22,
+    HH_MANIP_G_STEP = 23, /* Python's manipulation_pd.DERIVATIVE_STEP */
+    HH_MANIP_G_REACH_RTOL = 24, /* Python's inverse_kinematics._REACH_RTOL */
+    HH_MANIP_N_GIVEN = 25
+};
+/* params (HH_MANIP_N_PARAMS) of ManipulationPD: q0 and gravity from the hand, the weight
+ * its object's mass times gravity, the period dt (NaN: none). */
+int hh_manip_pack(const double *given, const double *hand, double dt, double *params, char *message, size_t size);
+
+enum {
+    HH_SUPPRESS_G_S_A = 0, /* nine */
+    HH_SUPPRESS_G_S_B = 9, /* nine */
+    HH_SUPPRESS_G_MODE = 18, /* HH_SUPPRESS_MAGNITUDE or _SIGNED */
+    HH_SUPPRESS_G_ENABLED = 19,
+    HH_SUPPRESS_G_TIME_CONSTANT = 20, /* s; > 0: the block low-passes (a state), 0: the static law */
+    HH_SUPPRESS_N_GIVEN = 21
+};
+/* params (HH_SUPPRESS_N_PARAMS) of Suppresser: mode PASS when not enabled, the low-pass
+ * step 1 - exp(-period / time_constant) when filtered and period > 0 (else 1). */
+int hh_suppress_pack(const double *given, double period, double *params, char *message, size_t size);
+
+/* ObjectSupport's context [fx, fy, torque, until]: the hand's object weight turned
+ * upwards, 0 - m g, while t < until. */
+int hh_support_pack(double until, const double *hand, double *context, char *message, size_t size);
+
 #endif

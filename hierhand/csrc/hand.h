@@ -184,6 +184,15 @@ const char *hh_hand_param_name(int param); /* NULL outside 0 .. HH_HAND_PARAMS-1
 const char *hh_hand_param_doc(int param); /* what the number is, with its unit */
 /* Check and pack a hand; returns the number of problems (0: ``m`` is ready). */
 int hh_model_from_hand(hh_model *m, const double *hand, double dt, hh_report_fn report, void *context);
+/* The moment of inertia of a uniform plate of mass ``mass`` and sides a, b about its
+ * centre, m (a^2 + b^2) / 12: an object's inertia where its hand file gives none. */
+double hh_plate_inertia(double mass, double a, double b);
+
+/* A hand as a kernel's record carries it (kernels.h): HH_SEG_FOLLOWS, then the hand
+ * vector. follows non-zero: the object's inertia is the plate inertia of its mass and size
+ * (its hand file gives none and one of them was set), hh_hand_of_segment computes it. */
+enum { HH_SEG_FOLLOWS = 0, HH_SEG_HAND = 1, HH_SEGMENT = 1 + HH_HAND_PARAMS };
+void hh_hand_of_segment(const double *segment, double *hand);
 
 /* -- state ------------------------------------------------------------------------------ */
 size_t hh_state_size(const hh_model *m);

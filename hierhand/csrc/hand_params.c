@@ -231,3 +231,16 @@ int hh_model_from_hand(hh_model *m, const double *hand, double dt, hh_report_fn 
     m->npts = pack_edges(m, hand[HH_P_OBJ_SIZE], hand[HH_P_OBJ_SIZE + 1], hand[HH_P_OBJ_SPACING]);
     return 0;
 }
+
+double hh_plate_inertia(double mass, double a, double b)
+{
+    return mass * (pow(a, 2.0) + pow(b, 2.0)) / 12.0;
+}
+
+void hh_hand_of_segment(const double *segment, double *hand)
+{
+    for (int i = 0; i < HH_HAND_PARAMS; i++)
+        hand[i] = segment[HH_SEG_HAND + i];
+    if (segment[HH_SEG_FOLLOWS] != 0.0)
+        hand[HH_P_OBJ_INERTIA] = hh_plate_inertia(hand[HH_P_OBJ_MASS], hand[HH_P_OBJ_SIZE], hand[HH_P_OBJ_SIZE + 1]);
+}

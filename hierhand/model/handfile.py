@@ -335,7 +335,7 @@ def _parse_object(check: "_Checker", raw: Any) -> ObjectParams | None:
     if "inertia" in raw:
         inertia = check.number(raw["inertia"], "object.inertia")
     else:
-        inertia = mass * (size[0] ** 2 + size[1] ** 2) / 12.0
+        inertia = _native.plate_inertia(mass, size[0], size[1])
     spacing = check.number(raw["surface_spacing"], "object.surface_spacing")
     return ObjectParams(
         mass=mass,

@@ -18,10 +18,10 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, BlockError
-from blocks.kernel import Kernel
+from blocks.kernel import Kernel, KernelRecord
 
 from .. import _native
-from ..kernels import KERNELS
+from ..kernels import KERNELS, PLANT_SEGMENT, context_of, hand_segment, hand_tunables, inertia_follows, record
 from .hand import Hand
 from .handfile import SECTIONS, default_hand_dict, merge_with_default, parse_hand
 from .layout import (
@@ -132,6 +132,12 @@ class HandPlant(DescribesHandPorts, Block):
         sections = {"gravity": gravity, "fingers": fingers, "object": object, "contact": contact}
         self.hand = Hand(parse_hand(merge_with_default(sections), "HandPlant parameters"))
         self._given = tuple(key for key in SECTIONS if sections[key] is not None)
+        given_inertia = isinstance(object, Mapping) and "inertia" in object
+        self._inertia_may_follow = not given_inertia
+        """Whether the object's inertia follows its mass and size when they change (the
+        diagram does not give it)."""
+        self._inertia_derived = object is not None and not given_inertia
+        """Whether it was computed from them here."""
         self.inputs = {"tau": 9, "f_ext": 3}
         self.input_defaults = {"f_ext": _ZERO3}
         self.outputs = dict(OUTPUT_PORTS)
@@ -236,24 +242,32 @@ class HandPlant(DescribesHandPorts, Block):
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
 
     def kernel(self) -> Kernel | None:
-        """The C step functions (``hierhand/csrc/python/py_kernels.c``): the native calls of
-        ``output``, ``update`` and ``advance`` on the bound model; None before ``bind``.
-        Its ``bind`` gives each run a ``Scratch`` of its own as the context (the steps
-        write their scratch there), so runs in several threads share nothing but the
-        constant model and run without the GIL. The output row's ports lie one after the
-        other in the order of ``outputs``, and the inputs are ``tau``, ``f_ext``, as the
-        kernel convention wants."""
-        model = self._model
-        if model is None:
+        """The C step functions (kernel type ``HandPlant``, ``hierhand/csrc/kernels.c``):
+        the native calls of ``output``, ``update`` and ``advance``; None before ``bind``.
+        Its ``bind`` builds each run a context of its own from the record (the model and
+        the scratch the steps write), so runs in several threads share nothing and run
+        without the GIL. The output row's ports lie one after the other in the order of
+        ``outputs``, and the inputs are ``tau``, ``f_ext``, as the kernel convention wants.
+        The record, ``[dt, hand segment]``, makes every number of the hand tunable in an
+        exported FMU; the object's inertia follows its mass and size there as it does in
+        a diagram (unless the diagram gives the inertia)."""
+        if self.dt is None:
             return None
-        return Kernel(context=0, bind=functools.partial(self._bound_kernel, model), nogil=True,
+        rec = self.kernel_record()
+        return Kernel(context=0, bind=functools.partial(self._bound_kernel, rec), nogil=True, record=rec,
                       **_KERNEL_FUNCTIONS)
 
-    def _bound_kernel(self, model: _native.Model, state: np.ndarray) -> Kernel:
-        """``Kernel.bind``: the kernel of one run, stepping ``state`` with a fresh scratch."""
+    def kernel_record(self) -> KernelRecord:
+        """``[dt, hand segment]`` with the hand's numbers as tunables (``kernels.h``)."""
+        return record("HandPlant", [self.dt], hand_segment(self.hand, self._inertia_derived),
+                      tunables=hand_tunables(PLANT_SEGMENT),
+                      follows=inertia_follows(PLANT_SEGMENT) if self._inertia_may_follow else ())
+
+    def _bound_kernel(self, rec: KernelRecord, state: np.ndarray) -> Kernel:
+        """``Kernel.bind``: the kernel of one run, stepping ``state`` in a context of its own."""
         self._check_state(state)
-        scratch = _native.Scratch(model)
-        return Kernel(context=scratch.address, owners=(scratch,), error=self._kernel_error, nogil=True,
+        ctx = context_of(rec)
+        return Kernel(context=ctx.address, owners=(ctx,), error=self._kernel_error, nogil=True, record=rec,
                       **_KERNEL_FUNCTIONS)
 
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BlockError:

@@ -14,11 +14,16 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
-from blocks.kernel import Kernel, address
+from blocks.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS
+from .. import _native
+from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
 from .hand_source import ModelsTheHand, hand_of
 from .port_info import DescribesHandPorts
+
+
+support_pack = _native.support_pack
+"""``support_pack(None, hand_vector, until) -> [fx, fy, torque, until]``: the force, 0 - m g (C)."""
 
 
 class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
@@ -48,9 +53,9 @@ class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
         if isinstance(until, bool) or not isinstance(until, (int, float)) or not math.isfinite(until):
             raise ValueError(f"parameter 'until' must be a finite time in seconds, got {until!r}")
         self.until = float(until)
-        force = np.zeros(3)
-        force[:2] = 0.0 - self.hand.params.object.mass * self.hand.gravity
-        self.force = force
+        self._links = hand_link(hand)
+        self._context = support_pack(None, self.hand.vector, self.until)  # [force, until], in C
+        self.force = self._context[:3].copy()
         self.force.flags.writeable = False
         self.inputs = {}
         self.outputs = {"y": 3}
@@ -60,6 +65,15 @@ class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
         return {"y": self.force.copy() if t < self.until else np.zeros(3)}
 
     def kernel(self) -> Kernel | None:
-        """``output`` in C: the force while ``t < until``, zero from then on."""
-        ctx = np.concatenate((self.force, [self.until]))
-        return Kernel(context=address(ctx), output=KERNELS["ObjectSupport.output"], owners=(ctx,), nogil=True)
+        """``output`` in C (kernel type ``ObjectSupport``): the force while ``t < until``,
+        zero from then on, from the record ``[hand segment, until]``. In an exported FMU
+        ``until`` is tunable, and the force follows the plant's object mass."""
+        held = getattr(self, "_kernel", None)
+        if held is None:
+            rec = record("ObjectSupport", hand_segment(self.hand, False), [self.until],
+                         tunables=(Tunable("until", SEGMENT, "time from which the support is gone", "s"),),
+                         links=self._links)
+            ctx = context_of(rec)
+            held = self._kernel = Kernel(context=ctx.address, output=KERNELS["ObjectSupport.output"], owners=(ctx,),
+                                         nogil=True, record=rec)
+        return held

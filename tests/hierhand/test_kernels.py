@@ -276,11 +276,11 @@ def test_coincident_contacts_fail_the_reflex_as_in_python(diagram):
 def test_an_unreachable_target_fails_the_manipulation_as_in_python():
     d = blocks.load_diagram(REGRASP)
     manip = d.blocks["ctrl.manip"].block
-    kernel = manip.kernel()
-    # the middle finger's targets a metre away, in the packed waypoints (which the kernel
-    # reads too) and in the trajectory the Python path names the error from
+    # the middle finger's targets a metre away, in the packed waypoints (which the kernel's
+    # record copies) and in the trajectory the Python path names the error from
     manip._waypoints[2, :, 1] += 1.0
     manip.trajectories[2]._w[:, 1] += 1.0
+    kernel = manip.kernel()
     given = {"q": manip.hand.q0.copy(), "qd": np.zeros(9), "fn": np.zeros(3), "normal": np.zeros(6),
              "obj": manip.hand.object_pose0}
     listed, mapping = _inputs(manip, given)

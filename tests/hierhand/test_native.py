@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from blocks import native_sources as framework_sources
 from blocks.block import BlockError
 from hierhand import _native, native_sources
 from hierhand.model import Hand, HandPlant
@@ -19,14 +20,19 @@ REPO = Path(__file__).resolve().parents[2]
 FMI_HEADERS = Path(__import__("fmpy").__file__).parent / "c-code"
 
 
-@pytest.mark.parametrize("name", native_sources.CORE + native_sources.FMU_COMMON
-                         + list(native_sources.FMI_WRAPPERS.values()))
-def test_core_and_fmu_sources_are_strict_c99(name, tmp_path):
+FMU_C_FILES = sorted({p for fmi in framework_sources.FMI_WRAPPERS
+                      for p in native_sources.fmu_sources(framework_sources.fmu_sources(fmi)) if p.endswith(".c")})
+"""Every C file of hierhand's FMU binaries (FMI 2 and 3): the framework's and the hand's."""
+
+
+@pytest.mark.parametrize("path", FMU_C_FILES)
+def test_core_and_fmu_sources_are_strict_c99(path, tmp_path):
     compiler = shutil.which("gcc")
     if compiler is None:
         pytest.skip("gcc is not installed")
     done = subprocess.run([compiler, "-std=c99", "-pedantic-errors", "-Wall", "-Wextra", "-Werror", "-fPIC",
-                           "-I", str(FMI_HEADERS), "-c", str(REPO / native_sources.CSRC / name),
+                           "-I", str(FMI_HEADERS), "-I", str(REPO / framework_sources.CSRC),
+                           "-I", str(REPO / native_sources.CSRC), "-c", str(REPO / path),
                            "-o", str(tmp_path / "x.o")], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
 

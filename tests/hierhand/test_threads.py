@@ -1,7 +1,7 @@
 """The hand's diagrams run in several threads at once, each as it runs alone.
 
 The hand's kernels run with the GIL released (``nogil``); the plant's scratch is its run's
-own (``HandPlant.kernel``'s bind makes a ``Scratch`` per run), and the controllers only
+own (``HandPlant.kernel``'s bind builds a context per run), and the controllers only
 read their contexts. So runs in two threads at once must give every logged sample and
 time of a serial run, bit for bit: two equal hands (diagrams/regrasp.yaml twice), one
 diagram object simulated in both threads, two different hands (one with a heavier
@@ -82,6 +82,9 @@ def test_a_run_steps_with_a_scratch_of_its_own():
     assert kernel.nogil and kernel.bind is not None
     first, second = (kernel.bind(plant.initial_state()) for _ in range(2))
     assert first.nogil and first.context and second.context and first.context != second.context
-    assert isinstance(first.owners[0], _native.Scratch)
-    with pytest.raises(ValueError, match="no step"):
-        _native.Scratch(plant.hand.native)
+    assert isinstance(first.owners[0], _native.Context)
+    rec = plant.kernel_record()
+    unbound = rec.values.copy()
+    unbound[0] = 0.0
+    with pytest.raises(ValueError, match="needs a positive period"):
+        _native.Context(rec.kind, unbound)

@@ -242,12 +242,12 @@ def _running_cases() -> list[Case]:
                       r"SIGBUS \(a bus error: e\.g\. a truncated or changed binary file\)",
                       files={"d.yaml": diagram(), "plant.fmu": fmu(plain[:len(plain) // 2])},
                       check=saved_as("failed at t=0 s: block 'plant' (FMU)")))
-    cases.append(Case("fmu-crash-in-terminate-leaves-the-run-complete-and-says-so", run, 0,
-                      r"FMU 'plant\.fmu' crashed in fmi2Terminate \(terminating it after its run\): SIGSEGV .*"
-                      r"\(after the run; its results are complete\)",
+    cases.append(Case("fmu-crash-in-terminate-fails-the-run-at-its-end", run, 1,
+                      r"failed at t=0\.5 s: block 'plant' \(FMU\) finish: FMU 'plant\.fmu' crashed in fmi2Terminate "
+                      r"\(terminating it after its run\): SIGSEGV",
                       files={"d.yaml": diagram(), "plant.fmu": fmu(misbehaving, **{
                           "resources__misbehave.txt": "fmi2Terminate segv"})},
-                      check=saved_as("complete")))
+                      check=saved_as("failed at t=0.5 s: block 'plant' (FMU) finish")))
     return cases
 
 

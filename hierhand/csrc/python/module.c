@@ -3,14 +3,12 @@
  * Functions take a Model (a packed hand) and float64 arrays that the caller allocates;
  * they return status codes (HH_OK, HH_ERR_*) that the Python side turns into messages.
  * LAYOUT names every slot of the flat arrays (the enums of hand.h and control.h), so that
- * Python reads the layout from the one place it is defined; the FMU's value references,
- * resource file and log categories (fmu_instance.h) too, for the exporter. SOURCES_DIGEST
+ * Python reads the layout from the one place it is defined. SOURCES_DIGEST
  * is the hash of the C sources it was built from.
  */
 #include "py_common.h"
 
 #include "../control.h"
-#include "../fmu_instance.h"
 
 #ifndef HH_SOURCES_DIGEST
 #define HH_SOURCES_DIGEST "unknown" /* setup.py stamps the hash of hierhand/csrc */
@@ -44,8 +42,7 @@ static const layout_entry PLANT_LAYOUT[] = {
     LAYOUT_ENTRY(HH_W_FN_PY), LAYOUT_ENTRY(HH_N_WRENCH), LAYOUT_ENTRY(HH_OK), LAYOUT_ENTRY(HH_ERR_Q),
     LAYOUT_ENTRY(HH_ERR_QD), LAYOUT_ENTRY(HH_ERR_OBJ), LAYOUT_ENTRY(HH_ERR_OBJ_VEL), LAYOUT_ENTRY(HH_ERR_PENETRATION),
     LAYOUT_ENTRY(HH_ERR_TAU), LAYOUT_ENTRY(HH_ERR_F_EXT), LAYOUT_ENTRY(HH_HAND_PARAMS),
-    LAYOUT_ENTRY(HH_MAX_POINTS), LAYOUT_ENTRY(HH_VR_TIME), LAYOUT_ENTRY(HH_VR_TAU), LAYOUT_ENTRY(HH_VR_F_EXT),
-    LAYOUT_ENTRY(HH_VR_OUTPUT), LAYOUT_ENTRY(HH_VR_PARAM), LAYOUT_ENTRY(HH_N_INPUTS),
+    LAYOUT_ENTRY(HH_MAX_POINTS),
     {NULL, 0},
 };
 
@@ -93,7 +90,7 @@ PyMODINIT_FUNC PyInit__native(void)
         PyErr_SetString(PyExc_SystemError, "hierhand._native: method table too small");
         return NULL;
     }
-    if (PyType_Ready(&hh_py_model_type) < 0 || PyType_Ready(&hh_py_scratch_type) < 0)
+    if (PyType_Ready(&hh_py_model_type) < 0 || PyType_Ready(&hh_py_context_type) < 0)
         return NULL;
     PyObject *module = PyModule_Create(&module_def);
     if (module == NULL)
@@ -105,15 +102,12 @@ PyMODINIT_FUNC PyInit__native(void)
         Py_DECREF(module);
         return NULL;
     }
-    if (PyModule_AddStringConstant(module, "SOURCES_DIGEST", HH_SOURCES_DIGEST) != 0 ||
-        PyModule_AddStringConstant(module, "FMU_RESOURCE_FILE", HH_RESOURCE_FILE) != 0 ||
-        PyModule_AddObject(module, "FMU_LOG_CATEGORIES",
-                           Py_BuildValue("(sss)", HH_LOG_EVENTS, HH_LOG_WARNING, HH_LOG_ERROR)) != 0) {
+    if (PyModule_AddStringConstant(module, "SOURCES_DIGEST", HH_SOURCES_DIGEST) != 0) {
         Py_DECREF(module);
         return NULL;
     }
     if (PyModule_AddObjectRef(module, "Model", (PyObject *)&hh_py_model_type) != 0 ||
-        PyModule_AddObjectRef(module, "Scratch", (PyObject *)&hh_py_scratch_type) != 0) {
+        PyModule_AddObjectRef(module, "Context", (PyObject *)&hh_py_context_type) != 0) {
         Py_DECREF(module);
         return NULL;
     }

@@ -9,7 +9,8 @@
 
 /* A packed hand (hh_model) with the scratch its steps from Python use. The scratch makes
  * a Model unsafe to step from two threads at once; those functions hold the GIL
- * throughout, and the compiled kernel steps with a Scratch of its run instead. */
+ * throughout, and the compiled kernel steps with a context of its run instead (its own
+ * model and scratch, py_kernels.c). */
 typedef struct {
     PyObject_HEAD
     hh_model model;
@@ -18,17 +19,8 @@ typedef struct {
 
 extern PyTypeObject hh_py_model_type;
 
-/* One run's scratch for stepping a Model: the context of the plant's compiled kernel
- * (py_kernels.c), which runs without the GIL. Each run of a plant gets its own, so runs in
- * several threads never share an hh_work: not those of one diagram, nor those of hands
- * that share one Model. The Model stays constant; a reference keeps it alive. */
-typedef struct {
-    PyObject_HEAD
-    ModelObject *model;
-    hh_work work;
-} ScratchObject;
-
-extern PyTypeObject hh_py_scratch_type;
+/* A kernel's context built by its type's constructor from a record (py_kernels.c). */
+extern PyTypeObject hh_py_context_type;
 
 /* ``obj`` as a Model, or NULL with TypeError naming ``what``. */
 ModelObject *hh_py_model(PyObject *obj, const char *what);

@@ -1,237 +1,129 @@
-/* The hierhand blocks' compiled kernels (blocks/csrc/blocks_kernel.h): adapters from the
- * framework's calling convention to the plant core and the controllers' laws, so that the
- * executor runs HandPlant, GraspReflex, ManipulationPD, Suppresser and ObjectSupport in C.
+/* The hierhand blocks' compiled kernels for Python: their kernel types (kernels.h) and
+ * Context, a context built by a type's constructor from a block's record.
  *
- * Each adapter calls the very C function the block's Python method calls (through the
- * functions of py_plant.c and py_control.c), with the same arguments, so results are equal
- * to the last bit. The blocks' kernel() methods (Python) build the contexts:
- *
- * - HandPlant: a Scratch object of the run (its Kernel's bind makes one per run): the
- *   stepping Model, read only, and the hh_work the steps write.
- *
- * None calls Python's C API or writes anything but the state, the outputs and a Scratch,
- * so the blocks' Kernels say nogil and the executor runs them with the GIL released.
- * - GraspReflex: uintptr_t[2] = {Model object, params};
- * - ManipulationPD: uintptr_t[5] = {Model object, params, waypoints, meta, capacity};
- * - Suppresser: the params (HH_SUPPRESS_N_PARAMS doubles); its state, the low-passed
- *   suppression inputs (9), or none for the static law (the kernel's output gets NULL);
- * - ObjectSupport: double[4] = {fx, fy, torque, until}.
- *
- * Inputs arrive in the order of the block's ``inputs`` and outputs leave in the order of
- * its ``outputs`` (the plant's output row, the reflex's, the PD's and the suppresser's
- * vectors already are in that order). Adapters whose law may stop half way through
- * writing (reflex, manipulation) compute into a local buffer and copy it out on success,
- * as the Python methods return fresh arrays; the reflex update reads a copy of the state,
- * since it writes the new state in place.
+ * A block's kernel() writes its record (hierhand.kernels) and makes a Context of it: the
+ * constructor checks the record's numbers and builds what the adapters read (the plant's
+ * model and scratch, a law's packed parameters), exactly as an exported FMU rebuilds it.
+ * The Context frees it when it goes away; its address is the Kernel's context. kernels()
+ * gives the adapters' addresses by "Block.phase".
  */
 #include "py_common.h"
 
 #include <stdint.h>
 #include <string.h>
 
-#include "../control.h"
+#include "../kernels.h"
 #include "blocks_kernel.h"
 
-/* -- Scratch: one run's hh_work for a Model ---------------------------------------------- */
+typedef struct {
+    PyObject_HEAD
+    const blk_kernel_type *type;
+    blk_built built;
+} ContextObject;
 
-static PyObject *scratch_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
+static const blk_kernel_type *type_named(const char *name)
 {
-    static char *keywords[] = {"model", NULL};
-    PyObject *obj;
-    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "O:Scratch", keywords, &obj))
+    for (const blk_kernel_type *k = hh_kernel_types; k->name != NULL; k++)
+        if (strcmp(k->name, name) == 0)
+            return k;
+    return NULL;
+}
+
+static PyObject *context_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
+{
+    static char *keywords[] = {"kind", "record", NULL};
+    const char *kind;
+    PyObject *record;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "sO:Context", keywords, &kind, &record))
         return NULL;
-    ModelObject *model = hh_py_model(obj, "model");
-    if (model == NULL)
-        return NULL;
-    if (!(model->model.body[HH_B_DT] > 0.0)) {
-        PyErr_SetString(PyExc_ValueError, "Scratch: the model has no step; make one with Model.with_dt(dt)");
+    const blk_kernel_type *k = type_named(kind);
+    if (k == NULL) {
+        PyErr_Format(PyExc_ValueError, "Context: no kernel type '%s'", kind);
         return NULL;
     }
-    ScratchObject *self = (ScratchObject *)type->tp_alloc(type, 0);
-    if (self == NULL)
+    Py_buffer view;
+    if (hh_py_doubles(record, &view, -1, 0, "record") != 0)
         return NULL;
-    if (hh_work_init(&self->work, model->model.npts) != 0) {
+    ContextObject *self = (ContextObject *)type->tp_alloc(type, 0);
+    if (self == NULL) {
+        PyBuffer_Release(&view);
+        return NULL;
+    }
+    char message[512] = "";
+    int code = k->construct((const double *)view.buf, (long)(view.len / (Py_ssize_t)sizeof(double)), &self->built,
+                            message, sizeof message);
+    PyBuffer_Release(&view);
+    if (code != 0) {
         Py_DECREF(self);
-        return PyErr_NoMemory();
+        PyErr_SetString(PyExc_ValueError, message);
+        return NULL;
     }
-    self->model = (ModelObject *)Py_NewRef(model);
+    self->type = k;
     return (PyObject *)self;
 }
 
-static void scratch_dealloc(ScratchObject *self)
+static void context_dealloc(ContextObject *self)
 {
-    hh_work_free(&self->work);
-    Py_XDECREF(self->model);
+    if (self->type != NULL && self->built.ctx != NULL)
+        self->type->destroy(self->built.ctx);
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-static PyObject *scratch_address(ScratchObject *self, void *closure)
+static PyObject *context_address(ContextObject *self, void *closure)
 {
     (void)closure;
-    return PyLong_FromVoidPtr(self);
+    return PyLong_FromVoidPtr(self->built.ctx);
 }
 
-static PyGetSetDef scratch_getset[] = {
-    {"address", (getter)scratch_address, NULL,
-     "the address of this object: the context of the plant's kernel (keep the Scratch alive while it runs)", NULL},
+static PyObject *context_state_size(ContextObject *self, void *closure)
+{
+    (void)closure;
+    return PyLong_FromLong(self->built.state_size);
+}
+
+/* initial_state(out): the constructed kernel's initial state into out (state_size values). */
+static PyObject *context_initial_state(ContextObject *self, PyObject *out)
+{
+    if (self->type->initial == NULL || self->built.state_size <= 0) {
+        PyErr_SetString(PyExc_ValueError, "this kernel has no state of its own");
+        return NULL;
+    }
+    Py_buffer view;
+    if (hh_py_doubles(out, &view, self->built.state_size, 1, "out") != 0)
+        return NULL;
+    self->type->initial(self->built.ctx, (double *)view.buf);
+    PyBuffer_Release(&view);
+    Py_RETURN_NONE;
+}
+
+static PyGetSetDef context_getset[] = {
+    {"address", (getter)context_address, NULL, "the context's address: a Kernel's context (keep this object alive)",
+     NULL},
+    {"state_size", (getter)context_state_size, NULL,
+     "the size of the kernel's state (0: none, -1: the block's own, not the kernel's)", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };
 
-PyTypeObject hh_py_scratch_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hierhand._native.Scratch",
-    .tp_basicsize = sizeof(ScratchObject),
-    .tp_dealloc = (destructor)scratch_dealloc,
+static PyMethodDef context_methods[] = {
+    {"initial_state", (PyCFunction)context_initial_state, METH_O,
+     "initial_state(out): the kernel's initial state into the float64 array out."},
+    {NULL, NULL, 0, NULL},
+};
+
+PyTypeObject hh_py_context_type = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hierhand._native.Context",
+    .tp_basicsize = sizeof(ContextObject),
+    .tp_dealloc = (destructor)context_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Scratch(model): the scratch of one run of the plant's compiled kernel, stepping model (a stepping "
-              "Model, kept alive); its address is that kernel's context.",
-    .tp_getset = scratch_getset,
-    .tp_new = scratch_new,
+    .tp_doc = "Context(kind, record): the context the constructor of kernel type kind (kernels.h) builds from "
+              "record (float64), ValueError with the constructor's message when it refuses the record; freed "
+              "with the object.",
+    .tp_getset = context_getset,
+    .tp_methods = context_methods,
+    .tp_new = context_new,
 };
 
-/* -- HandPlant: inputs tau (9), f_ext (3); out: the output row (HH_N_OUTPUTS) ---------------- */
-
-static int plant_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
-                        int *which)
-{
-    (void)t;
-    (void)inputs;
-    ScratchObject *run = (ScratchObject *)(uintptr_t)ctx;
-    return hh_output(&run->model->model, &run->work, state, out, which);
-}
-
-static int plant_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
-{
-    (void)t;
-    ScratchObject *run = (ScratchObject *)(uintptr_t)ctx;
-    int done;
-    return hh_step(&run->model->model, &run->work, state, inputs[0], inputs[1], &done, which);
-}
-
-static int plant_advance(const void *ctx, double t, double *state, const double *const *inputs, int n, double *rows,
-                         int *done, int *which)
-{
-    (void)t;
-    ScratchObject *run = (ScratchObject *)(uintptr_t)ctx;
-    long stepped = 0;
-    int code = hh_advance(&run->model->model, &run->work, state, inputs[0], inputs[1], (long)n, rows, HH_N_OUTPUTS,
-                          &stepped, which);
-    /* hh_advance counts the failing update; the rows before it are complete (as
-       HandPlant.advance: written = max(done - 1, 0)) */
-    *done = code == HH_OK ? n : (stepped > 1 ? (int)(stepped - 1) : 0);
-    return code;
-}
-
-/* -- GraspReflex: inputs q, tip, fn, ft, normal, share; out: tau_g, force, active ------------ */
-
-enum { RI_Q = 0, RI_TIP = 1, RI_FN = 2, RI_FT = 3, RI_NORMAL = 4, RI_SHARE = 5 };
-
-static int reflex_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
-                         int *which)
-{
-    (void)t;
-    const uintptr_t *c = (const uintptr_t *)ctx;
-    const ModelObject *model = (const ModelObject *)c[0];
-    const double *params = (const double *)c[1];
-    hh_reflex_inputs in = {.tip = inputs[RI_TIP], .normal = inputs[RI_NORMAL], .fn = inputs[RI_FN], .share = NULL};
-    double buffer[HH_REFLEX_N_OUT];
-    *which = 0;
-    int code = hh_reflex_output(&model->model, params, state, &in, inputs[RI_Q], buffer);
-    if (code == HH_REFLEX_OK)
-        memcpy(out, buffer, sizeof buffer);
-    return code;
-}
-
-static int reflex_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
-{
-    (void)t;
-    const uintptr_t *c = (const uintptr_t *)ctx;
-    const double *params = (const double *)c[1];
-    hh_reflex_inputs in = {
-        .tip = inputs[RI_TIP], .normal = inputs[RI_NORMAL], .fn = inputs[RI_FN], .share = inputs[RI_SHARE]};
-    double current[HH_REFLEX_N_STATE], next[HH_REFLEX_N_STATE];
-    memcpy(current, state, sizeof current);
-    *which = 0;
-    int code = hh_reflex_update(params, current, &in, inputs[RI_FT], next);
-    if (code == HH_REFLEX_OK)
-        memcpy(state, next, sizeof next);
-    return code;
-}
-
-/* -- ManipulationPD: inputs q, qd, fn, support, normal, obj; out: tau_m, tau_ff, q_ref ------- */
-
-static int manipulation_output(const void *ctx, double t, const double *state, const double *const *inputs,
-                               double *out, int *which)
-{
-    (void)state;
-    const uintptr_t *c = (const uintptr_t *)ctx;
-    const ModelObject *model = (const ModelObject *)c[0];
-    hh_trajectories tr = {.waypoints = (const double *)c[2], .meta = (const double *)c[3], .capacity = (long)c[4]};
-    double buffer[HH_MANIP_N_OUT];
-    hh_manip_inputs in = {.q = inputs[0], .qd = inputs[1], .fn = inputs[2], .support = inputs[3],
-                          .normal = inputs[4], .obj = inputs[5]};
-    int status = hh_manipulation_output(&model->model, (const double *)c[1], &tr, t, &in, buffer);
-    if (status == HH_MANIP_OK) {
-        *which = 0;
-        memcpy(out, buffer, sizeof buffer);
-    } else {
-        *which = status - HH_MANIP_UNREACHABLE; /* the finger out of reach */
-    }
-    return status;
-}
-
-/* -- Suppresser: inputs tau_g, tau_m, tau_ff; out: tau, tau_g_eff, share ---------------------- */
-
-static int suppresser_output(const void *ctx, double t, const double *state, const double *const *inputs,
-                             double *out, int *which)
-{
-    (void)t;
-    *which = 0;
-    hh_suppress((const double *)ctx, inputs[0], state, inputs[1], inputs[2], out); /* state NULL: static law */
-    return 0;
-}
-
-static int suppresser_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
-{
-    (void)t;
-    *which = 0;
-    double next[HH_JOINTS];
-    hh_suppress_update((const double *)ctx, state, inputs[0], inputs[1], next);
-    memcpy(state, next, sizeof next);
-    return 0;
-}
-
-/* -- ObjectSupport: no inputs; out: y (3) = the force while t < until, else zero -------------- */
-
-static int support_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
-                          int *which)
-{
-    (void)state;
-    (void)inputs;
-    const double *c = (const double *)ctx;
-    int on = t < c[3];
-    for (int i = 0; i < 3; i++)
-        out[i] = on ? c[i] : 0.0;
-    *which = 0;
-    return 0;
-}
-
-/* -- the table and the module functions ---------------------------------------------------- */
-
-/* Typed fields, so that the compiler checks every adapter against blocks_kernel.h. */
-typedef struct {
-    const char *block;
-    blk_output_fn output;
-    blk_update_fn update;
-    blk_advance_fn advance;
-} block_kernels;
-
-static const block_kernels KERNELS[] = {
-    {"HandPlant", plant_output, plant_update, plant_advance},
-    {"GraspReflex", reflex_output, reflex_update, NULL},
-    {"ManipulationPD", manipulation_output, NULL, NULL},
-    {"Suppresser", suppresser_output, suppresser_update, NULL},
-    {"ObjectSupport", support_output, NULL, NULL},
-};
+/* -- the adapters' addresses ------------------------------------------------------------------ */
 
 static int add_kernel(PyObject *found, const char *block, const char *phase, void *function)
 {
@@ -252,21 +144,13 @@ static PyObject *py_kernels(PyObject *module, PyObject *unused)
     (void)module;
     (void)unused;
     PyObject *found = PyDict_New();
-    for (size_t i = 0; found != NULL && i < sizeof KERNELS / sizeof KERNELS[0]; i++) {
-        const block_kernels *k = &KERNELS[i];
-        if (add_kernel(found, k->block, "output", (void *)(uintptr_t)k->output) != 0 ||
-            add_kernel(found, k->block, "update", (void *)(uintptr_t)k->update) != 0 ||
-            add_kernel(found, k->block, "advance", (void *)(uintptr_t)k->advance) != 0)
+    for (const blk_kernel_type *k = hh_kernel_types; found != NULL && k->name != NULL; k++) {
+        if (add_kernel(found, k->name, "output", (void *)(uintptr_t)k->output) != 0 ||
+            add_kernel(found, k->name, "update", (void *)(uintptr_t)k->update) != 0 ||
+            add_kernel(found, k->name, "advance", (void *)(uintptr_t)k->advance) != 0)
             Py_CLEAR(found);
     }
     return found;
-}
-
-static PyObject *py_model_address(PyObject *module, PyObject *obj)
-{
-    (void)module;
-    ModelObject *self = hh_py_model(obj, "model");
-    return self == NULL ? NULL : PyLong_FromVoidPtr(self);
 }
 
 static PyObject *py_kernel_abi(PyObject *module, PyObject *unused)
@@ -279,10 +163,7 @@ static PyObject *py_kernel_abi(PyObject *module, PyObject *unused)
 PyMethodDef hh_py_kernel_methods[] = {
     {"kernels", py_kernels, METH_NOARGS,
      "kernels() -> {name: address}: the blocks' compiled kernels ('HandPlant.output', ...), functions of the types "
-     "of blocks/csrc/blocks_kernel.h."},
-    {"model_address", py_model_address, METH_O,
-     "model_address(model): the address of a Model object, the context of the kernels that read it (keep the "
-     "Model alive while they run)."},
+     "of blocks/csrc/blocks_kernel.h, from the kernel types of kernels.h."},
     {"kernel_abi", py_kernel_abi, METH_NOARGS, "kernel_abi(): BLK_KERNEL_ABI of blocks_kernel.h built against."},
     {NULL, NULL, 0, NULL},
 };

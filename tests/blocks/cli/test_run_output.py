@@ -58,7 +58,7 @@ def test_results_that_cannot_be_saved_anywhere_are_reported_lost(tmp_path, monke
     (tmp_path / "signals.npz").mkdir()
     monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "no-such-temp"))
     r = Results({"a.y": (np.zeros(1), np.zeros((1, 1)))}, {"status": "complete"})
-    saved = save_run(r, tmp_path, csv=False, plot=False)
+    saved = save_run(r, tmp_path, csv=False)
     assert saved.folder is None
     assert saved.problem.startswith(f"cannot save the results in {tmp_path} (Is a directory: ")
     assert saved.problem.endswith("): they are lost")

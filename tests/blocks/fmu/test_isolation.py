@@ -291,22 +291,31 @@ def test_an_fmu_that_hangs_fails_the_run_after_the_call_timeout(tmp_path, misbeh
 # -- after the run ------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("call, how, message", [
-    ("fmi2Terminate", "segv", "crashed in fmi2Terminate (terminating it after its run): SIGSEGV"),
-    ("fmi2FreeInstance", "exit3", "called exit(3) in fmi2FreeInstance (freeing it)"),
+@pytest.mark.parametrize("how, message", [
+    ("segv", "crashed in fmi2Terminate (terminating it after its run): SIGSEGV"),
+    ("exit3", "called exit(3) in fmi2Terminate (terminating it after its run)"),
 ])
-def test_a_crash_after_the_run_is_reported_and_the_results_stand(tmp_path, misbehaving, caplog, call, how, message):
-    """terminate runs when the run gives its instance back, freeInstance when the block frees
-    it: the results are complete by then."""
-    path = misbehaving_fmu(tmp_path / "late.fmu", "cs2", misbehaving["cs2"], f"{call} {how}")
+def test_a_crash_in_terminate_fails_the_run_at_its_end_with_its_results(tmp_path, misbehaving, how, message):
+    """terminate runs when the run gives its instance back, at its end and before its
+    results are made (``Block.finish``): a crash there fails the run at its end time,
+    naming the call, and every sample is kept."""
+    path = misbehaving_fmu(tmp_path / "late.fmu", "cs2", misbehaving["cs2"], f"fmi2Terminate {how}")
+    results = simulate(diagram(path))
+    assert results.status.startswith("failed at t=0.5 s: block 'f' (FMU) finish: "), results.status
+    assert message in results.status, results.status
+    assert len(results["f.y"][0]) == 6
+
+
+def test_a_crash_in_free_instance_after_the_runs_is_a_warning(tmp_path, misbehaving, caplog):
+    """freeInstance runs when the block frees its pooled instance, after its runs."""
+    path = misbehaving_fmu(tmp_path / "late.fmu", "cs2", misbehaving["cs2"], "fmi2FreeInstance exit3")
     d = diagram(path)
     with caplog.at_level(logging.WARNING, logger="blocks.fmu"):
         results = simulate(d)
-        gc.collect()                        # the run's state goes, and its instance back to the pool
-        d.blocks["f"].block.close()         # the block frees its instances
+        d.blocks["f"].block.close()
     assert results.complete and len(results["f.y"][0]) == 6
     warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
-    assert any(message in w and "(after the run; its results are complete)" in w for w in warnings), warnings
+    assert any("called exit(3) in fmi2FreeInstance (freeing it)" in w for w in warnings), warnings
 
 
 def test_a_well_behaved_misbehaving_fmu_is_the_first_order_fmu(tmp_path, misbehaving, fmus):

@@ -104,7 +104,7 @@ int main(int argc, char **argv)
         logs[e] = malloc((size_t)(lg[BLK_L_CAPACITY] * lg[BLK_L_WIDTH] + 1) * sizeof(double));
     }
     int64_t *counters = calloc((size_t)(table.n_logs * BLK_LC_N + 1), sizeof(int64_t));
-    blk_run run = {&table, arena, kernels, logs, counters, {NULL, NULL, NULL, NULL, NULL}, 0, {0}, 0};
+    blk_run run = {&table, arena, kernels, logs, counters, {NULL, NULL, NULL, NULL, NULL}, 0, {0}, 0, {0}, NULL};
     int status = blk_run_table(&run);
     const blk_outcome *o = &run.outcome;
     printf("%d %lld %lld %lld %lld %d %lld %lld\n", status, (long long)o->end, (long long)o->reached,

@@ -149,6 +149,8 @@ def test_an_npz_that_inflates_past_the_limit_is_refused_unread(tmp_path):
     path = tmp_path / "bomb.npz"
     with zipfile.ZipFile(path, "w", compression=zipfile.ZIP_DEFLATED) as archive:
         with archive.open("time.npy", "w", force_zip64=True) as member:
+            np.lib.format.write_array_header_1_0(member, {"descr": "<f8", "fortran_order": False,
+                                                          "shape": (MAX_DATA_BYTES // 8 + 1,)})
             chunk = bytes(1 << 20)
             for _ in range(MAX_DATA_BYTES // len(chunk) + 1):
                 member.write(chunk)

@@ -34,7 +34,7 @@ def test_split_keeps_brackets_and_quotes_together():
     ("a.0=1,2", "not BLOCK.PARAM"),
     ("a.k", "expected BLOCK.PARAM=V1,V2"),
     ("a.k=1,,2", "empty value"),
-    ("a.k=[1,", "not valid YAML"),
+    ("a.k=[1,", "YAML syntax error"),
 ])
 def test_bad_grid_items_are_refused(item, message):
     with pytest.raises(SweepError, match=message):

@@ -13,6 +13,19 @@ import pytest
 
 from hierhand.control.grasp_reflex import GraspReflex
 from hierhand.control.reflex_kernel import (
+    G_APPROACH,
+    G_COINCIDENT_RTOL,
+    G_FOLLOW,
+    G_GRASP,
+    G_HOLD_SHARE,
+    G_KI,
+    G_MARGIN,
+    G_MAX_FORCE,
+    G_MIN_FORCE,
+    G_RELEASE_SHARE,
+    G_SAFETY_RATIO,
+    G_THRESHOLD,
+    N_GIVEN,
     N_PARAMS,
     P_APPROACH,
     P_COINCIDENT_RTOL,
@@ -233,9 +246,23 @@ def test_packed_parameters_land_in_the_slots_control_h_defines():
              P_INITIAL + 2, P_COINCIDENT_RTOL, P_RELEASE_SHARE, P_TIP_RADIUS, P_TIP_RADIUS + 1, P_TIP_RADIUS + 2,
              P_FOLLOW, P_HOLD_SHARE]
     assert sorted(slots) == list(range(N_PARAMS))
-    p = pack_params(0.05, 0.5, 50.0, 0.001, 1.0, 0.6 / 1.05, 30.0, [True, False, True], release_share=0.75,
-                    tip_radius=(0.009, 0.008, 0.007), follow_suppression=False, hold_share=0.85)
+    from hierhand.model.hand_vector import parameter_names
+
+    given = np.zeros(N_GIVEN)
+    given[G_THRESHOLD], given[G_APPROACH], given[G_KI], given[G_MIN_FORCE] = 0.05, 0.5, 50.0, 1.0
+    given[G_SAFETY_RATIO], given[G_MARGIN], given[G_MAX_FORCE] = 0.6, 0.05, 30.0
+    given[G_GRASP:G_GRASP + 3] = [1.0, 0.0, 1.0]
+    given[G_RELEASE_SHARE], given[G_HOLD_SHARE], given[G_FOLLOW] = 0.75, 0.85, 0.0
+    given[G_COINCIDENT_RTOL] = _COINCIDENT_RTOL
+    hand = Hand.default().vector.copy()
+    names = parameter_names()
+    for f, radius in enumerate((0.009, 0.008, 0.007)):
+        hand[names.index(f"fingers[{f + 1}].tip_radius")] = radius
+    p = pack_params(given, hand, 0.001)
     assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL and p[P_RELEASE_SHARE] == 0.75 and p[P_FOLLOW] == 0.0
-    assert p[P_HOLD_SHARE] == 0.85
+    assert p[P_HOLD_SHARE] == 0.85 and p[P_DT] == 0.001 and p[P_RATIO] == 0.6 / 1.05
     assert p[P_TIP_RADIUS:P_TIP_RADIUS + 3].tolist() == [0.009, 0.008, 0.007]
     assert p[P_INITIAL:P_INITIAL + 3].tolist() == [1.0, 0.0, 1.0] and p[P_KI] == 50.0
+    given[G_KI] = -5.0
+    with pytest.raises(ValueError, match=r"^parameter 'ki' must be a positive number, got -5.0$"):
+        pack_params(given, hand, 0.001)

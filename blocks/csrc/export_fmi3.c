@@ -1,4 +1,4 @@
-/* The FMI 3.0 co-simulation interface of the hand plant FMU, over fmu_instance.c.
+/* The FMI 3.0 co-simulation interface of an exported diagram FMU, over export_instance.c.
  *
  * Every function of fmi3Functions.h is exported, as importers may look each one up; the
  * ones outside co-simulation without event mode (model exchange, scheduled execution,
@@ -9,15 +9,15 @@
 #include <stdlib.h>
 
 #include "fmi3Functions.h"
-#include "fmu_instance.h"
+#include "export_instance.h"
 
 typedef struct {
-    hh_instance *inst;
+    blk_instance *inst;
     fmi3LogMessageCallback log_message;
     fmi3InstanceEnvironment environment;
 } component;
 
-static void log_to_host(void *environment, const char *instance, hh_status status, const char *category,
+static void log_to_host(void *environment, const char *instance, blk_status status, const char *category,
                         const char *message)
 {
     (void)instance;
@@ -26,20 +26,20 @@ static void log_to_host(void *environment, const char *instance, hh_status statu
         c->log_message(c->environment, (fmi3Status)status, category, message);
 }
 
-static hh_instance *instance_of(fmi3Instance instance)
+static blk_instance *instance_of(fmi3Instance instance)
 {
     return instance != NULL ? ((component *)instance)->inst : NULL;
 }
 
 #define INSTANCE_OR_ERROR(instance)                                                                                  \
-    hh_instance *inst = instance_of(instance);                                                                       \
+    blk_instance *inst = instance_of(instance);                                                                       \
     if (inst == NULL)                                                                                                \
     return fmi3Error
 
 static fmi3Status unsupported(fmi3Instance instance, const char *function)
 {
     INSTANCE_OR_ERROR(instance);
-    hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "%s is not supported by this co-simulation FMU", function);
+    blk_instance_log(inst, BLK_STATUS_ERROR, BLK_LOG_ERROR, "%s is not supported by this co-simulation FMU", function);
     return fmi3Error;
 }
 
@@ -48,7 +48,7 @@ static fmi3Status no_variables(fmi3Instance instance, size_t nValueReferences, c
     INSTANCE_OR_ERROR(instance);
     if (nValueReferences == 0)
         return fmi3OK;
-    hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "this FMU has no %s variables", type);
+    blk_instance_log(inst, BLK_STATUS_ERROR, BLK_LOG_ERROR, "this FMU has no %s variables", type);
     return fmi3Error;
 }
 
@@ -63,14 +63,14 @@ fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, siz
                                const fmi3String categories[])
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_set_logging(inst, loggingOn, nCategories, categories);
+    return (fmi3Status)blk_instance_set_logging(inst, loggingOn, nCategories, categories);
 }
 
 static void refuse_interface(fmi3InstanceEnvironment environment, fmi3LogMessageCallback logMessage,
                              const char *interface)
 {
     if (logMessage != NULL)
-        logMessage(environment, fmi3Error, HH_LOG_ERROR, interface);
+        logMessage(environment, fmi3Error, BLK_LOG_ERROR, interface);
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
@@ -113,7 +113,7 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
         return NULL;
     c->log_message = logMessage;
     c->environment = instanceEnvironment;
-    c->inst = hh_instance_new(instanceName, instantiationToken, resourcePath, log_to_host, c, loggingOn);
+    c->inst = blk_instance_new(instanceName, instantiationToken, resourcePath, log_to_host, c, loggingOn);
     if (c->inst == NULL) {
         free(c);
         return NULL;
@@ -144,7 +144,7 @@ void fmi3FreeInstance(fmi3Instance instance)
 {
     if (instance == NULL)
         return;
-    hh_instance_free(((component *)instance)->inst);
+    blk_instance_free(((component *)instance)->inst);
     free(instance);
 }
 
@@ -153,16 +153,15 @@ fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean tolera
 {
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_enter_initialization(inst, startTime);
+    fmi3Status status = (fmi3Status)blk_instance_setup(inst, startTime, stopTimeDefined, stopTime);
+    return status == fmi3OK ? (fmi3Status)blk_instance_enter_initialization(inst) : status;
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_exit_initialization(inst);
+    return (fmi3Status)blk_instance_exit_initialization(inst);
 }
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance)
@@ -173,22 +172,22 @@ fmi3Status fmi3EnterEventMode(fmi3Instance instance)
 fmi3Status fmi3Terminate(fmi3Instance instance)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_terminate(inst);
+    return (fmi3Status)blk_instance_terminate(inst);
 }
 
 fmi3Status fmi3Reset(fmi3Instance instance)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_reset(inst);
+    return (fmi3Status)blk_instance_reset(inst);
 }
 
 /* -- values ------------------------------------------------------------------------------- */
 
-static fmi3Status scalar_count(hh_instance *inst, size_t nValueReferences, size_t nValues)
+static fmi3Status scalar_count(blk_instance *inst, size_t nValueReferences, size_t nValues)
 {
     if (nValues == nValueReferences)
         return fmi3OK;
-    hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR,
+    blk_instance_log(inst, BLK_STATUS_ERROR, BLK_LOG_ERROR,
                     "%zu values for %zu value references: every variable of this FMU is a scalar", nValues,
                     nValueReferences);
     return fmi3Error;
@@ -200,7 +199,7 @@ fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     INSTANCE_OR_ERROR(instance);
     if (scalar_count(inst, nValueReferences, nValues) != fmi3OK)
         return fmi3Error;
-    return (fmi3Status)hh_instance_get(inst, valueReferences, nValueReferences, values);
+    return (fmi3Status)blk_instance_get(inst, valueReferences, nValueReferences, values);
 }
 
 fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueReferences[], size_t nValueReferences,
@@ -209,7 +208,7 @@ fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference valueR
     INSTANCE_OR_ERROR(instance);
     if (scalar_count(inst, nValueReferences, nValues) != fmi3OK)
         return fmi3Error;
-    return (fmi3Status)hh_instance_set(inst, valueReferences, nValueReferences, values);
+    return (fmi3Status)blk_instance_set(inst, valueReferences, nValueReferences, values);
 }
 
 #define NO_VARIABLES_OF(NAME, TYPE)                                                                                  \
@@ -305,31 +304,31 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_get_state(inst, (hh_snapshot **)FMUState);
+    return (fmi3Status)blk_instance_get_state(inst, (blk_snapshot **)FMUState);
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_instance_set_state(inst, (const hh_snapshot *)FMUState);
+    return (fmi3Status)blk_instance_set_state(inst, (const blk_snapshot *)FMUState);
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState)
 {
     (void)instance;
-    return (fmi3Status)hh_snapshot_free((hh_snapshot **)FMUState);
+    return (fmi3Status)blk_snapshot_free((blk_snapshot **)FMUState);
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_snapshot_size(inst, (const hh_snapshot *)FMUState, size);
+    return (fmi3Status)blk_snapshot_size(inst, (const blk_snapshot *)FMUState, size);
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[], size_t size)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_snapshot_serialize(inst, (const hh_snapshot *)FMUState, (unsigned char *)serializedState,
+    return (fmi3Status)blk_snapshot_serialize(inst, (const blk_snapshot *)FMUState, (unsigned char *)serializedState,
                                              size);
 }
 
@@ -337,8 +336,8 @@ fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte seriali
                                    fmi3FMUState *FMUState)
 {
     INSTANCE_OR_ERROR(instance);
-    return (fmi3Status)hh_snapshot_deserialize(inst, (const unsigned char *)serializedState, size,
-                                               (hh_snapshot **)FMUState);
+    return (fmi3Status)blk_snapshot_deserialize(inst, (const unsigned char *)serializedState, size,
+                                               (blk_snapshot **)FMUState);
 }
 
 /* -- derivatives, configuration, clocks: not available ---------------------------------------- */
@@ -571,15 +570,17 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
 {
     (void)noSetFMUStatePriorToCurrentPoint;
     INSTANCE_OR_ERROR(instance);
-    fmi3Status status = (fmi3Status)hh_instance_do_step(inst, currentCommunicationPoint, communicationStepSize);
+    int terminated = 0;
+    fmi3Status status =
+        (fmi3Status)blk_instance_do_step(inst, currentCommunicationPoint, communicationStepSize, &terminated);
     if (eventHandlingNeeded != NULL)
         *eventHandlingNeeded = fmi3False;
     if (terminateSimulation != NULL)
-        *terminateSimulation = fmi3False;
+        *terminateSimulation = terminated ? fmi3True : fmi3False;
     if (earlyReturn != NULL)
         *earlyReturn = fmi3False;
     if (lastSuccessfulTime != NULL)
-        *lastSuccessfulTime = hh_instance_time(inst);
+        *lastSuccessfulTime = blk_instance_time(inst);
     return status;
 }
 

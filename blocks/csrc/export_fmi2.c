@@ -1,4 +1,4 @@
-/* The FMI 2.0 co-simulation interface of the hand plant FMU, over fmu_instance.c.
+/* The FMI 2.0 co-simulation interface of an exported diagram FMU, over export_instance.c.
  *
  * Only the common and co-simulation functions are exported (a co-simulation-only FMU
  * needs no model-exchange functions). Every failure is logged through the host's logger
@@ -7,18 +7,18 @@
 #include <stdlib.h>
 
 #include "fmi2Functions.h"
-#include "fmu_instance.h"
+#include "export_instance.h"
 
 typedef struct {
-    hh_instance *inst;
+    blk_instance *inst;
     fmi2CallbackFunctions functions;
-    double start_time;
+    int terminated; /* the diagram ended: fmi2GetBooleanStatus(fmi2Terminated) */
 } component;
 
 /* fmi2CallbackLogger takes a printf format. Hosts written in other languages often show it
  * as it is, so the message itself is passed as the format, its '%' doubled: both kinds of
  * host then show the text, and none can be made to read arguments that are not there. */
-static void log_to_host(void *environment, const char *instance, hh_status status, const char *category,
+static void log_to_host(void *environment, const char *instance, blk_status status, const char *category,
                         const char *message)
 {
     const component *c = environment;
@@ -36,13 +36,13 @@ static void log_to_host(void *environment, const char *instance, hh_status statu
 }
 
 /* The instance of a component, or NULL when there is none to talk to. */
-static hh_instance *instance_of(fmi2Component c)
+static blk_instance *instance_of(fmi2Component c)
 {
     return c != NULL ? ((component *)c)->inst : NULL;
 }
 
 #define INSTANCE_OR_ERROR(c)                                                                                         \
-    hh_instance *inst = instance_of(c);                                                                              \
+    blk_instance *inst = instance_of(c);                                                                              \
     if (inst == NULL)                                                                                                \
     return fmi2Error
 
@@ -51,14 +51,14 @@ static fmi2Status no_variables(fmi2Component c, size_t nvr, const char *type)
     INSTANCE_OR_ERROR(c);
     if (nvr == 0)
         return fmi2OK;
-    hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "this FMU has no %s variables", type);
+    blk_instance_log(inst, BLK_STATUS_ERROR, BLK_LOG_ERROR, "this FMU has no %s variables", type);
     return fmi2Error;
 }
 
 static fmi2Status unsupported(fmi2Component c, const char *function)
 {
     INSTANCE_OR_ERROR(c);
-    hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "%s is not supported by this FMU", function);
+    blk_instance_log(inst, BLK_STATUS_ERROR, BLK_LOG_ERROR, "%s is not supported by this FMU", function);
     return fmi2Error;
 }
 
@@ -76,7 +76,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
                                const fmi2String categories[])
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_set_logging(inst, loggingOn, nCategories, categories);
+    return (fmi2Status)blk_instance_set_logging(inst, loggingOn, nCategories, categories);
 }
 
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
@@ -92,17 +92,17 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     c->functions = *functions;
     const char *name = instanceName != NULL ? instanceName : "";
     if (fmuType != fmi2CoSimulation) {
-        log_to_host(c, name, HH_STATUS_ERROR, HH_LOG_ERROR, "this FMU supports co-simulation only");
+        log_to_host(c, name, BLK_STATUS_ERROR, BLK_LOG_ERROR, "this FMU supports co-simulation only");
         free(c);
         return NULL;
     }
     char folder[4096];
     const char *resources = NULL;
-    if (fmuResourceLocation == NULL || hh_path_from_uri(fmuResourceLocation, folder, sizeof folder) != 0)
-        log_to_host(c, name, HH_STATUS_ERROR, HH_LOG_ERROR, "the resource location is not a local file URI");
+    if (fmuResourceLocation == NULL || blk_path_from_uri(fmuResourceLocation, folder, sizeof folder) != 0)
+        log_to_host(c, name, BLK_STATUS_ERROR, BLK_LOG_ERROR, "the resource location is not a local file URI");
     else
         resources = folder;
-    c->inst = resources != NULL ? hh_instance_new(name, fmuGUID, resources, log_to_host, c, loggingOn) : NULL;
+    c->inst = resources != NULL ? blk_instance_new(name, fmuGUID, resources, log_to_host, c, loggingOn) : NULL;
     if (c->inst == NULL) {
         free(c);
         return NULL;
@@ -114,7 +114,7 @@ void fmi2FreeInstance(fmi2Component c)
 {
     if (c == NULL)
         return;
-    hh_instance_free(((component *)c)->inst);
+    blk_instance_free(((component *)c)->inst);
     free(c);
 }
 
@@ -123,46 +123,43 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 {
     (void)toleranceDefined;
     (void)tolerance;
-    (void)stopTimeDefined;
-    (void)stopTime;
     INSTANCE_OR_ERROR(c);
-    if (inst->phase != HH_INSTANTIATED) {
-        hh_instance_log(inst, HH_STATUS_ERROR, HH_LOG_ERROR, "fmi2SetupExperiment must come before initialization");
+    if (blk_instance_phase(inst) != BLK_INSTANTIATED) {
+        blk_instance_log(inst, BLK_STATUS_ERROR, BLK_LOG_ERROR, "fmi2SetupExperiment must come before initialization");
         return fmi2Error;
     }
-    ((component *)c)->start_time = startTime;
-    return fmi2OK;
+    return (fmi2Status)blk_instance_setup(inst, startTime, stopTimeDefined, stopTime);
 }
 
 fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_enter_initialization(inst, ((component *)c)->start_time);
+    return (fmi2Status)blk_instance_enter_initialization(inst);
 }
 
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_exit_initialization(inst);
+    return (fmi2Status)blk_instance_exit_initialization(inst);
 }
 
 fmi2Status fmi2Terminate(fmi2Component c)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_terminate(inst);
+    return (fmi2Status)blk_instance_terminate(inst);
 }
 
 fmi2Status fmi2Reset(fmi2Component c)
 {
     INSTANCE_OR_ERROR(c);
-    ((component *)c)->start_time = 0.0;
-    return (fmi2Status)hh_instance_reset(inst);
+    ((component *)c)->terminated = 0;
+    return (fmi2Status)blk_instance_reset(inst);
 }
 
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[])
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_get(inst, vr, nvr, value);
+    return (fmi2Status)blk_instance_get(inst, vr, nvr, value);
 }
 
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[])
@@ -189,7 +186,7 @@ fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[])
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_set(inst, vr, nvr, value);
+    return (fmi2Status)blk_instance_set(inst, vr, nvr, value);
 }
 
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[])
@@ -216,31 +213,31 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_get_state(inst, (hh_snapshot **)FMUstate);
+    return (fmi2Status)blk_instance_get_state(inst, (blk_snapshot **)FMUstate);
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_set_state(inst, (const hh_snapshot *)FMUstate);
+    return (fmi2Status)blk_instance_set_state(inst, (const blk_snapshot *)FMUstate);
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     (void)c;
-    return (fmi2Status)hh_snapshot_free((hh_snapshot **)FMUstate);
+    return (fmi2Status)blk_snapshot_free((blk_snapshot **)FMUstate);
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_snapshot_size(inst, (const hh_snapshot *)FMUstate, size);
+    return (fmi2Status)blk_snapshot_size(inst, (const blk_snapshot *)FMUstate, size);
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_snapshot_serialize(inst, (const hh_snapshot *)FMUstate, (unsigned char *)serializedState,
+    return (fmi2Status)blk_snapshot_serialize(inst, (const blk_snapshot *)FMUstate, (unsigned char *)serializedState,
                                              size);
 }
 
@@ -248,8 +245,8 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
                                    fmi2FMUstate *FMUstate)
 {
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_snapshot_deserialize(inst, (const unsigned char *)serializedState, size,
-                                               (hh_snapshot **)FMUstate);
+    return (fmi2Status)blk_snapshot_deserialize(inst, (const unsigned char *)serializedState, size,
+                                               (blk_snapshot **)FMUstate);
 }
 
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference vUnknown_ref[], size_t nUnknown,
@@ -290,7 +287,12 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 {
     (void)noSetFMUStatePriorToCurrentPoint;
     INSTANCE_OR_ERROR(c);
-    return (fmi2Status)hh_instance_do_step(inst, currentCommunicationPoint, communicationStepSize);
+    int terminated = 0;
+    fmi2Status status =
+        (fmi2Status)blk_instance_do_step(inst, currentCommunicationPoint, communicationStepSize, &terminated);
+    ((component *)c)->terminated = terminated;
+    /* the diagram ended during the step: fmi2Discard, with fmi2Terminated and the time it reached */
+    return terminated && status == fmi2OK ? fmi2Discard : status;
 }
 
 fmi2Status fmi2CancelStep(fmi2Component c)
@@ -310,7 +312,7 @@ fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *
     INSTANCE_OR_ERROR(c);
     if (s != fmi2LastSuccessfulTime || value == NULL)
         return unsupported(c, "fmi2GetRealStatus of this kind");
-    *value = hh_instance_time(inst);
+    *value = blk_instance_time(inst);
     return fmi2OK;
 }
 
@@ -326,7 +328,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
     INSTANCE_OR_ERROR(c);
     if (s != fmi2Terminated || value == NULL)
         return unsupported(c, "fmi2GetBooleanStatus of this kind");
-    *value = fmi2False;
+    *value = ((component *)c)->terminated ? fmi2True : fmi2False;
     return fmi2OK;
 }
 

@@ -1,0 +1,58 @@
+"""The framework's C sources and what is built from them (read by setup.py too).
+
+One list, so that the extension ``blocks._native``, the FMU binaries built at install
+and the ``sources/`` folder of an exported diagram FMU always hold the same files. Paths
+are relative to the repository root (``CSRC``). This module imports nothing of the
+package, so that setup.py can read it before anything is built.
+
+An exported FMU's binary is the op-table core, the library's kernels, the FMU instance
+and one FMI wrapper, plus a kernel-set file that lists the kernel types the binary holds
+(``export_kernels.c`` for the library alone; an application lists its own beside it).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+CSRC = "blocks/csrc"
+
+CORE = ["core.c"]
+CORE_HEADERS = ["core.h", "blocks_kernel.h"]
+LIBRARY = ["library.c", "lib_math.c", "lib_dynamic.c", "lib_sources.c"]
+LIBRARY_HEADERS = ["library.h", "lib_common.h"]
+HOST = ["host.c", "fmu.c", "fmu_me.c", "fmu_host.c"]
+HOST_HEADERS = ["fmu.h", "fmu_me.h", "fmu_calls.h", "fmu_host.h"]
+EXPORT = ["export_instance.c"]
+EXPORT_HEADERS = ["export_instance.h"]
+FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
+KERNEL_SET = "export_kernels.c"
+"""The kernel-set file of a binary holding the library's kernel types only."""
+
+CFLAGS = ["-O2", "-fvisibility=hidden", "-fno-math-errno", "-ffp-contract=off", "-Wall"]
+"""-ffp-contract=off: no fused multiply-adds, so every build rounds as the reference does."""
+
+
+def paths(names: list[str], folder: str = CSRC) -> list[str]:
+    return [f"{folder}/{name}" for name in names]
+
+
+EXTENSION_SOURCES = paths(HOST + CORE + LIBRARY)
+EXTENSION_DEPENDS = paths(CORE_HEADERS + LIBRARY_HEADERS + HOST_HEADERS)
+
+
+def fmu_sources(fmi: int) -> list[str]:
+    """The framework's files (repository paths) in every exported FMU of FMI ``fmi``, its
+    kernel-set file excepted: C files first, then headers."""
+    return paths(CORE + LIBRARY + EXPORT + [FMI_WRAPPERS[fmi]] + CORE_HEADERS + LIBRARY_HEADERS + EXPORT_HEADERS)
+
+
+def fmi_headers() -> str:
+    """The folder of the FMI 2 / 3 headers the libraries are built against (fmpy's copy)."""
+    spec = importlib.util.find_spec("fmpy")
+    if spec is None or not spec.submodule_search_locations:
+        raise RuntimeError("building the FMU binaries needs fmpy (for the FMI headers); pip installs it as a build requirement")
+    folder = Path(list(spec.submodule_search_locations)[0]) / "c-code"
+    if not (folder / "fmi2Functions.h").is_file() or not (folder / "fmi3Functions.h").is_file():
+        raise RuntimeError(f"fmpy's FMI headers are missing from {folder}")
+    return str(folder)

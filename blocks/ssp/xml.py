@@ -1,0 +1,109 @@
+"""The SSP's XML: its namespaces and prefixes, safe parsing with lines, numbers as exact text.
+
+SSD, SSV and SSM files come from other tools, so they are parsed without DTDs, entities or
+network access, and under a size limit. Every element keeps its source line
+(``sourceline``), which the messages about it give. Names are written with the
+prefixes the standard's examples use (``ssd:``, ``ssc:``, ``ssv:``, ``ssm:``), since some
+readers (libcosim) match the prefixes rather than the namespaces.
+"""
+
+from __future__ import annotations
+
+from fractions import Fraction
+from pathlib import Path
+from typing import Any
+
+SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
+SSB = "http://ssp-standard.org/SSP1/SystemStructureSignalDictionary"
+OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+OMS = "https://raw.githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"
+PREFIXES = {"ssd": SSD, "ssc": SSC, "ssv": SSV, "ssm": SSM, "osp": OSP, "oms": OMS}
+
+OSP_ANNOTATION = "com.opensimulationplatform"
+"""The annotation type libcosim reads (step-size hints, the fixed-step algorithm)."""
+OMS_ANNOTATION = "org.openmodelica"
+"""The annotation type OMSimulator reads (its simulation information)."""
+
+MAX_XML_BYTES = 16 * 1024 * 1024
+"""Limit on the size of one SSD, SSV or SSM file."""
+
+
+class XmlError(ValueError):
+    """An XML file that cannot be read: ``line`` where, if known."""
+
+    def __init__(self, message: str, line: int | None = None):
+        super().__init__(message)
+        self.line = line
+
+
+def q(prefix: str, name: str) -> str:
+    """The qualified (Clark) name ``{namespace}name`` of ``prefix:name``."""
+    return f"{{{PREFIXES[prefix]}}}{name}"
+
+
+def parse_file(path: Path) -> tuple[Any, str]:
+    """The root element of the XML file ``path`` and its text; XmlError if it cannot be read."""
+    from lxml import etree
+
+    try:
+        size = path.stat().st_size
+        if size > MAX_XML_BYTES:
+            raise XmlError(f"the file is {size} bytes, more than the limit of {MAX_XML_BYTES}")
+        data = path.read_bytes()
+    except OSError as exc:
+        raise XmlError(f"cannot be read: {exc.strerror or exc}") from None
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
+                             remove_comments=True, remove_pis=True)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        raise XmlError(f"not well-formed XML: {exc.msg}", exc.lineno) from None
+    return root, data.decode("utf-8", "replace")
+
+
+def local(element: Any) -> str:
+    """The element's name without its namespace."""
+    tag = element.tag
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+def namespace(element: Any) -> str:
+    tag = element.tag
+    return tag[1:].split("}", 1)[0] if isinstance(tag, str) and tag.startswith("{") else ""
+
+
+def elements(parent: Any) -> list:
+    """The child elements of ``parent`` (comments and text left out)."""
+    return [c for c in parent if isinstance(c.tag, str)] if parent is not None else []
+
+
+def child(parent: Any, prefix: str, name: str) -> Any:
+    return parent.find(q(prefix, name)) if parent is not None else None
+
+
+def children(parent: Any, prefix: str, name: str) -> list:
+    return parent.findall(q(prefix, name)) if parent is not None else []
+
+
+def annotations(element: Any, kind: str) -> list:
+    """The contents (child elements) of ``element``'s ``ssd:Annotations`` of type ``kind``."""
+    found = []
+    for annotation in children(child(element, "ssd", "Annotations"), "ssc", "Annotation"):
+        if annotation.get("type") == kind:
+            found.extend(elements(annotation))
+    return found
+
+
+def exact(text: str) -> Fraction:
+    """A number written in the XML (``xs:double``: ``0.001``, ``1e-4``) as the exact
+    rational of its decimal text; ValueError if it is not one."""
+    return Fraction(text.strip())
+
+
+def shown(text: Any) -> str:
+    """An attribute's text for a message: at most 60 characters, quoted."""
+    s = str(text)
+    return repr(s if len(s) <= 60 else s[:57] + "...")

@@ -1,0 +1,79 @@
+"""A test's readiness sign inside the process under test: a signal sent at a chosen point.
+
+Put this folder first on PYTHONPATH and set ``SIGNAL_AT`` to where the process should
+signal itself, and ``SIGNAL_SEND`` to the signals (``SIGTERM,SIGINT``; default SIGINT):
+
+- ``import:numpy``: when the process starts to import ``numpy`` (its start-up);
+- ``blocks.loader:read_builder`` or ``blocks.results:Results.write_files``: at the first
+  call of that function or method, before it runs (``SIGNAL_CALL=N``: at its N-th call).
+
+The signals are sent by the process to itself at exactly that point, so a test of what a
+signal does in each phase (imports, loading, simulating, saving, plotting) needs no sleep
+and does not depend on the machine's speed.
+"""
+
+import importlib.abc
+import os
+import signal
+import sys
+
+_AT = os.environ.get("SIGNAL_AT", "")
+_SEND = [getattr(signal, name) for name in os.environ.get("SIGNAL_SEND", "SIGINT").split(",")]
+_CALL = int(os.environ.get("SIGNAL_CALL", "1"))
+_calls = 0
+
+
+def _fire() -> None:
+    global _calls
+    _calls += 1
+    if _calls == _CALL:
+        for signum in _SEND:
+            os.kill(os.getpid(), signum)
+
+
+class _Watch(importlib.abc.MetaPathFinder):
+    """Fires when the module named in SIGNAL_AT is imported (``import:NAME``), or wraps the
+    function it names once its module has been imported."""
+
+    def __init__(self, module: str, attr: str | None):
+        self.module, self.attr = module, attr
+
+    def find_spec(self, name, path=None, target=None):
+        if name != self.module:
+            return None
+        if self.attr is None:
+            _fire()
+            return None
+        sys.meta_path.remove(self)
+        try:
+            spec = importlib.util.find_spec(name)
+        finally:
+            sys.meta_path.insert(0, self)
+        loader = spec.loader
+        attr = self.attr
+
+        class _Loader(importlib.abc.Loader):
+            def create_module(self, spec):
+                return loader.create_module(spec)
+
+            def exec_module(self, module):
+                loader.exec_module(module)
+                owner_name, _, method = attr.rpartition(".")
+                owner = getattr(module, owner_name) if owner_name else module
+                real = getattr(owner, method)
+
+                def signalling(*args, **kwargs):
+                    _fire()
+                    return real(*args, **kwargs)
+
+                setattr(owner, method, signalling)
+
+        spec.loader = _Loader()
+        return spec
+
+
+if _AT:
+    import importlib.util
+
+    where, _, what = _AT.partition(":")
+    sys.meta_path.insert(0, _Watch(what, None) if where == "import" else _Watch(where, what))
