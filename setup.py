@@ -2,7 +2,8 @@
 
 Metadata lives in pyproject.toml; this file only declares what is compiled, because
 setuptools' extension support is the build path every pip and every Python install
-already has (no CMake, no code generator). The framework's extension ``blocks._native``
+already has (no CMake, no code generator), and copies the shipped diagrams into the
+package (``hierhand/diagrams/``), which package data cannot reach from outside it. The framework's extension ``blocks._native``
 is the CPython host (``host.c``) of the op-table interpreter (``core.c``, plain C99 that
 needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``); the
 hand's, ``hierhand._native``, binds its C core. Besides the extensions the build links
@@ -23,6 +24,7 @@ from pathlib import Path
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
+from setuptools.command.build_py import build_py
 
 ROOT = Path(__file__).resolve().parent
 
@@ -80,6 +82,27 @@ class BuildNative(build_ext):
         return outputs
 
 
+class BuildPy(build_py):
+    """build_py that also puts the shipped diagrams (``diagrams/*.yaml``) into the package,
+    as ``hierhand/diagrams/``, so that an installed wheel runs ``hierhand reproduce``
+    without the repository. An editable install reads the repository's folder itself."""
+
+    def run(self) -> None:
+        super().run()
+        if getattr(self, "editable_mode", False):
+            return
+        target = Path(self.build_lib) / SHIPPED_DIAGRAMS
+        target.mkdir(parents=True, exist_ok=True)
+        for diagram in sorted((ROOT / "diagrams").glob("*.yaml")):
+            self.copy_file(str(diagram), str(target / diagram.name))
+
+    def get_outputs(self, include_bytecode: bool = True) -> list[str]:
+        shipped = [str(Path(self.build_lib) / SHIPPED_DIAGRAMS / p.name) for p in (ROOT / "diagrams").glob("*.yaml")]
+        return super().get_outputs(include_bytecode) + shipped
+
+
+SHIPPED_DIAGRAMS = Path("hierhand", "diagrams")
+
 setup(
     ext_modules=[
         Extension(
@@ -99,5 +122,5 @@ setup(
             libraries=["m"],
         )
     ],
-    cmdclass={"build_ext": BuildNative},
+    cmdclass={"build_ext": BuildNative, "build_py": BuildPy},
 )

@@ -72,11 +72,13 @@ class ParameterError(ValueError):
     one value is to blame) with a message naming it. The diagram loader reports each
     problem on a line of its own, at the line of the diagram, params file or ``--set``
     that gave that value; any other exception of a constructor is one problem at the
-    block's parameters.
+    block's parameters. ``hint``, if given, says how to fix them (the loader's default
+    hint points to the type's parameter documentation).
     """
 
-    def __init__(self, problems, message: str | None = None):
+    def __init__(self, problems, message: str | None = None, hint: str = ""):
         self.problems = [(tuple(path), str(text)) for path, text in problems]
+        self.hint = hint
         super().__init__(message if message is not None else "; ".join(t for _, t in self.problems))
 
 

@@ -14,15 +14,25 @@ can run.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Mapping
+from typing import Any, Mapping
 
+from .diagram import Diagram
 from .issues import Issue
 from .records import (Annotation, BlockEntry, DiagramRecord, DiagramSource, LogRequest, PortEntry, Problem, ReferenceEntry,
                       Site, SubsystemEntry, WireEntry, call_site)
 
-if TYPE_CHECKING:
-    from .diagram import Diagram
 
+
+def _wiring_svg(diagram: Diagram) -> str:
+    """Jupyter's view of a Diagram: its wiring graph. ``blocks.graph`` is a layer above the
+    diagram's data, so the view is attached here, where every Diagram is made, and the
+    drawing is imported when a diagram is first shown."""
+    from .graph import svg_text
+
+    return svg_text(diagram)
+
+
+Diagram._repr_svg_ = _wiring_svg
 
 class DiagramBuilder(DiagramRecord):
     """Records a diagram, then ``build()`` checks and makes it.

@@ -471,9 +471,9 @@ class Constructor:
                 block = cls(**arguments)
             except Exception as exc:  # a block's own message says which parameter is wrong
                 problems = exc.problems if isinstance(exc, ParameterError) else [((), str(exc))]
+                hint = getattr(exc, "hint", "") or f"see 'hierhand blocks {cls.registered_name()}' for its parameters"
                 for path, text in problems:
-                    self.param_error(p, path, f"block '{name}' ({type_name}): {text}",
-                                     f"see 'hierhand blocks {cls.registered_name()}' for its parameters")
+                    self.param_error(p, path, f"block '{name}' ({type_name}): {text}", hint)
                 return None
         try:
             block.bind(period)

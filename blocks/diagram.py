@@ -12,6 +12,7 @@ can be planned and run any number of times.
 
 from __future__ import annotations
 
+import dataclasses
 import posixpath
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -274,6 +275,18 @@ class Diagram:
     subsystems: dict[str, Composite] = field(default_factory=dict)
     """Every subsystem, nested ones too, by path, in the order they are written."""
 
+    def __repr__(self) -> str:
+        """'<Diagram 'toy-multirate' (diagrams/toy.yaml): 6 blocks, 7 connections, logs plant.y; t_end 1 s>'."""
+        from .timebase import format_duration
+
+        n = len(self.subsystems)
+        subs = f" ({n} subsystem{'s' if n != 1 else ''})" if n else ""
+        logged = [e.signal for e in self.log]
+        logs = ", ".join(logged) if len(logged) <= 3 else f"{len(logged)} signals"
+        t_end = f"; t_end {format_duration(self.t_end)}" if self.t_end is not None else ""
+        return (f"<Diagram {self.name!r} ({self.file}): {len(self.blocks)} blocks{subs}, "
+                f"{len(self.connections)} connections, logs {logs or 'nothing'}{t_end}>")
+
     @property
     def inputs(self) -> dict[str, DiagramPort]:
         """The diagram's own inputs (``inputs:``): a diagram meant to be a subsystem."""
@@ -307,6 +320,14 @@ class Diagram:
         return self.issue(None, f"diagram '{self.name}' has {' and '.join(parts)} that an including "
                           "diagram gives it: it runs only as a subsystem",
                           f"use it as a block of another diagram ({use}) and connect its inputs there")
+
+    def decimated(self, factor: int) -> "Diagram":
+        """This diagram logging every ``factor``-th sample of what it logs (each log entry's
+        own ``decimate`` times ``factor``): ``run --decimate``. ValueError unless ``factor``
+        is a positive whole number."""
+        if isinstance(factor, bool) or not isinstance(factor, int) or factor < 1:
+            raise ValueError(f"decimation must be a positive whole number, got {factor!r}")
+        return dataclasses.replace(self, log=[dataclasses.replace(e, decimate=e.decimate * factor) for e in self.log])
 
     def drivers_of(self, block: str, port: str) -> list[Connection]:
         """The connections feeding input ``block.port``: one, or several that each drive some

@@ -17,7 +17,7 @@ import numpy as np
 
 from .limits import MAX_PLOT_AXES, MAX_PLOT_LINES
 from .plot_markers import Marker, markers as run_markers
-from .plot_select import Trace, select
+from .plot_select import Trace, by_unit, select
 from .results import Results
 
 AXES_PER_PAGE = 6
@@ -27,6 +27,15 @@ FIGURE_WIDTH = 11.0
 AXES_HEIGHT = 2.3
 TITLE_WIDTH = 110
 STOP_MARGIN = 0.02
+DPI = 110
+LEFT = 1.25         # inches left of the axes: tick labels and a two-line axis label
+BOTTOM = 0.55       # below the last axis: its tick labels and the time label
+TITLE_LINE = 0.24   # per line of the page's title
+GAP = 0.3           # between two axes
+LEGEND_CHAR = 0.068  # inches per character of a legend entry ("small" text)
+LEGEND_HANDLE = 0.6  # a legend entry's line sample and spacing
+PNG = {"compress_level": 3}
+"""PNG settings: a faster deflate than the default 6, for a few percent more bytes."""
 MARKER_COLOUR = "dimgray"
 MARKER_GID = "marker"
 """The gid of every artist that draws a marker (their lines, spans and texts)."""
@@ -35,40 +44,50 @@ MARKER_GID = "marker"
 def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | None = None,
                  title: str | None = None, markers: bool | Sequence[Marker] = True) -> list[Path]:
     """Write PNG(s) of ``signals`` (selections, see ``blocks.plot_select``; default every
-    logged signal, one per axis) to ``path``; more than 6 axes make pages.
+    logged signal, one per axis) to ``path``; more than 6 axes make pages, as even as can
+    be (13 axes: 5, 4 and 4), named ``STEM-1.png``, ``STEM-2.png``, ...
 
-    Discrete signals hold between samples, so they are drawn as steps; a signal's last
-    value is held to the run's end time (where a block ended it, if one did, as the title
-    says), or for a failed or interrupted run to where it stopped, which a vertical line
-    marks with the status. ``markers``: the events to mark on every axis, or True for the
-    diagram's (``blocks.plot_markers.markers``), False for none.
+    A whole signal whose elements differ in unit is an axis per unit (``plant.obj[x,y]``
+    in m, ``plant.obj[theta]`` in rad), so that no axis mixes units. Discrete signals hold
+    between samples, so they are drawn as steps; a signal's last value is held to the
+    run's end time (where a block ended it, if one did, as the title says), or for a failed
+    or interrupted run to where it stopped, which a vertical line marks with the status.
+    ``markers``: the events to mark on every axis, or True for the diagram's
+    (``blocks.plot_markers.markers``), False for none.
     Raises ``SelectionError`` (a ValueError) for a selection of nothing logged. Returns
     the files written.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     selections = list(signals) if signals else list(results)
     if not selections:
         raise ValueError("no signals to plot: the run logged none (add a 'log:' list to the diagram)")
     if len(selections) > MAX_PLOT_AXES:
         check_plot_size(len(selections), 0)
-    axes = [select(results, s) for s in selections]
+    axes = [axis for s in selections for axis in by_unit(results, select(results, s))]
     check_plot_size(len(axes), sum(len(tr.columns) for traces in axes for tr in traces))
     events = run_markers(results.info)[0] if markers is True else list(markers or [])
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    pages = [axes[i:i + AXES_PER_PAGE] for i in range(0, len(axes), AXES_PER_PAGE)]
+    pages = balanced(axes, AXES_PER_PAGE)
     written = []
     for number, page in enumerate(pages, start=1):
         fig = figure(results, page, title, events)
         out = path if len(pages) == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
-        fig.savefig(out, dpi=110)
-        plt.close(fig)
+        fig.savefig(out, dpi=DPI, pil_kwargs=PNG)
         written.append(out)
     return written
+
+
+def balanced(items: list, most: int) -> list[list]:
+    """``items`` in as few pages of at most ``most`` as can be, the pages as even as can
+    be (the first ones one longer)."""
+    count = -(-len(items) // most)
+    size, extra = divmod(len(items), count)
+    pages, start = [], 0
+    for page in range(count):
+        stop = start + size + (page < extra)
+        pages.append(items[start:stop])
+        start = stop
+    return pages
 
 
 class PlotSizeError(ValueError):
@@ -95,18 +114,33 @@ def figure(results: Results, selections: Sequence[str | list[Trace]], title: str
     member, so nine joints read as three fingers of three. An axis of several signals
     names each line ``signal[element]``. The time axis spans the data: from the first
     sample to the end time, or to where a failed or interrupted run stopped, which a
-    dashed line marks, with a dot on each element's last sample."""
-    import matplotlib.pyplot as plt
+    dashed line marks, with a dot on each element's last sample.
+
+    The page is laid out by measure (margins in inches for the labels, the title and the
+    widest legend) rather than by matplotlib's constrained layout, which would measure
+    every text of the page once more before drawing it."""
+    from matplotlib.figure import Figure
 
     axes_traces = [select(results, s) if isinstance(s, str) else list(s) for s in selections]
     end, stop = time_span(results)
     firsts = [float(results[tr.signal][0][0]) for traces in axes_traces for tr in traces
               if len(results[tr.signal][0])]
     start = min(firsts, default=0.0)
-    fig, axes = plt.subplots(len(axes_traces), 1, sharex=True, squeeze=False, layout="constrained",
-                             figsize=(FIGURE_WIDTH, 1.0 + AXES_HEIGHT * len(axes_traces)))
+    heading = title or results.info.get("diagram", "")
+    note = results.end_note if results.complete else results.status
+    if note:
+        heading += "\n" + textwrap.fill(f"[{note}]", TITLE_WIDTH)
+    n = len(axes_traces)
+    top = 0.25 + TITLE_LINE * (heading.count("\n") + 1)
+    right = max([0.3] + [legend_width(results, traces) for traces in axes_traces])
+    height = top + BOTTOM + AXES_HEIGHT * n
+    fig = Figure(figsize=(FIGURE_WIDTH, height))
+    fig.subplots_adjust(left=LEFT / FIGURE_WIDTH, right=1 - right / FIGURE_WIDTH, top=1 - top / height,
+                        bottom=BOTTOM / height, hspace=GAP / (AXES_HEIGHT - GAP))
+    axes = fig.subplots(n, 1, sharex=True, squeeze=False)
+    columns = int((FIGURE_WIDTH - LEFT - right) * DPI)
     for ax, traces in zip(axes[:, 0], axes_traces):
-        lines = _draw_traces(ax, results, traces, end, stop)
+        lines = _draw_traces(ax, results, traces, end, stop, columns)
         if 1 < lines <= MAX_LEGEND:
             ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small", frameon=False,
                       ncol=1 if lines <= LEGEND_ROWS else 2, borderaxespad=0.0, handlelength=2.5)
@@ -119,16 +153,41 @@ def figure(results: Results, selections: Sequence[str | list[Trace]], title: str
                             xytext=(0, 3), textcoords="offset points", ha="right", va="bottom",
                             color="tab:red", fontsize="small")
     axes[-1, 0].set_xlabel("time (s)")
-    heading = title or results.info.get("diagram", "")
-    note = results.end_note if results.complete else results.status
-    if note:
-        heading += "\n" + textwrap.fill(f"[{note}]", TITLE_WIDTH)
-    fig.suptitle(heading)
+    fig.suptitle(heading, y=1 - 0.12 / height, va="top")
     return fig
 
 
-def _draw_traces(ax, results: Results, traces: list[Trace], end: float | None, stop: float | None) -> int:
-    """Draw an axis's traces; returns how many lines carry a legend label."""
+def legend_width(results: Results, traces: list[Trace]) -> float:
+    """Inches the legend of an axis of ``traces`` takes right of it (0: none)."""
+    labels = [f"{tr.signal}[{label}] (?)" if len(traces) > 1 else f"{label} (?)"
+              for tr in traces for label in tr.labels]
+    if not 1 < len(labels) <= MAX_LEGEND:
+        return 0.0
+    columns = 1 if len(labels) <= LEGEND_ROWS else 2
+    return 0.2 + columns * (LEGEND_HANDLE + LEGEND_CHAR * max(map(len, labels)))
+
+
+def envelope(t: np.ndarray, v: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray]:
+    """Samples ``(t, v)`` (held after each) thinned for a plot ``columns`` pixels wide to
+    what draws the same picture: in each pixel column its first value, its least and its
+    greatest at the column's first time, and its last value at its last time, so every
+    excursion still shows and the value held into the next column is the last one. Fewer
+    samples than four per column are returned as they are."""
+    if len(t) <= 4 * columns or t[-1] <= t[0]:
+        return t, v
+    bucket = np.minimum(((t - t[0]) / (t[-1] - t[0]) * columns).astype(np.int64), columns - 1)
+    starts = np.flatnonzero(np.r_[True, bucket[1:] != bucket[:-1]])
+    lasts = np.r_[starts[1:] - 1, len(t) - 1]
+    low, high = np.minimum.reduceat(v, starts, axis=0), np.maximum.reduceat(v, starts, axis=0)
+    times = np.column_stack([t[starts], t[starts], t[starts], t[lasts]]).ravel()
+    values = np.stack([v[starts], low, high, v[lasts]], axis=1).reshape(-1, v.shape[1])
+    return times, values
+
+
+def _draw_traces(ax, results: Results, traces: list[Trace], end: float | None, stop: float | None,
+                 columns: int = 1000) -> int:
+    """Draw an axis's traces (thinned to ``columns`` pixel columns, see ``envelope``);
+    returns how many lines carry a legend label."""
     overlaid = len(traces) > 1
     if overlaid:
         styles = line_styles([f"{tr.signal}[{label}]" for tr in traces for label in tr.labels])
@@ -139,6 +198,7 @@ def _draw_traces(ax, results: Results, traces: list[Trace], end: float | None, s
         last_t, last_v = (t[-1], v[-1]) if len(t) else (None, None)
         if end is not None and len(t) and t[-1] < end:
             t, v = np.append(t, end), np.vstack([v, v[-1:]])
+        t, v = envelope(t, v, columns)
         width = v.shape[1]
         all_units = results.units(tr.signal)
         units = [all_units[c] for c in tr.columns] if all_units is not None else None

@@ -67,6 +67,24 @@ def select(results: Results, text: str) -> list[Trace]:
     return traces
 
 
+def by_unit(results: Results, traces: list[Trace]) -> list[list[Trace]]:
+    """The axes an axis of ``traces`` becomes so that each has one unit: a whole signal
+    whose elements differ in unit (``plant.obj``: x, y in m, theta in rad) one axis per
+    unit, ``plant.obj[x,y]`` and ``plant.obj[theta]``, in the order the units come; any
+    other selection (elements, overlays) one axis, as asked."""
+    if len(traces) != 1 or not traces[0].whole:
+        return [traces]
+    (tr,) = traces
+    units = results.units(tr.signal)
+    if units is None or len(set(units)) < 2:
+        return [traces]
+    groups: dict[str, list[int]] = {}
+    for column, unit in zip(tr.columns, units):
+        groups.setdefault(unit, []).append(column)
+    return [[Trace(tr.signal, tuple(cols), tuple(tr.labels[c] for c in cols),
+                   f"{tr.signal}[{','.join(tr.labels[c] for c in cols)}]")] for cols in groups.values()]
+
+
 def _trace(results: Results, signal: str, elements: str | None) -> Trace:
     width = results[signal][1].shape[1]
     given = results.element_labels(signal)

@@ -21,7 +21,7 @@ import numpy as np
 from .api_args import boolean
 from .limits import MAX_RESULTS_BYTES
 from .npzfile import read_npz
-from .results_folder import RUN_JSON, SIGNALS_CSV, SIGNALS_NPZ, reading, writing
+from .results_folder import RUN_JSON, SIGNALS_CSV, SIGNALS_MAT, SIGNALS_NPZ, reading, writing
 
 TIME_PREFIX = "time:"
 
@@ -38,6 +38,16 @@ def held_index(t: np.ndarray, times, rtol: float = 0.0) -> np.ndarray:
     if rtol:
         times = times + rtol * max(1.0, float(np.abs(times).max(initial=0.0)))
     return np.searchsorted(t, times, side="right") - 1
+
+
+CSV_ROWS = 4096
+"""Rows of signals.csv formatted at a time."""
+
+
+def check_digits(digits: int | None) -> None:
+    """ValueError unless ``digits`` is None (shortest round trip) or 1 to 17."""
+    if digits is not None and (isinstance(digits, bool) or not isinstance(digits, int) or not 1 <= digits <= 17):
+        raise ValueError(f"CSV digits must be a whole number from 1 to 17 (17 keeps every double), got {digits!r}")
 
 
 class ResultsError(Exception):
@@ -72,6 +82,17 @@ class Results:
 
     def __len__(self) -> int:
         return len(self.signals)
+
+    def __repr__(self) -> str:
+        from .results_summary import as_text
+
+        return as_text(self)
+
+    def _repr_html_(self) -> str:
+        """Jupyter's view: the status and a table of the signals."""
+        from .results_summary import as_html
+
+        return as_html(self)
 
     @property
     def status(self) -> str:
@@ -136,22 +157,39 @@ class Results:
 
     # -- files ---------------------------------------------------------------------
 
-    def save(self, directory: str | Path, csv: bool = False) -> Path:
-        """Write signals.npz and run.json (and signals.csv) into ``directory``, replacing
-        the result files of the run saved there before as one set (a complete run's kept
-        in ``previous-complete-run`` when this one is not complete: ``results_folder``)."""
+    def save(self, directory: str | Path, csv: bool = False, mat: bool = False,
+             csv_digits: int | None = None) -> Path:
+        """Write signals.npz and run.json (and signals.csv, signals.mat) into ``directory``,
+        replacing the result files of the run saved there before as one set (a complete
+        run's kept in ``previous-complete-run`` when this one is not complete:
+        ``results_folder``)."""
         boolean("csv", csv)
+        boolean("mat", mat)
         with writing(directory) as staged:
-            self.write_files(staged, csv)
+            self.write_files(staged, csv, mat=mat, csv_digits=csv_digits)
         return Path(directory)
 
-    def write_files(self, folder: Path, csv: bool = False) -> None:
-        """Write signals.npz, run.json (and signals.csv) into ``folder`` as they are: the
-        staging folder of ``results_folder.writing``, which makes them one set."""
+    def save_mat(self, path: str | Path) -> Path:
+        """Write the signals, with their times, units and element names, and the run's
+        record as a MATLAB MAT file (see ``blocks.results_mat``); needs scipy."""
+        from .atomic_file import atomic_writer
+        from .results_mat import write_mat
+
+        with atomic_writer(path) as f:
+            write_mat(self, f)
+        return Path(path)
+
+    def write_files(self, folder: Path, csv: bool = False, mat: bool = False, csv_digits: int | None = None) -> None:
+        """Write signals.npz, run.json (and signals.csv with ``csv``, signals.mat with
+        ``mat``) into ``folder`` as they are: the staging folder of
+        ``results_folder.writing``, which makes them one set."""
+        from .results_mat import write_mat
+
         for name, (_, v) in self.signals.items():
             if np.ndim(v) != 2:
                 raise ValueError(f"signal '{name}' cannot be saved: its values must be an array of "
                                  f"shape (samples, width), got shape {np.shape(v)}")
+        check_digits(csv_digits)
         arrays = {}
         for name, (t, v) in self.signals.items():
             arrays[name] = v
@@ -160,7 +198,10 @@ class Results:
             np.savez(f, **arrays)
         if csv:
             with open(folder / SIGNALS_CSV, "wb") as f:
-                self.write_csv(f)
+                self.write_csv(f, csv_digits)
+        if mat:
+            with open(folder / SIGNALS_MAT, "wb") as f:
+                write_mat(self, f)
         info = dict(self.info)
         info["signals"] = {n: {"width": int(v.shape[1]), "samples": int(v.shape[0])}
                            for n, (t, v) in self.signals.items()}
@@ -189,14 +230,17 @@ class Results:
         units = self.units(name)
         return units[0] if units and units[0] and all(u == units[0] for u in units) else None
 
-    def write_csv(self, f) -> None:
+    def write_csv(self, f, digits: int | None = None) -> None:
         """Columns ``time`` (every logged sample time) and each signal held at those times.
 
         A signal of width 1 is the column ``block.port``; the columns of a wider one are
         ``block.port[i]``, counting from 0, unless its block names its elements
         (``Block.element_labels``): then ``block.port[label]``, so an FMU's ports keep the
-        FMU's own indices (``plant.y[1]``, ``plant.A[1,2]``).
+        FMU's own indices (``plant.y[1]``, ``plant.A[1,2]``). Numbers are written as the
+        shortest text that reads back as the same double (``0.001``, not
+        ``0.0010000000000000000208``), or with ``digits`` significant digits (1 to 17).
         """
+        check_digits(digits)
         if not self.signals:
             f.write(b"time\n")
             return
@@ -211,7 +255,12 @@ class Results:
                 header += [name] if v.shape[1] == 1 else [f"{name}[{i}]" for i in range(v.shape[1])]
         names = io.StringIO()
         csv.writer(names, lineterminator="").writerow(header)  # quotes labels such as "A[1,2]"
-        np.savetxt(f, np.hstack(columns), delimiter=",", header=names.getvalue(), comments="", fmt="%.17g")
+        f.write((names.getvalue() + "\n").encode("utf-8"))
+        number = float.__repr__ if digits is None else f"%.{digits}g".__mod__
+        table = np.hstack(columns)
+        for start in range(0, len(table), CSV_ROWS):
+            rows = table[start:start + CSV_ROWS].tolist()
+            f.write("".join(",".join(map(number, row)) + "\n" for row in rows).encode("ascii"))
 
     @classmethod
     def load(cls, directory: str | Path) -> "Results":

@@ -1,9 +1,9 @@
 """A results folder written as one consistent set of files, whoever else writes there.
 
-A run's files (signals.npz, run.json, signals.csv with --csv, plots/signals*.png with
---plot) must belong together: two runs into one folder must never leave one run's
-run.json beside the other's signals.npz, nor a run without --csv an earlier run's
-signals.csv. So a run writes its files into a private staging folder inside the results
+A run's files (signals.npz, run.json, signals.csv with --csv, signals.mat with --mat,
+plots/signals*.png with --plot) must belong together: two runs into one folder must
+never leave one run's run.json beside the other's signals.npz, nor a run without --csv
+an earlier run's signals.csv. So a run writes its files into a private staging folder inside the results
 folder, then, holding an exclusive lock on the folder, replaces the previous run's result
 files with them: run.json is removed first and put in last, so a folder with a run.json
 holds one complete set, and a folder left without one (the machine stopped while the
@@ -33,6 +33,7 @@ except ImportError:  # Windows: no flock
 
 SIGNALS_NPZ = "signals.npz"
 SIGNALS_CSV = "signals.csv"
+SIGNALS_MAT = "signals.mat"
 RUN_JSON = "run.json"
 PLOTS = "plots"
 PLOT_PATTERN = "signals*.png"
@@ -156,7 +157,7 @@ def _replace(directory: Path, staged: Path) -> Path | None:
         kept = _keep(directory, plots_link)
         _note_kept(staged / RUN_JSON, kept.name)
     marker.unlink(missing_ok=True)
-    for name in (SIGNALS_NPZ, SIGNALS_CSV):
+    for name in (SIGNALS_NPZ, SIGNALS_CSV, SIGNALS_MAT):
         if (staged / name).exists():
             os.replace(staged / name, directory / name)
         else:
@@ -189,7 +190,7 @@ def _keep(directory: Path, plots_link: bool) -> Path:
             break
         except FileExistsError:
             continue
-    for name in (SIGNALS_NPZ, SIGNALS_CSV, RUN_JSON):
+    for name in (SIGNALS_NPZ, SIGNALS_CSV, SIGNALS_MAT, RUN_JSON):
         if os.path.lexists(directory / name):
             os.replace(directory / name, kept / name)
     plots = directory / PLOTS

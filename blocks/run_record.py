@@ -130,7 +130,8 @@ def _signals(diagram: Diagram, schedule: Schedule, binding: Binding) -> dict[str
 def info(diagram: Diagram, schedule: Schedule, t_end: Fraction, status: str, wall: float, t_stop: float | None,
          ended: dict | None, labels: dict[str, list[str]], units: dict[str, str | list[str]]) -> dict:
     """run.json's record of the run (``element_labels`` only when a block names elements,
-    ``units`` only when a block knows the units of a logged signal)."""
+    ``units`` only when a block knows the units of a logged signal, ``decimate`` only for
+    signals logged at fewer than every hit)."""
     simulated = float(t_end) if t_stop is None else t_stop
     record = {
         "diagram": diagram.name,
@@ -150,6 +151,9 @@ def info(diagram: Diagram, schedule: Schedule, t_end: Fraction, status: str, wal
     }
     if diagram.subsystems:
         record["subsystems"] = diagram.composition()
+    decimated = {e.signal: e.decimate for e in diagram.log if e.decimate > 1}
+    if decimated:
+        record["decimate"] = decimated
     if labels:
         record["element_labels"] = labels
     if units:

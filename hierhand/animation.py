@@ -1,9 +1,9 @@
 """Animation of a run (GIF, or MP4 with ffmpeg): the hand, the object and the contact forces.
 
 ``animate_run(results, "hand.gif")`` draws the ``HandPlant`` of a results folder (see
-``blocks.Results``) frame by frame with ``hierhand.model.draw.draw_hand`` and writes a GIF
-with matplotlib's Pillow writer (``*.mp4``: matplotlib's FFMpeg writer, when an ffmpeg
-executable is on the PATH or ``imageio_ffmpeg`` is installed). It needs the plant's ``q``
+``blocks.Results``) frame by frame with ``hierhand.model.draw.draw_hand`` and writes each
+frame as it is drawn (``hierhand.frame_writers``: a GIF, or an MP4 through ffmpeg, when an
+ffmpeg executable is on the PATH or ``imageio_ffmpeg`` is installed), keeping none. It needs the plant's ``q``
 and ``obj`` logged; with ``fn`` and ``normal`` (and ``ft``) logged too it draws the force
 each fingertip applies to the object, ``fn * n + ft * t`` with ``t`` the normal ``n``
 turned +90 degrees, at the contact point (tip centre + tip radius * n), and its normal
@@ -130,20 +130,17 @@ def _check_format(path: Path) -> None:
 
 
 def _writer(path: Path, fps: float):
-    if path.suffix.lower() == ".gif":
-        from matplotlib.animation import PillowWriter
+    """The writer of ``path``'s format, which takes the frames one at a time."""
+    from .frame_writers import GifWriter, Mp4Writer
 
-        return PillowWriter(fps=fps)
+    if path.suffix.lower() == ".gif":
+        return GifWriter(path, fps)
     exe = ffmpeg_executable()
     if exe is None:
         raise AnimationError(f"{path}: writing MP4 needs ffmpeg, which was not found (install it, e.g. "
                              f"'apt install ffmpeg' or 'pip install imageio-ffmpeg'), or write a GIF: "
                              f"-o {path.with_suffix('.gif')}")
-    from matplotlib.animation import FFMpegWriter
-
-    writer = FFMpegWriter(fps=fps, codec="h264", extra_args=["-pix_fmt", "yuv420p"])
-    writer.ffmpeg_exe = exe
-    return writer
+    return Mp4Writer(path, fps, exe)
 
 
 # -- data ---------------------------------------------------------------------------
@@ -347,16 +344,33 @@ class _Scene:
                 parts.append(names[f])
         return "in contact (normal force): " + ", ".join(parts)
 
-    def save(self, path: Path, writer, dpi: int) -> None:
-        import matplotlib
-        from matplotlib.animation import FuncAnimation
+    def frames(self, dpi: int = 100):
+        """Each frame's pixels, (height, width, 4) uint8 RGBA, one at a time (the canvas's
+        own buffer: valid until the next frame is drawn). What every frame
+        shares (axes, grid, legend, key arrow, notes) is drawn once; each frame restores
+        those pixels and draws only its own artists on them (blitting)."""
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
 
         fig, draw = self.figure(dpi)
-        anim = FuncAnimation(fig, draw, frames=len(self.times), init_func=lambda: [], blit=False,
-                             repeat=False, cache_frame_data=False)
-        exe = getattr(writer, "ffmpeg_exe", None)
-        with matplotlib.rc_context({"animation.ffmpeg_path": exe} if exe else {}):
-            anim.save(path, writer=writer, dpi=dpi)
+        canvas = FigureCanvasAgg(fig)
+        canvas.draw()
+        background = canvas.copy_from_bbox(fig.bbox)
+        for k in range(len(self.times)):
+            canvas.restore_region(background)
+            for artist in sorted(draw(k), key=lambda a: a.get_zorder()):  # as a whole draw orders them
+                fig.draw_artist(artist)
+            yield np.asarray(canvas.buffer_rgba())
+
+    def save(self, path: Path, writer, dpi: int) -> None:
+        """Draw the frames into ``writer`` (``hierhand.frame_writers``), which keeps none."""
+        try:
+            for rgba in self.frames(dpi):
+                writer.add(rgba)
+        finally:
+            try:
+                writer.close()
+            except RuntimeError as exc:
+                raise AnimationError(str(exc)) from None
 
 
 def _find_plant(results, plant: str | None):

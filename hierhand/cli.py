@@ -9,6 +9,8 @@ tasks) and ``fmu export`` (a diagram of library and hand blocks, or the plant, a
 from __future__ import annotations
 
 import argparse
+import os
+import re
 import sys
 from pathlib import Path
 from typing import Sequence
@@ -20,6 +22,19 @@ DESCRIPTION = "Multirate block-diagram co-simulation: run YAML diagrams, inspect
 MEASURES_HELP = "a hand task measure: separation_time, object_dropped, peak_ratio[(T)], recovery_time[(T)]"
 """What ``--metric`` may name besides the reducers: the measures hierhand registers
 (``hierhand.tasks.measures``, entry-point group ``blocks.measures``)."""
+
+
+EXPORTED_FMU = re.compile(r"FMU file not found: looked at (?P<path>\S*HandPlant_fmi(?P<fmi>[23])\.fmu)\b")
+"""The message of a missing FMU named as ``hierhand fmu export`` names its files."""
+
+
+def advice(issue) -> str | None:
+    """How to make a missing plant FMU of this package: ``hierhand fmu export``."""
+    found = EXPORTED_FMU.search(issue.message)
+    if found is None:
+        return None
+    path = os.path.relpath(os.path.normpath(found["path"]))
+    return f"make it with 'hierhand fmu export --fmi {found['fmi']} -o {path}'"
 
 
 def add_animate(sub, program) -> argparse.ArgumentParser:
@@ -53,7 +68,8 @@ def add_reproduce(sub, program) -> argparse.ArgumentParser:
     rep.add_argument("-o", "--output", type=Path, default=Path("runs/reproduce"),
                      help="output folder (default: runs/reproduce)")
     rep.add_argument("--diagrams", type=Path, default=None,
-                     help="folder of the task diagrams (default: the repository's diagrams/)")
+                     help="folder of the task diagrams (default: the shipped ones, diagrams/ of the "
+                          "repository or of the installed package)")
     rep.set_defaults(handler=cmd_reproduce)
     return rep
 
@@ -137,7 +153,7 @@ def cmd_fmu_export(args: argparse.Namespace) -> int:
 
 
 PROGRAM = Program(
-    name="hierhand", description=DESCRIPTION, distribution="hierhand", env_prefix="HIERHAND",
+    name="hierhand", description=DESCRIPTION, distribution="hierhand", env_prefix="HIERHAND", advice=advice,
     commands=(run.add, validate.add, graph.add, plot.add, add_animate, add_reproduce,
               fmu.group("export a diagram or the hand plant as an FMU, or describe an FMU", add_fmu_export,
                         fmu.info),

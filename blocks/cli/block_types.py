@@ -9,7 +9,11 @@ from .program import EXIT_OK, UsageError
 
 def add(sub, program) -> argparse.ArgumentParser:
     """The ``blocks`` command."""
-    types = sub.add_parser("blocks", help="list block types with their ports and parameters")
+    types = sub.add_parser("blocks", help="list block types with their ports and parameters",
+                           description="Describe the registered block types (the library's and those "
+                                       "packages register through the blocks.types entry points): their "
+                                       "parameters with defaults, ports with widths, units and element "
+                                       "names, and feedthrough.")
     types.add_argument("types", nargs="*", metavar="TYPE", help="only these types")
     types.set_defaults(handler=cmd_blocks)
     return types

@@ -16,7 +16,7 @@ from .program import EXIT_OK, Command, UsageError
 def group(help: str, *subcommands: Command) -> Command:
     """The ``fmu`` command with ``subcommands`` (``info`` and any of the application's)."""
     def add(sub, program) -> argparse.ArgumentParser:
-        fmu = sub.add_parser("fmu", help=help)
+        fmu = sub.add_parser("fmu", help=help, description=help[:1].upper() + help[1:] + ".")
         fmu_sub = fmu.add_subparsers(dest="fmu_command", required=True, metavar="FMU_COMMAND")
         for command in subcommands:
             command(fmu_sub, program)
@@ -26,7 +26,10 @@ def group(help: str, *subcommands: Command) -> Command:
 
 def info(sub, program) -> argparse.ArgumentParser:
     """The ``fmu info`` command."""
-    parser = sub.add_parser("info", help="variables, causality, default experiment, interface types")
+    parser = sub.add_parser("info", help="variables, causality, default experiment, interface types",
+                            description="Describe an FMU (FMI 2.0 or 3.0) from its modelDescription.xml: "
+                                        "its interfaces, default experiment, and variables with causality, "
+                                        "type, unit and start value. Its binary is neither loaded nor run.")
     parser.add_argument("path", type=Path, metavar="PATH", help="FMU file")
     parser.set_defaults(handler=cmd_fmu_info)
     return parser

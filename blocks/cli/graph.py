@@ -14,7 +14,12 @@ from .program import EXIT_OK, UsageError
 
 def add(sub, program) -> argparse.ArgumentParser:
     """The ``graph`` command."""
-    graph = sub.add_parser("graph", help="draw the wiring of a diagram (DOT, SVG or PNG)")
+    graph = sub.add_parser("graph", help="draw the wiring of a diagram (DOT, SVG or PNG)",
+                           description="Draw DIAGRAM's wiring: each block a box with its name, type, rate "
+                                       "and the parameters the diagram gives it, its ports on its edges, "
+                                       "wires port to port (delayed ones dashed), colours by rate. .svg, "
+                                       ".png and .pdf are drawn with matplotlib; .dot (or no -o) is "
+                                       "Graphviz text.")
     diagram_args(graph)
     graph.add_argument("-o", "--output", type=Path,
                        help="file to write: .dot, .svg or .png (default: DOT text on stdout)")

@@ -25,7 +25,9 @@ def add(sub, program) -> argparse.ArgumentParser:
     plot.add_argument("run_dir", type=Path, metavar="RUN_DIR", help=f"results folder of '{program.name} run'")
     plot.add_argument("-s", "--signal", action="append", dest="signals", metavar="SELECTION", help=SELECTION_HELP)
     plot.add_argument("--no-markers", action="store_true", help="do not mark the diagram's events")
-    plot.add_argument("-o", "--output", type=Path, help="PNG file (default: RUN_DIR/plots/signals.png)")
+    plot.add_argument("-o", "--output", type=Path, metavar="FILE.png",
+                      help="PNG file (default: RUN_DIR/plots/signals.png); more axes than fit one page "
+                           "make pages FILE-1.png, FILE-2.png, ...")
     plot.set_defaults(handler=cmd_plot)
     return plot
 

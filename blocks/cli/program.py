@@ -20,10 +20,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import os
 import sys
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
+
+if TYPE_CHECKING:
+    from blocks.issues import Issue
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 EXIT_INTERRUPTED = 130
@@ -49,10 +53,18 @@ class Program:
     distribution: str | None = None
     """None: the distribution that ships the ``blocks`` package."""
     env_prefix: str = "BLOCKS"
+    advice: Callable[[Issue], str | None] | None = None
+    """The application's hint for a problem it knows how to fix (an FMU that its own
+    exporter makes), in place of the problem's own; None: no better hint."""
 
     def env(self, suffix: str) -> str:
         """The name of one of the program's environment variables, e.g. ``HIERHAND_DEBUG``."""
         return f"{self.env_prefix}_{suffix}"
+
+    def advised(self, issue: Issue) -> Issue:
+        """``issue`` with the application's hint, where it has one."""
+        hint = self.advice(issue) if self.advice is not None else None
+        return dataclasses.replace(issue, hint=hint) if hint else issue
 
 
 def build_parser(program: Program) -> argparse.ArgumentParser:
@@ -99,7 +111,7 @@ def main(program: Program, argv: Sequence[str] | None = None) -> int:
         return args.handler(args)
     except DiagramError as exc:
         for issue in exc.issues:
-            print(str(issue), file=sys.stderr)
+            print(str(program.advised(issue)), file=sys.stderr)
         return EXIT_BAD_INPUT
     except (UsageError, ResultsError) as exc:
         print(f"{program.name}: error: {exc}", file=sys.stderr)

@@ -19,6 +19,15 @@ def add(sub, program) -> argparse.ArgumentParser:
     run.add_argument("-o", "--output", type=Path,
                      help="results folder (default: runs/<diagram name>, the name made one safe folder name)")
     run.add_argument("--csv", action="store_true", help="also write signals.csv")
+    run.add_argument("--csv-digits", type=int, metavar="N",
+                     help="significant digits of signals.csv's numbers, 1 to 17 (default: the shortest "
+                          "text that reads back as the same double)")
+    run.add_argument("--mat", action="store_true",
+                     help="also write signals.mat (MATLAB, Octave, scipy.io): each signal's time, values, "
+                          "units and element names")
+    run.add_argument("--decimate", type=int, metavar="N",
+                     help="log every N-th sample of each logged signal (on top of the diagram's own "
+                          "decimate), for long runs")
     run.add_argument("--plot", action="store_true", help="also plot the logged signals to <output>/plots/")
     run.add_argument("-q", "--quiet", action="store_true", help="no progress bar or summary line")
     run.add_argument("--allow-nonfinite", action="store_true",
@@ -47,6 +56,31 @@ class ProgressBar:
         self.line.close()
 
 
+def check_formats(args: argparse.Namespace) -> None:
+    """UsageError for a --csv-digits or --decimate out of range, before anything is loaded."""
+    from blocks.results import check_digits
+
+    if args.csv_digits is not None:
+        if not args.csv:
+            raise UsageError("--csv-digits sets the precision of signals.csv: add --csv")
+        try:
+            check_digits(args.csv_digits)
+        except ValueError as exc:
+            raise UsageError(f"--csv-digits: {exc}") from None
+    if args.decimate is not None and args.decimate < 1:
+        raise UsageError(f"--decimate must be a positive whole number, got {args.decimate}")
+
+
+def check_mat_names(diagram) -> None:
+    """UsageError, before the run, for a logged signal that a MAT file cannot name."""
+    from blocks.results_mat import MatNameError, mat_paths
+
+    try:
+        mat_paths(e.signal for e in diagram.log)
+    except MatNameError as exc:
+        raise UsageError(f"--mat: {exc}") from None
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     """Simulate and save. The output folder is checked before the run (plots included);
     Ctrl-C or SIGTERM stops the run and its results so far are saved, and no signal cuts
@@ -65,7 +99,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .run_output import check_output, remove_if_empty, save_plots, save_run
 
     prog = args.program.name
+    check_formats(args)
     diagram = load(args)
+    if args.decimate is not None:
+        diagram = diagram.decimated(args.decimate)
+    if args.mat:
+        check_mat_names(diagram)
     t_end = end_time(args, diagram)
     out = args.output or Path("runs") / folder_name(diagram.name)
     if args.plot:
@@ -89,7 +128,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         finally:
             bar.close()
         with stops.held():
-            saved = save_run(results, out, csv=args.csv, temp_prefix=f"{prog}-results-")
+            saved = save_run(results, out, csv=args.csv, mat=args.mat, csv_digits=args.csv_digits,
+                             temp_prefix=f"{prog}-results-")
         if args.plot and saved.folder is not None:
             if stops.received is None:
                 try:

@@ -47,20 +47,22 @@ def remove_if_empty(out: Path) -> None:
         out.rmdir()
 
 
-def save_run(results: Results, out: Path, csv: bool, temp_prefix: str = "results-") -> Saved:
-    """Write the results (signals.csv with ``csv``) into ``out``, or failing that into a
-    new temporary folder whose name starts with ``temp_prefix``."""
+def save_run(results: Results, out: Path, csv: bool, temp_prefix: str = "results-", mat: bool = False,
+             csv_digits: int | None = None) -> Saved:
+    """Write the results (signals.csv with ``csv``, at ``csv_digits``, signals.mat with
+    ``mat``) into ``out``, or failing that into a new temporary folder whose name starts
+    with ``temp_prefix``."""
     kept: list[Path] = []
     try:
         with writing(out, kept) as staged:
-            results.write_files(staged, csv)
+            results.write_files(staged, csv, mat=mat, csv_digits=csv_digits)
         return Saved(out, kept=kept[0] if kept else None)
     except OSError as exc:
         reason = describe(exc)
     spare = None
     try:
         spare = Path(tempfile.mkdtemp(prefix=temp_prefix))
-        results.save(spare, csv)
+        results.save(spare, csv, mat=mat, csv_digits=csv_digits)
     except OSError as exc:
         if spare is not None:
             shutil.rmtree(spare, ignore_errors=True)

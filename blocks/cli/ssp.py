@@ -11,9 +11,13 @@ from .program import EXIT_OK
 
 
 def add(sub, program) -> argparse.ArgumentParser:
-    ssp = sub.add_parser("ssp", help="exchange systems of FMUs as SSP (System Structure and Parameterization)")
+    ssp = sub.add_parser("ssp", help="exchange systems of FMUs as SSP (System Structure and Parameterization)",
+                         description="Exchange systems of FMUs with other tools as SSP archives (System "
+                                     "Structure and Parameterization).")
     ssp_sub = ssp.add_subparsers(dest="ssp_command", required=True, metavar="SSP_COMMAND")
-    export = ssp_sub.add_parser("export", help="write a diagram of FMU blocks as an SSP archive")
+    export = ssp_sub.add_parser("export", help="write a diagram of FMU blocks as an SSP archive",
+                                description="Write DIAGRAM, a diagram of FMU blocks (or an SSP read back), "
+                                            "as an SSP archive.")
     export.add_argument("diagram", type=Path, metavar="DIAGRAM", help="YAML diagram file (or an SSP)")
     export.add_argument("-o", "--output", type=Path, required=True, metavar="SYSTEM.ssp", help="the SSP to write")
     export.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",

@@ -143,18 +143,33 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         raise UsageError(str(exc)) from None
     report = summary.report
     if not args.quiet:
-        where = ("" if report.ran == 0 else f" on {report.workers} Dask worker(s)" if report.workers else
-                 " in a local process (too little work for a cluster to pay off)" if report.local else
-                 " in this process")
-        if report.workers and report.local:
-            where += f", {report.local} of them in a local process while the cluster started"
-        print(f"sweep: {summary.points} points: {report.ran} run{where} ({report.failed} failed), "
+        print(f"sweep: {summary.points} points: {report.ran} run{where_ran(report)} ({report.failed} failed), "
               f"{summary.skipped} already in {summary.csv}; {summary.wall_s:.3g} s")
     if summary.failed:
         print(f"{prog}: {summary.failed} point(s) failed; see the status and error columns of "
               f"{summary.csv}", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
+
+
+def where_ran(report) -> str:
+    """Where a sweep's points ran, as the summary line says it: in this process, in a local
+    process, on the cluster's workers, or split between the local process and the cluster."""
+    def workers(n: int) -> str:
+        return f"{n} Dask worker{'s' if n != 1 else ''}"
+
+    if report.ran == 0:
+        return ""
+    if not report.workers:
+        return (" in a local process (too little work for a cluster to pay off)" if report.local
+                else " in this process")
+    on_cluster = report.ran - report.local
+    if not report.local:
+        return f" on {workers(report.workers)}"
+    if not on_cluster:
+        return f" in a local process, all before the cluster of {workers(report.workers)} was ready"
+    return (f": {on_cluster} on {workers(report.workers)}, {report.local} in a local process "
+            "while the cluster started")
 
 
 def cmd_sweep_plot(args: argparse.Namespace) -> int:

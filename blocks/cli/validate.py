@@ -15,7 +15,8 @@ def add(sub, program) -> argparse.ArgumentParser:
     """The ``validate`` command."""
     validate = sub.add_parser("validate", help="check a diagram and print its schedule",
                               description="Check DIAGRAM and print blocks, periods, base tick, "
-                                          "hyperperiod and execution order.")
+                                          "hyperperiod and execution order. Nothing is run: an FMU's "
+                                          "binary is not loaded.")
     diagram_args(validate)
     validate.add_argument("--plan", action="store_true",
                           help="also print the run's op table: blocks, programs of ops, copies and logs, with names")
@@ -38,6 +39,7 @@ def cmd_validate(args: argparse.Namespace) -> int:
           + (f"; t_end: {format_duration(t_end)} = {s.n_ticks} ticks" if t_end else ""))
     print("blocks:")
     print_block_tree(diagram, s)
+    print_terms(diagram, s)
     print_ports(diagram)
     print_element_wiring(diagram)
     print_references_and_notes(diagram)
@@ -93,6 +95,25 @@ def print_block_tree(diagram, s) -> None:
         label = indent(name) + name
         print(f"{label:<{wn}}  {spec.type_name:<{wt}}  {s.rate_text(name):<22} in: {ins}  out: {outs}"
               + (f"  ({', '.join(notes)})" if notes else ""))
+
+
+TERMS = {
+    "inherited": "fires whenever a block feeding it fires",
+    "lazy": "a stateless block of inherited rate, computed only when a block that fires reads it, "
+            "so it adds no events of its own",
+    "advanced between events": "stepped over the ticks where nothing else fires in one call",
+}
+"""The words of the block list that need saying once, and what they mean."""
+
+
+def print_terms(diagram, s) -> None:
+    """One line explaining each of ``TERMS`` the block list used."""
+    texts = [s.rate_text(name) for name in diagram.blocks]
+    used = {"inherited": any("inherited" in t for t in texts), "lazy": bool(s.lazy),
+            "advanced between events": bool(s.advanced)}
+    for term, meaning in TERMS.items():
+        if used[term]:
+            print(f"  ({term}: {meaning})")
 
 
 def port_of(spec, port: str, width: int) -> str:

@@ -24,7 +24,7 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any, Callable
 
-from ..block import Block, BlockError, EndRun, Signal
+from ..block import Block, BlockError, EndRun, ParameterError, Signal
 from ..kernel import Kernel
 from ..timebase import format_duration
 from . import interrupt
@@ -147,9 +147,11 @@ class FMU(Block):
                 fp.seek(0)
                 is_zip = zipfile.is_zipfile(fp)
         except FMUNotFound:
-            raise ValueError(f"FMU file not found: looked at {resolved} (in a diagram, a relative path "
-                             "is resolved against the diagram's folder; from Python, against the "
-                             "current directory)") from None
+            raise ParameterError([(("path",), f"FMU file not found: looked at {resolved} (in a diagram, a "
+                                  "relative path is resolved against the diagram's folder; from Python, "
+                                  "against the current directory)")],
+                                 hint="check the path; an FMU that a tool exports must be exported "
+                                      "before a diagram can use it") from None
         except OSError as exc:
             raise ValueError(f"{shown} cannot be read: {exc.strerror or exc}") from None
         if not is_zip:

@@ -26,11 +26,11 @@ colours), ``ports`` (what a box shows), ``layout`` (layers and their order), ``d
 from __future__ import annotations
 
 from .dot import to_dot
-from .drawing import draw, draw_picture, geometry, render
+from .drawing import draw, draw_picture, geometry, render, svg_text
 from .layout import crossings, layered
 from .ports import is_feedthrough
 from .rates import effective_rate, rate_colors
 from .view import Picture, picture
 
 __all__ = ["Picture", "crossings", "draw", "draw_picture", "effective_rate", "geometry", "is_feedthrough", "layered",
-           "picture", "rate_colors", "render", "to_dot"]
+           "picture", "rate_colors", "render", "svg_text", "to_dot"]

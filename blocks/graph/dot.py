@@ -44,7 +44,7 @@ def record_label(pic: Picture, name: str) -> str:
         fields = "|".join(f"<{port_id(direction, p)}> {record_text(p)}" for p in names)
         return [f"{{{fields}}}"] if fields else []
     node = pic.nodes[name]
-    middle = "\\n".join(record_text(t) for t in (name, node.type_line, node.rate_line))
+    middle = "\\n".join(record_text(t) for t in (name, node.type_line, node.rate_line, *node.notes))
     parts = ports("in", input_ports(pic, name)) + [middle] + ports("out", output_ports(pic, name))
     return "{" + "|".join(parts) + "}"
 
@@ -88,8 +88,9 @@ def node_lines(pic: Picture, group: str, indent: str) -> list[str]:
     for name, node in pic.nodes.items():
         if node.group == group:
             label = record_label(pic, name)
+            fill, style = ("gray93", ', style="filled,dashed"') if node.disabled else (tint(node.colour), "")
             lines.append(f'{indent}{dot_quoted(name)} [label="{label}", color="{node.colour}", '
-                         f'fillcolor="{tint(node.colour)}", penwidth=1.6];')
+                         f'fillcolor="{fill}", penwidth=1.6{style}];')
     for frame in pic.frames:
         parent = frame.path.rpartition(".")[0] if frame.depth else ""
         if parent == group:

@@ -3,6 +3,7 @@ in channels, and (expanded) each subsystem a frame around its blocks."""
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from ..schedule import Schedule
 from .layout import Layered, group_of, layered
 from .ports import input_ports, output_ports
 from .rates import tint
-from .view import Frame, Picture, picture
+from .view import DISABLED, Frame, Picture, picture
 
 
 # All lengths in inches; y grows downwards while laying out (the axes are flipped).
@@ -23,6 +24,8 @@ TITLE_FONT = 10.0   # block names
 SMALL_FONT = 8.0    # type and rate
 ROW = 0.25          # one port row
 HEADER = 0.62       # name, type and rate above the ports
+NOTE_ROW = 0.19     # one line of a box's notes (its parameters), below the ports
+DISABLED_COLOUR = "tab:red"
 PAD = 0.1           # inside the box, left and right of the port names
 V_GAP = 0.45        # between boxes of a layer
 WAYPOINT = 0.16     # height a passing wire takes in a layer
@@ -32,15 +35,18 @@ FRAME_HEAD = 0.32   # a frame's label above the boxes in it
 FRAME_PAD = 0.14    # between a frame and what it holds (and a frame inside it)
 
 
+@functools.lru_cache(maxsize=4096)
 def text_width(text: str, size: float, bold: bool = False) -> float:
-    """Width in inches of ``text`` in the default font at ``size`` points."""
+    """Width in inches of ``text`` in the default font at ``size`` points (its glyphs'
+    advances, as the renderer lays them out; remembered, since a picture asks often)."""
     from matplotlib.font_manager import FontProperties
-    from matplotlib.textpath import TextPath
+    from matplotlib.textpath import text_to_path
 
     if not text:
         return 0.0
-    path = TextPath((0, 0), text, size=size, prop=FontProperties(weight="bold" if bold else "normal"))
-    return path.get_extents().width / 72.0 + 0.02
+    prop = FontProperties(size=size, weight="bold" if bold else "normal")
+    width, _, _ = text_to_path.get_text_width_height_descent(text, prop, ismath=False)
+    return width / 72.0 + 0.02
 
 
 @dataclass
@@ -81,9 +87,9 @@ def geometry(picture: Picture, lay: Layered) -> Geometry:
         in_w = max((text_width(p, FONT) for p in ins), default=0.0)
         out_w = max((text_width(p, FONT) for p in outs), default=0.0)
         head = max(text_width(name, TITLE_FONT, bold=True), text_width(node.type_line, SMALL_FONT),
-                   text_width(node.rate_line, SMALL_FONT))
+                   text_width(node.rate_line, SMALL_FONT), *(text_width(n, SMALL_FONT) for n in node.notes))
         w = max(head + 2 * PAD, in_w + out_w + 2 * PAD + 0.35, 1.0)
-        h = HEADER + max(len(ins), len(outs), 1) * ROW + 0.08
+        h = HEADER + max(len(ins), len(outs), 1) * ROW + 0.08 + (len(node.notes) * NOTE_ROW + 0.04 if node.notes else 0)
         sizes[name] = (w, h, ins, outs)
     conns = picture.wires
     index = {id(c): i for i, c in enumerate(conns)}
@@ -364,8 +370,15 @@ def draw_picture(pic: Picture):
         node = pic.nodes[name]
         colour = node.colour
         ax.add_patch(FancyBboxPatch((box.x, box.y), box.w, box.h, boxstyle="round,pad=0,rounding_size=0.05",
-                                    facecolor=tint(colour), edgecolor=colour, linewidth=1.8, zorder=2,
-                                    gid=f"block:{name}"))
+                                    facecolor="0.93" if node.disabled else tint(colour), edgecolor=colour,
+                                    linewidth=1.8, zorder=2, gid=f"block:{name}",
+                                    linestyle=(0, (3, 2)) if node.disabled else "-"))
+        notes_y = box.y + HEADER + max(len(box.inputs), len(box.outputs), 1) * ROW + 0.06
+        for i, note in enumerate(node.notes):
+            off = note == DISABLED or note.endswith(" " + DISABLED)
+            ax.text(box.x + PAD, notes_y + (i + 0.5) * NOTE_ROW, note, fontsize=SMALL_FONT, ha="left", va="center",
+                    zorder=4, color=DISABLED_COLOUR if off else "0.25", fontweight="bold" if off else "normal",
+                    gid=f"note:{name}")
         cx = box.x + box.w / 2
         ax.text(cx, box.y + 0.16, name, fontsize=TITLE_FONT, fontweight="bold", ha="center", va="center", zorder=4)
         ax.text(cx, box.y + 0.34, node.type_line, fontsize=SMALL_FONT, style="italic",
@@ -422,6 +435,18 @@ def draw_frame(ax, frame: Frame, rect: tuple[float, float, float, float]) -> Non
                                 gid=f"frame:{frame.path}"))
     ax.text(x + 0.1, y + 0.16, frame.label, fontsize=SMALL_FONT, fontweight="bold", color="0.35", ha="left",
             va="center", zorder=4)
+
+
+def svg_text(diagram: Diagram, schedule: Schedule | None = None, expand: bool = False) -> str:
+    """The wiring as SVG text (planned over the diagram's own t_end when no schedule is given)."""
+    import io
+
+    from ..schedule import build_schedule
+
+    fig = draw(diagram, schedule if schedule is not None else build_schedule(diagram, None), expand)
+    out = io.StringIO()
+    fig.savefig(out, format="svg")
+    return out.getvalue()
 
 
 def render(diagram: Diagram, schedule: Schedule, path: str | Path, expand: bool = False) -> Path:

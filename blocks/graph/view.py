@@ -15,6 +15,14 @@ from ..diagram import Composite, Connection, Diagram
 from ..schedule import Schedule
 from .rates import MIXED_COLOR, Rate, rate_colors, rate_line
 
+NOTE_CHARS = 34
+"""The longest parameter note a box shows in full; a longer one shows its name only."""
+MOST_NOTES = 4
+DISABLED = "disabled"
+"""The note of a block whose ``enabled`` parameter is false (the convention of blocks that
+can be switched off, such as the hand's suppresser): it passes its input through or does
+nothing, which changes what the diagram does while its wiring stays the same."""
+
 SEVERAL_RATES = "subsystem of several rates"
 """The legend's entry for the colour of a subsystem box whose blocks run at different rates
 (Simulink's yellow 'hybrid')."""
@@ -34,6 +42,11 @@ class Node:
     """Output -> the inputs it reads at the same hit (through the blocks inside, for a subsystem)."""
     group: str = ""
     """The innermost subsystem whose frame holds it (expanded), ``""`` for none."""
+    notes: list[str] = field(default_factory=list)
+    """Lines under its ports: the parameters the diagram gives it (a subsystem: the
+    overrides its entry gives), ``disabled`` for a switched-off block, and for a
+    subsystem the switched-off blocks inside (``suppress disabled``)."""
+    disabled: bool = False
 
 
 @dataclass(frozen=True)
@@ -71,9 +84,12 @@ def picture(diagram: Diagram, schedule: Schedule, expand: bool = False) -> Pictu
                 nodes[top] = subsystem_node(diagram, schedule, rates, collapsed[top], legend)
             continue
         blk = spec.block
+        off = is_disabled(spec.params)
+        shown = {k: v for k, v in spec.params.items() if not (k == "enabled" and off)}
         nodes[name] = Node(name, spec.type_name, rate_line(schedule, rates, name), rates.colors[name],
                            list(blk.inputs), list(blk.outputs), {p: blk.reads(p) for p in blk.outputs},
-                           group=innermost(diagram, name) if expand else "")
+                           group=innermost(diagram, name) if expand else "",
+                           notes=([DISABLED] if off else []) + parameter_notes(shown), disabled=off)
     wires = list(diagram.root.wires) if collapsed else list(diagram.connections)
     for node in nodes.values():
         node.inputs += [c.dst_port for c in wires if c.dst_block == node.name and c.dst_port not in node.inputs]
@@ -84,6 +100,34 @@ def picture(diagram: Diagram, schedule: Schedule, expand: bool = False) -> Pictu
             members = tuple(n for n in diagram.blocks if n.startswith(path + "."))
             frames.append(Frame(path, f"{path}: {sub.origin}", members, path.count(".")))
     return Picture(diagram.name, nodes, wires, legend, frames)
+
+
+def is_disabled(params: dict) -> bool:
+    """Whether a block's parameters switch it off (``enabled: false``)."""
+    return params.get("enabled") is False
+
+
+def parameter_notes(params: dict, most: int = MOST_NOTES) -> list[str]:
+    """``key = value`` lines for the parameters a diagram gives (nested ones by their dotted
+    path), a long value as ``key = ...``; past ``most`` lines, how many more there are."""
+    lines = []
+    for key, value in params.items():
+        text = f"{key} = {value_text(value)}"
+        lines.append(text if len(text) <= NOTE_CHARS else f"{key} = ...")
+    if len(lines) > most:
+        lines = lines[:most - 1] + [f"(+{len(lines) - most + 1} more parameters)"]
+    return lines
+
+
+def value_text(value) -> str:
+    """A parameter's value as a diagram writes it: YAML's ``true``/``false``, lists in brackets."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(value_text(v) for v in value) + "]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {value_text(v)}" for k, v in value.items()) + "}"
+    return str(value)
 
 
 def innermost(diagram: Diagram, block: str) -> str:
@@ -107,8 +151,12 @@ def subsystem_node(diagram: Diagram, schedule: Schedule, rates, sub: Composite,
         if all(c != MIXED_COLOR for _, c in legend):
             legend.append((SEVERAL_RATES, MIXED_COLOR))
     line = ", ".join(rate.text(schedule) for rate in distinct)
+    off = [sub.name_of(n) for n in inside if is_disabled(diagram.blocks[n].params)]
     return Node(sub.path, f"subsystem {sub.origin}", line, colour, list(sub.inputs), list(sub.outputs),
-                {port: feeds_through(diagram, sub, port) for port in sub.outputs})
+                {port: feeds_through(diagram, sub, port) for port in sub.outputs},
+                notes=[f"{name} {DISABLED}" for name in off]
+                + parameter_notes({k: v for k, v in sub.params.items()
+                                   if not (k.endswith(".enabled") and k[:-len(".enabled")] in off)}))
 
 
 def feeds_through(diagram: Diagram, sub: Composite, output: str) -> frozenset[str]:

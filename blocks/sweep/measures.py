@@ -25,6 +25,8 @@ The contract of a measure:
   when the measure cannot be computed from that diagram (a signal it reads is not logged,
   a parameter it needs is missing), so a sweep that cannot work fails in a second.
   ``require_logged`` gives the standard message for unlogged signals.
+- An optional attribute ``unit`` (``"s"``, ``"1"`` for a dimensionless number): sweep.json
+  records it under ``units`` and ``sweep-plot`` labels the metric with it.
 - Measures travel to Dask workers with the metric: a module-level function is sent as a
   reference to it, anything else as cloudpickle can send it.
 """

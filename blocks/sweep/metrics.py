@@ -50,6 +50,26 @@ class Metric:
     args: tuple[float, ...] = ()
     """The measure's arguments."""
 
+    def unit(self, diagram) -> str | None:
+        """The unit of this metric's values, where it is known: a reducer's is its signal
+        element's (as the diagram's ports give them), a first time's is seconds, a
+        measure's its ``unit`` attribute; None when unknown."""
+        if self.measure is not None:
+            unit = getattr(self.measure, "unit", None)
+            return unit if isinstance(unit, str) else None
+        if self.kind in THRESHOLD_REDUCERS:
+            return "s"
+        block, port = self.signal.rsplit(".", 1)
+        spec = diagram.blocks.get(block)
+        try:
+            units = spec.port_units(port) if spec is not None else None
+        except Exception:  # a block's port_units that fails says no unit here; the run says why
+            return None
+        if isinstance(units, (list, tuple)):
+            index = self.index or 0
+            units = units[index] if -len(units) <= index < len(units) else None
+        return units if isinstance(units, str) and units else None
+
     # -- checking against the diagram before the sweep --------------------------------
 
     def check(self, diagram) -> None:

@@ -38,6 +38,8 @@ class SweepPlan:
     parameters: list[str]
     diagram_hash: str
     axes: dict[str, Any] = field(default_factory=dict)
+    units: dict[str, str] = field(default_factory=dict)
+    """The unit of each metric whose unit is known (``Metric.unit``)."""
 
     def description(self) -> dict[str, Any]:
         """What sweep.json records: enough to read the CSV and to repeat the sweep."""
@@ -50,6 +52,7 @@ class SweepPlan:
             "parameters": self.parameters,
             "axes": self.axes,
             "metrics": {m.name: m.text.partition("=")[2].strip() for m in self.job.metrics},
+            "units": self.units,
             "points": len(self.points),
         }
 
@@ -85,8 +88,9 @@ def prepare(diagram: str | Path, points: list[Point], metrics: list[Metric], t_e
     bundle = bundle_for(diagram, [base, checked], _swept_files(base, points), step=step)
     job = SweepJob(diagram=str(Path(diagram).resolve()), metrics=tuple(metrics), t_end=t_end, trust=trust,
                    origins=tuple((origins or {}).items()), bundle=bundle, keep_results=keep_results)
+    units = {m.name: unit for m in metrics if (unit := m.unit(checked)) is not None}
     return SweepPlan(job=job, points=unique_points(points, bundle.hash, t_end), parameters=keys,
-                     diagram_hash=bundle.hash, axes=axes or {})
+                     diagram_hash=bundle.hash, axes=axes or {}, units=units)
 
 
 def _swept_files(base, points: list[Point]) -> dict[str, Path]:

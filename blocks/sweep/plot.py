@@ -5,8 +5,10 @@ value of the sweep keeps its place on the axes. Over one parameter,
 each combination of the other parameters gets its own line (labelled with its values) as
 long as there are at most MAX_LINES of them; beyond that the plot shows their mean with a
 min-max band, and says so in the title. A heat map averages over the other parameters,
-also said in the title; cells without a value stay blank. Parameter values that are not
-numbers (lists, names) are placed in order of appearance and labelled as written.
+also said in the title; cells without a value stay blank, the others carry their value.
+Numeric parameter values keep their true places (cells reach halfway to their neighbours);
+values that are not numbers (lists, names) are placed in order of appearance and labelled
+as written, the axis saying so. A metric's unit, where sweep.json records one, labels it.
 """
 
 from __future__ import annotations
@@ -85,12 +87,13 @@ def plot_sweep(directory: str | Path, x: str, metric: str, output: str | Path, y
     if y is not None and y == x:
         raise SweepError("--x and --y name the same parameter")
     parameters, table = sweep_table(directory, [x] + ([y] if y else []), metric)
+    units = read_sweep(directory)[0].get("units") or {}
     others = [p for p in parameters if p not in (x, y)]
     fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
     if y is None:
-        _lines(ax, table, x, others, metric)
+        _lines(ax, table, x, others, metric, units)
     else:
-        _heat_map(fig, ax, table, x, y, others, metric)
+        _heat_map(fig, ax, table, x, y, others, metric, units)
     output = Path(output)
     output.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(output, dpi=120)
@@ -98,7 +101,7 @@ def plot_sweep(directory: str | Path, x: str, metric: str, output: str | Path, y
     return output
 
 
-def _lines(ax, table: list[dict], x: str, others: list[str], metric: str) -> None:
+def _lines(ax, table: list[dict], x: str, others: list[str], metric: str, units: dict[str, str] | None = None) -> None:
     xs = _distinct([r[x] for r in table])
     pos, labels = _positions(xs)
     index = {json.dumps(v, sort_keys=True): i for i, v in enumerate(xs)}
@@ -129,11 +132,29 @@ def _lines(ax, table: list[dict], x: str, others: list[str], metric: str) -> Non
     if labels:
         ax.set_xticks(pos, labels)
     ax.set_xlabel(x)
-    ax.set_ylabel(metric)
+    unit = (units or {}).get(metric)
+    ax.set_ylabel(metric + (f" ({unit})" if unit else ""))
     ax.grid(True, alpha=0.3)
 
 
-def _heat_map(fig, ax, table: list[dict], x: str, y: str, others: list[str], metric: str) -> None:
+MAX_CELL_TEXTS = 400
+"""Heat maps of at most this many cells write each cell's value in it."""
+
+
+def _edges(centres: np.ndarray) -> np.ndarray:
+    """Cell edges around sorted distinct values: halfway between neighbours, and half a
+    step beyond the first and the last (one value: a cell of width 1 around it)."""
+    if len(centres) == 1:
+        return np.array([centres[0] - 0.5, centres[0] + 0.5])
+    mid = (centres[:-1] + centres[1:]) / 2
+    return np.concatenate([[2 * centres[0] - mid[0]], mid, [2 * centres[-1] - mid[-1]]])
+
+
+def _heat_map(fig, ax, table: list[dict], x: str, y: str, others: list[str], metric: str,
+              units: dict[str, str] | None = None) -> None:
+    """The metric over x and y: numbers at their true places (cells spanning halfway to
+    their neighbours, so 100, 200, 300, 500 are not drawn as equal steps), other values as
+    labelled categories in order of appearance, and each cell's value written in it."""
     xs, ys = _distinct([r[x] for r in table]), _distinct([r[y] for r in table])
     xi = {json.dumps(v, sort_keys=True): i for i, v in enumerate(xs)}
     yi = {json.dumps(v, sort_keys=True): i for i, v in enumerate(ys)}
@@ -144,11 +165,20 @@ def _heat_map(fig, ax, table: list[dict], x: str, y: str, others: list[str], met
     grid = np.full((len(ys), len(xs)), np.nan)
     for (i, j), vals in cells.items():
         grid[i, j] = np.mean(vals)
-    image = ax.imshow(grid, origin="lower", aspect="auto", cmap="viridis")
-    fig.colorbar(image, ax=ax, label=metric)
-    ax.set_xticks(range(len(xs)), [json.dumps(v) for v in xs], rotation=45 if len(xs) > 6 else 0)
-    ax.set_yticks(range(len(ys)), [json.dumps(v) for v in ys])
-    ax.set_xlabel(x)
-    ax.set_ylabel(y)
+    (px, x_labels), (py, y_labels) = _positions(xs), _positions(ys)
+    image = ax.pcolormesh(_edges(px), _edges(py), np.ma.masked_invalid(grid), cmap="viridis", shading="flat")
+    unit = (units or {}).get(metric)
+    fig.colorbar(image, ax=ax, label=metric + (f" ({unit})" if unit else ""))
+    if grid.size <= MAX_CELL_TEXTS:
+        low, high = np.nanmin(grid), np.nanmax(grid)
+        for (i, j), value in np.ndenumerate(grid):
+            if np.isfinite(value):
+                bright = high > low and (value - low) / (high - low) > 0.6
+                ax.text(px[j], py[i], f"{value:.3g}", ha="center", va="center", fontsize="x-small",
+                        color="black" if bright else "white")
+    ax.set_xticks(px, x_labels or [f"{v:g}" for v in px], rotation=45 if len(xs) > 6 else 0)
+    ax.set_yticks(py, y_labels or [f"{v:g}" for v in py])
+    ax.set_xlabel(x + (" (categories, in order of appearance)" if x_labels else ""))
+    ax.set_ylabel(y + (" (categories, in order of appearance)" if y_labels else ""))
     ax.set_title(f"{metric} over {x} and {y}" + (f" (mean over {', '.join(others)})" if others else "")
                  + ("; blank: no value" if np.isnan(grid).any() else ""))

@@ -61,10 +61,16 @@ def separation_time(results, diagram) -> float | None:
     return regrasp_events(results)["fore_separation_time_s"]
 
 
+separation_time.unit = "s"
+
+
 @checked_by(_check_contact)
 def object_dropped(results, diagram) -> float:
     """1 if the object was dropped, else 0."""
     return float(dropped(results))
+
+
+object_dropped.unit = "1"
 
 
 @checked_by(_check_ratio("peak_ratio"))
@@ -73,8 +79,14 @@ def peak_ratio(results, diagram, disturbance_time: float | None = None) -> float
     return grasp_summary(results, _disturbance(diagram, disturbance_time))["peak_ratio"]
 
 
+peak_ratio.unit = "1"
+
+
 @checked_by(_check_ratio("recovery_time"))
 def recovery_time(results, diagram, disturbance_time: float | None = None) -> float | None:
     """Seconds from the disturbance until |f_t|/f_n is back under the safety ratio for good
     (None: it never is)."""
     return grasp_summary(results, _disturbance(diagram, disturbance_time))["recovery_time_s"]
+
+
+recovery_time.unit = "s"

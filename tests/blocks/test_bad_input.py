@@ -108,8 +108,14 @@ def line_after(text: str, anchor: str, needle: str) -> int:
 
 
 def hierhand(*args: str, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "hierhand", *args], capture_output=True, text=True,
-                          cwd=cwd, env=env, timeout=120)
+    """``python -m hierhand ARGS`` in ``cwd``: a process of its own, forked from the session's
+    command-line server (``tests.forked_cli``), or with ``env`` a fresh interpreter."""
+    if env is None:
+        from tests.forked_cli import shared
+
+        return shared().run([str(a) for a in args], cwd, timeout=120)
+    return subprocess.run([sys.executable, "-m", "hierhand", *args], capture_output=True,
+                          text=True, cwd=cwd, env=env, timeout=120)
 
 
 def issue_lines(stderr: str, path: Path) -> list[tuple[int, str]]:

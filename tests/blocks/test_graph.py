@@ -229,3 +229,41 @@ def test_render_writes_the_file(tmp_path, suffix):
         assert data.startswith(b"\x89PNG\r\n\x1a\n")
     else:
         assert b"<svg" in data and b"wire:gain.y -&gt; sum.u1 (delay 1)" in data
+
+
+def shipped_picture(name: str, expand: bool = False):
+    d = load_diagram(ROOT / "diagrams" / f"{name}.yaml")
+    return d, picture(d, build_schedule(d, None), expand)
+
+
+def test_a_disabled_block_shows_on_the_subsystem_box_and_the_two_regrasp_graphs_differ():
+    _, on = shipped_picture("regrasp")
+    _, off = shipped_picture("regrasp_unsuppressed")
+    assert off.nodes["ctrl"].notes[0] == "suppress disabled"
+    assert "suppress.S_b = 0.02" in off.nodes["ctrl"].notes
+    assert not any("disabled" in n for n in on.nodes["ctrl"].notes)
+    assert "support" in on.nodes and on.nodes["support"].notes == ["hand = plant", "until = 0.1"]
+
+
+def test_expanded_a_disabled_block_is_drawn_as_such_in_the_figure_and_the_dot_text():
+    d, pic = shipped_picture("regrasp_unsuppressed", expand=True)
+    node = pic.nodes["ctrl.suppress"]
+    assert node.disabled and node.notes[0] == "disabled" and "enabled = false" not in node.notes
+    assert not pic.nodes["ctrl.reflex"].disabled
+    fig = draw(d, build_schedule(d, None), expand=True)
+    (box,) = [p for p in fig.axes[0].patches if p.get_gid() == "block:ctrl.suppress"]
+    assert box.get_linestyle() != "-"
+    notes = [t.get_text() for t in fig.axes[0].texts if t.get_gid() == "note:ctrl.suppress"]
+    assert notes[0] == "disabled"
+    dot = to_dot(d, build_schedule(d, None), expand=True)
+    (line,) = [ln for ln in dot.splitlines() if ln.strip().startswith('"ctrl.suppress" [')]
+    assert "disabled" in line and 'style="filled,dashed"' in line
+
+
+def test_long_and_many_parameters_are_cut_short():
+    from blocks.graph.view import parameter_notes
+
+    assert parameter_notes({"k": 5.0, "signs": "+-", "on": True}) == ["k = 5.0", "signs = +-", "on = true"]
+    assert parameter_notes({"A": [[0.999]]}) == ["A = [[0.999]]"]
+    assert parameter_notes({"trajectories": {"fore": {"waypoints": [[0.1] * 4] * 3}}}) == ["trajectories = ..."]
+    assert parameter_notes({f"p{i}": i for i in range(6)}) == ["p0 = 0", "p1 = 1", "p2 = 2", "(+3 more parameters)"]

@@ -185,3 +185,44 @@ def test_plot_signals_marks_the_runs_steps_unless_asked_not_to(tmp_path, monkeyp
     plot_signals(run, tmp_path / "a.png")
     plot_signals(run, tmp_path / "b.png", markers=False)
     assert [[m.start for m in ms] for ms in drawn] == [[0.002], []]
+
+
+def test_a_signal_of_mixed_units_is_an_axis_per_unit_and_pages_are_balanced(tmp_path, monkeypatch):
+    import blocks.plot as plot
+
+    pages = []
+    real = plot.figure
+    monkeypatch.setattr(plot, "figure", lambda r, page, *a: pages.append(page) or real(r, page, *a))
+    many = described()
+    many.signals.update({f"c{i}.y": (np.arange(3) * 1e-3, np.ones((3, 1))) for i in range(10)})
+    written = plot_signals(many, tmp_path / "p.png")
+    axes = [[tr.title for tr in traces] for page in pages for traces in page]
+    assert axes[:4] == [["b.q"], ["b.pose[x,y]"], ["b.pose[theta]"], ["b.r"]]  # b.pose: m, then rad
+    assert [len(p) for p in pages] == [5, 5, 4] and len(written) == 3  # 14 axes: not 6, 6 and 2
+
+
+def test_an_axis_per_unit_is_labelled_with_that_unit_alone():
+    from blocks.plot_select import by_unit, select
+
+    r = described()
+    fig = figure(r, by_unit(r, select(r, "b.pose")))
+    try:
+        assert [ax.get_ylabel() for ax in fig.axes] == ["b.pose[x,y]\n(m)", "b.pose[theta]\n(rad)"]
+        assert legend_texts(fig.axes[0]) == ["x", "y"] and fig.axes[1].get_legend() is None
+    finally:
+        plt.close(fig)
+
+
+def test_many_samples_are_thinned_to_what_each_pixel_column_shows():
+    from blocks.plot import envelope
+
+    t = np.arange(100_000) * 1e-5
+    v = np.column_stack([np.sin(2 * np.pi * 7 * t), (np.arange(100_000) == 51_234).astype(float)])
+    tt, vv = envelope(t, v, 500)
+    assert len(tt) <= 4 * 500 and tt[0] == t[0] and tt[-1] == t[-1]
+    assert np.all(np.diff(tt) >= 0)
+    assert vv[:, 0].max() == v[:, 0].max() and vv[:, 0].min() == v[:, 0].min()
+    assert vv[:, 1].max() == 1.0  # a one-sample spike still shows
+    assert np.array_equal(vv[-1], v[-1])  # the value held at the end
+    few_t, few_v = envelope(t[:1000], v[:1000], 500)
+    assert np.array_equal(few_t, t[:1000]) and np.array_equal(few_v, v[:1000])  # under 4 a column: as they are

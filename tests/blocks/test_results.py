@@ -314,3 +314,26 @@ def test_units_that_do_not_fit_the_port_fail_the_run_at_its_start(units, problem
 def test_results_without_units_in_run_json_have_none():
     r = two_rate_results()
     assert r.units("b.y") is None and r.unit("a.y") is None
+
+
+def test_csv_numbers_are_the_shortest_text_that_reads_back_the_same_double(tmp_path):
+    values = np.array([[0.001], [1 / 3], [1e-300], [-2.5e17], [np.nan], [np.inf]])
+    r = Results({"x.y": (np.arange(6) * 0.001, values)}, {"status": "complete"})
+    r.save(tmp_path, csv=True)
+    lines = (tmp_path / "signals.csv").read_text().splitlines()
+    assert lines[:3] == ["time,x.y", "0.0,0.001", "0.001,0.3333333333333333"]
+    assert lines[4:] == ["0.003,-2.5e+17", "0.004,nan", "0.005,inf"]
+    _, rows = read_csv(tmp_path / "signals.csv")
+    np.testing.assert_array_equal([row[1] for row in rows], values[:, 0])
+
+
+def test_csv_digits_rounds_to_that_many_significant_digits(tmp_path):
+    r = Results({"x.y": (np.array([0.0, 0.001]), np.array([[1 / 3], [123456.789]]))}, {"status": "complete"})
+    r.save(tmp_path, csv=True, csv_digits=4)
+    assert (tmp_path / "signals.csv").read_text().splitlines() == ["time,x.y", "0,0.3333", "0.001,1.235e+05"]
+
+
+@pytest.mark.parametrize("digits", [0, 18, 2.5, True, "6"])
+def test_csv_digits_outside_1_to_17_is_refused(tmp_path, digits):
+    with pytest.raises(ValueError, match="CSV digits must be a whole number from 1 to 17"):
+        two_rate_results().save(tmp_path, csv=True, csv_digits=digits)

@@ -54,17 +54,12 @@ def frames(path) -> int:
         return im.n_frames
 
 
-def test_cli_writes_a_gif_with_several_frames(run_dir, tmp_path):
-    gif = tmp_path / "new" / "folder" / "hand.gif"  # the folder is created
-    proc = cli(run_dir, "-o", gif)
+def test_cli_writes_a_gif_of_the_frames_asked_for(run_dir, tmp_path):
+    gif = tmp_path / "new" / "folder" / "every.gif"  # the folder is created
+    proc = cli(run_dir, "-o", gif, "--every", "50")
     assert proc.returncode == 0, proc.stderr
-    assert gif.is_file()
-    assert frames(gif) > 1  # t = 0 and the final state at 20 ms
-
-    every = tmp_path / "every.gif"
-    proc = cli(run_dir, "-o", every, "--every", "50")
-    assert proc.returncode == 0, proc.stderr
-    assert frames(every) == 5  # q samples 0, 50, 100, 150, 200 (0 to 20 ms at 0.1 ms)
+    assert frames(gif) == 5  # q samples 0, 50, 100, 150, 200 (0 to 20 ms at 0.1 ms)
+    assert "5 frames at 25 fps" in proc.stdout
 
 
 def test_cli_without_q_is_bad_input_naming_the_signal(run_dir, tmp_path):
@@ -201,16 +196,51 @@ def test_mp4_without_ffmpeg_is_a_one_line_error(run_dir, tmp_path, monkeypatch, 
     assert not (tmp_path / "a.mp4").exists()
 
 
-def test_mp4_uses_matplotlibs_ffmpeg_writer_when_ffmpeg_is_found(tmp_path, monkeypatch):
+def test_mp4_is_piped_to_the_ffmpeg_found(tmp_path, monkeypatch):
     import shutil
 
-    from matplotlib.animation import FFMpegWriter
-
     from hierhand.animation import _writer
+    from hierhand.frame_writers import Mp4Writer
 
     monkeypatch.setattr(shutil, "which", lambda name, *a, **k: "/opt/bin/ffmpeg" if name == "ffmpeg" else None)
     writer = _writer(tmp_path / "a.mp4", 25)
-    assert isinstance(writer, FFMpegWriter) and writer.ffmpeg_exe == "/opt/bin/ffmpeg" and writer.fps == 25
+    assert isinstance(writer, Mp4Writer) and writer.ffmpeg == "/opt/bin/ffmpeg" and writer.fps == 25
+
+
+def rendered(fig) -> tuple[np.ndarray, tuple[slice, slice]]:
+    """A figure's pixels, and the rows and columns of its axes (the hand and the arrows)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    pixels = np.asarray(canvas.buffer_rgba())[..., :3].astype(float)
+    box = fig.axes[0].get_window_extent()
+    height = pixels.shape[0]
+    return pixels, (slice(int(height - box.y1) + 2, int(height - box.y0) - 2), slice(int(box.x0) + 2, int(box.x1) - 2))
+
+
+def test_each_gif_frame_is_the_hand_its_arrows_and_its_time_as_a_whole_figure_draws_them(regrasp, tmp_path):
+    """The GIF's frames are drawn by blitting (what frames share drawn once); each frame's
+    hand and force arrows must look as the frame's own figure drawn whole (``frame_figure``)
+    does, up to the GIF's 256-colour palette, and its header must show its own time."""
+    out = animate_run(regrasp, tmp_path / "r.gif", every=20)  # q (every 1 ms) samples 0, 20, 40 and the last, 50
+    times = [0.0, 0.02, 0.04, 0.05]
+    with Image.open(out) as im:
+        assert im.n_frames == len(times)
+        decoded = []
+        for k in range(im.n_frames):
+            im.seek(k)
+            decoded.append(np.asarray(im.convert("RGB")).astype(float))
+    for k, t in enumerate(times):
+        whole, (rows, cols) = rendered(frame_figure(regrasp, t))
+        assert decoded[k].shape == whole.shape
+        off = np.abs(decoded[k][rows, cols] - whole[rows, cols]).max(axis=2) > 48
+        assert off.mean() < 0.001, f"frame {k} (t = {t} s): {off.sum()} pixels of the axes differ from its figure"
+    header = slice(0, rows.start - 40)  # the time, phase and contact lines above the axes
+    for a, b in zip(decoded, decoded[1:]):
+        assert (np.abs(a[header] - b[header]).max(axis=2) > 60).sum() > 20  # each frame its own time
+    moved = np.abs(decoded[2][rows, cols] - decoded[0][rows, cols]).max(axis=2) > 60
+    assert moved.sum() > 200  # the hand moved and the arrows came
 
 
 def test_cli_writes_an_mp4_that_decodes_to_its_frames(run_dir, tmp_path):

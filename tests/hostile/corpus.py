@@ -43,8 +43,9 @@ class Case:
     env: dict[str, str] = field(default_factory=dict)
 
 
-def run(case: Case, folder: Path) -> subprocess.CompletedProcess:
-    """Write the case's files under ``folder`` and run its command line there."""
+def run(case: Case, folder: Path, cli=None) -> subprocess.CompletedProcess:
+    """Write the case's files under ``folder`` and run its command line there: through
+    ``cli`` (a ``tests.forked_cli.ForkedCLI``) if given, else in a fresh interpreter."""
     for rel, content in case.files.items():
         path = folder / rel
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -53,6 +54,8 @@ def run(case: Case, folder: Path) -> subprocess.CompletedProcess:
         else:
             path.write_text(content, encoding="utf-8")
     argv = [a.format(dir=folder, root=ROOT) for a in case.argv]
+    if cli is not None and not case.env:  # a case's own environment (a locale) needs an interpreter of its own
+        return cli.run(argv, folder, timeout=case.timeout)
     env = dict(os.environ, PYTHONPATH=str(ROOT), **case.env)
     return subprocess.run([sys.executable, "-m", "hierhand", *argv], capture_output=True, text=True,
                           cwd=folder, env=env, timeout=case.timeout)

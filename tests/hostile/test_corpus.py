@@ -23,6 +23,8 @@ def all_cases() -> list[Case]:
 
 @pytest.mark.parametrize("case", all_cases(), ids=lambda c: c.name)
 def test_case(case: Case, tmp_path: Path):
+    from tests.forked_cli import shared
+
     folder = tmp_path / "case"
     folder.mkdir()
-    verify(case, folder, run(case, folder))
+    verify(case, folder, run(case, folder, shared()))

@@ -24,6 +24,12 @@ PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
 def hierhand(*args: str, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
+    """``python -m hierhand ARGS`` in ``cwd``: a process of its own, forked from the session's
+    command-line server (``tests.forked_cli``), or with ``env`` a fresh interpreter."""
+    if env is None:
+        from tests.forked_cli import shared
+
+        return shared().run([str(a) for a in args], cwd, timeout=300)
     return subprocess.run([sys.executable, "-m", "hierhand", *map(str, args)], capture_output=True,
                           text=True, cwd=cwd, env=env, timeout=300)
 
@@ -135,6 +141,8 @@ def test_validate_prints_tick_hyperperiod_and_order(tmp_path):
     assert "base tick: 100 us" in out
     assert "hyperperiod" in out and "10 ms" in out
     assert "execution order" in out
+    assert "(lazy: a stateless block of inherited rate, computed only when a block that fires reads it" in out
+    assert "(advanced between events: stepped over the ticks where nothing else fires in one call)" in out
     for name in TOY_BLOCKS:
         assert name in out
     order = out.split("execution order", 1)[1]

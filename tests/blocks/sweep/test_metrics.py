@@ -64,3 +64,29 @@ def test_metrics_are_checked_against_the_diagram(text, message):
     parse_metric("ok=final(plant.y)").check(diagram)
     with pytest.raises(SweepError, match=message):
         parse_metric(text).check(diagram)
+
+
+def test_a_metric_knows_its_unit_where_the_diagram_or_the_measure_says():
+    from blocks import loads_diagram
+    from blocks.sweep.measures import register_measure, unregister_measure
+
+    d = loads_diagram("""
+time: {t_end: 2 ms}
+blocks:
+  src: {type: "python:tests.blocks.blockdefs:Labelled", period: 1 ms, params: {labels: [x, y, theta], units: [m, m, rad]}}
+  k: {type: Constant, params: {value: 1.0}}
+log: [src.y, k.y]
+""", trust=True)
+
+    def spread(results, diagram):
+        return 0.0
+
+    spread.unit = "mm"
+    register_measure("spread_for_test", spread)
+    try:
+        units = {m.name: m.unit(d) for m in parse_metrics(["a=max(src.y[2])", "b=final(src.y[0])",
+                                                           "c=first_time_above(src.y[1], 0.5)", "d=final(k.y)",
+                                                           "e=spread_for_test"])}
+    finally:
+        unregister_measure("spread_for_test")
+    assert units == {"a": "rad", "b": "m", "c": "s", "d": None, "e": "mm"}

@@ -5,10 +5,6 @@ workers, in-process runs, resuming, failure isolation, input errors, and a real
 from __future__ import annotations
 
 import csv
-import shutil
-import socket
-import subprocess
-import time
 from pathlib import Path
 
 import pytest
@@ -107,49 +103,11 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, extra, message):
     assert not (tmp_path / "s" / "sweep.csv").exists()
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def _stop(procs: list[subprocess.Popen]) -> None:
-    for p in procs:
-        if p.poll() is None:
-            p.terminate()
-    for p in procs:
-        try:
-            p.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            p.kill()
-            p.wait(timeout=5)
-
-
-@pytest.mark.skipif(shutil.which("dask") is None, reason="the dask command is not installed")
-def test_sweep_on_a_running_scheduler(tmp_path):
-    from distributed import Client
-
-    address = f"tcp://127.0.0.1:{_free_port()}"
-    dask = shutil.which("dask")
-    log = open(tmp_path / "dask.log", "w")
-    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", address.rsplit(":", 1)[1],
-                               "--no-dashboard"], stdout=log, stderr=subprocess.STDOUT)]
-    try:
-        for _ in range(2):
-            procs.append(subprocess.Popen([dask, "worker", address, "--nthreads", "1", "--nworkers", "1",
-                                           "--host", "127.0.0.1", "--no-dashboard"],
-                                          stdout=log, stderr=subprocess.STDOUT))
-        deadline = time.monotonic() + 60
-        with Client(address, timeout=30) as client:
-            client.wait_for_workers(2, timeout=max(1.0, deadline - time.monotonic()))
-        out = tmp_path / "sweep"
-        assert main(["sweep", *BASE, "-o", str(out), "--grid", "prop.k=1,2,4", "--scheduler", address]) == 0
-        assert sorted(r["prop.k"] for r in rows(out)) == ["1", "2", "4"]
-        assert all(r["status"] == "ok" for r in rows(out))
-    finally:
-        _stop(procs[1:])  # the workers first: without their scheduler they wait 8 s to be killed
-        _stop(procs[:1])
-        log.close()
+def test_sweep_on_a_running_scheduler(tmp_path, dask_elsewhere):
+    out = tmp_path / "sweep"
+    assert main(["sweep", *BASE, "-o", str(out), "--grid", "prop.k=1,2,4", "--scheduler", dask_elsewhere.address]) == 0
+    assert sorted(r["prop.k"] for r in rows(out)) == ["1", "2", "4"]
+    assert all(r["status"] == "ok" for r in rows(out))
 
 
 CRASH_MODULE = '''

@@ -9,15 +9,13 @@ import csv
 import math
 import os
 import shutil
-import subprocess
 import tempfile
-import time
 import zipfile
 from pathlib import Path
 
 import pytest
 
-from blocks import Results, load_diagram, scratch
+from blocks import Results, load_diagram
 from blocks.sweep import grid_points, parse_metrics, run_sweep
 from blocks.sweep.plan import execute, prepare
 from blocks.sweep.runner import SweepJob, run_point
@@ -272,38 +270,13 @@ def test_version_mismatch_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
     assert not (tmp_path / "s" / "sweep.csv").exists()  # refused before the file is made
 
 
-@pytest.mark.skipif(shutil.which("dask") is None, reason="the dask command is not installed")
-def test_a_dask_worker_elsewhere_runs_the_points(tmp_path):
-    from distributed import Client
-
-    from .test_sweep_cli import _free_port, _stop
-
+def test_a_dask_worker_elsewhere_runs_the_points(tmp_path, dask_elsewhere):
     diagram = make_project(tmp_path / "proj")
     expected = direct(diagram)
     plan = prepare(diagram, POINTS, parse_metrics(METRICS), trust=True)
     shutil.rmtree(tmp_path / "proj")
-    port = _free_port()
-    address = f"tcp://127.0.0.1:{port}"
-    dask = shutil.which("dask")
-    elsewhere = tmp_path / "worker-home"
-    elsewhere.mkdir()
-    env = {**{k: v for k, v in os.environ.items() if k != scratch.ENV}, "TMPDIR": str(elsewhere)}  # another machine
-    log = open(tmp_path / "dask.log", "w")
-    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-                              stdout=log, stderr=subprocess.STDOUT, cwd=elsewhere)]
-    try:
-        procs.append(subprocess.Popen([dask, "worker", address, "--nthreads", "1", "--nworkers", "1",
-                                       "--host", "127.0.0.1", "--no-dashboard"],
-                                      stdout=log, stderr=subprocess.STDOUT, cwd=elsewhere, env=env))
-        deadline = time.monotonic() + 60
-        with Client(address, timeout=30) as client:
-            client.wait_for_workers(1, timeout=max(1.0, deadline - time.monotonic()))
-        out = tmp_path / "sweep"
-        report, _, failed = execute(plan, out, scheduler=address, progress=False)
-        assert (report.ran, failed) == (4, 2)
-        check(out, expected)
-        assert not list(elsewhere.glob("blocks-*/bundle-*"))  # the worker's copy goes with the sweep
-    finally:
-        _stop(procs[1:])  # the worker first: without its scheduler it waits 8 s to be killed
-        _stop(procs[:1])
-        log.close()
+    out = tmp_path / "sweep"
+    report, _, failed = execute(plan, out, scheduler=dask_elsewhere.address, progress=False)
+    assert (report.ran, failed) == (4, 2)
+    check(out, expected)
+    assert not list(dask_elsewhere.home.glob("blocks-*/bundle-*"))  # the workers' copies go with the sweep
