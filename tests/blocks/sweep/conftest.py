@@ -60,7 +60,8 @@ def dask_elsewhere(tmp_path_factory):
     address = f"tcp://127.0.0.1:{port}"
     env = {**{k: v for k, v in os.environ.items() if k != scratch.ENV}, "TMPDIR": str(home)}  # another machine
     log = open(root / "dask.log", "w")
-    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
+    procs = [subprocess.Popen([dask, "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard",
+                              "--dashboard-address", "127.0.0.1:0"],
                               stdout=log, stderr=subprocess.STDOUT, cwd=home)]
     try:
         for _ in range(2):

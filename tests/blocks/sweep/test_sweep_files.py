@@ -255,7 +255,7 @@ def test_version_mismatch_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
 
     monkeypatch.setattr(Client, "get_versions", mismatched)
     with LocalCluster(n_workers=1, processes=False, threads_per_worker=1, protocol="tcp", host="127.0.0.1",
-                      dashboard_address=None) as cluster:
+                      dashboard_address=None, scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster:
         diagram = make_project(tmp_path / "proj")
         code = main(["sweep", str(diagram), "-o", str(tmp_path / "s"), "--grid", "ref.value=1",
                      "--metric", "y=final(plant.y)", "--trust", "-q", "--scheduler", cluster.scheduler_address])
