@@ -14,6 +14,7 @@ composes, whose recursion would overflow the C stack) and the values aliases may
 from __future__ import annotations
 
 import bisect
+import copy
 import os
 import reprlib
 import stat
@@ -57,6 +58,13 @@ class LineDict(dict):
     def line_of(self, key: Any) -> int:
         return self.key_lines.get(key, self.line)
 
+    def __deepcopy__(self, memo: dict) -> "LineDict":
+        """A copy with its lines, made directly (copy's generic way is slow, and every
+        block's parameters are copied once per load)."""
+        new = LineDict((k, copy.deepcopy(v, memo)) for k, v in self.items())
+        new.__dict__.update(copy.deepcopy(self.__dict__, memo))
+        return new
+
 
 class LineList(list):
     """A sequence from YAML with ``line`` (of the sequence) and ``item_lines``."""
@@ -66,6 +74,12 @@ class LineList(list):
 
     def line_of(self, index: int) -> int:
         return self.item_lines[index] if 0 <= index < len(self.item_lines) else self.line
+
+    def __deepcopy__(self, memo: dict) -> "LineList":
+        """A copy with its lines, made directly (as LineDict's)."""
+        new = LineList(copy.deepcopy(v, memo) for v in self)
+        new.__dict__.update(copy.deepcopy(self.__dict__, memo))
+        return new
 
 
 def line_of(container: Any, key: Any, default: int = 0) -> int:

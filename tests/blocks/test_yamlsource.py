@@ -3,6 +3,7 @@ errors, and the limits on hostile text: size, kind, encoding, nesting and alias 
 
 from __future__ import annotations
 
+import copy
 import os
 import time
 
@@ -326,3 +327,14 @@ yaml_values = st.recursive(
 def test_load_yaml_agrees_with_safe_load(value, flow):
     text = yaml.safe_dump(value, default_flow_style=flow)
     assert load_yaml(text) == yaml.safe_load(text)
+
+
+def test_a_deep_copy_keeps_every_line_and_shares_nothing():
+    data = load_yaml("a:\n  b: [1, [2, 3]]\n  c: {x: 3}\n")
+    copied = copy.deepcopy(data)
+    assert copied == data and type(copied["a"]) is type(data["a"])
+    assert copied["a"].line_of("c") == data["a"].line_of("c") == 3
+    assert copied["a"]["b"].line_of(1) == data["a"]["b"].line_of(1) == 2
+    copied["a"]["b"][1].append(4)
+    copied["a"].key_lines["c"] = 99
+    assert data["a"]["b"][1] == [2, 3] and data["a"].line_of("c") == 3
