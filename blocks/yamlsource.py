@@ -61,7 +61,8 @@ class LineDict(dict):
     def __deepcopy__(self, memo: dict) -> "LineDict":
         """A copy with its lines, made directly (copy's generic way is slow, and every
         block's parameters are copied once per load)."""
-        new = LineDict((k, copy.deepcopy(v, memo)) for k, v in self.items())
+        new = memo[id(self)] = LineDict()  # registered first, as copy does, should a value hold this mapping
+        new.update((k, copy.deepcopy(v, memo)) for k, v in self.items())
         new.__dict__.update(copy.deepcopy(self.__dict__, memo))
         return new
 
@@ -77,7 +78,8 @@ class LineList(list):
 
     def __deepcopy__(self, memo: dict) -> "LineList":
         """A copy with its lines, made directly (as LineDict's)."""
-        new = LineList(copy.deepcopy(v, memo) for v in self)
+        new = memo[id(self)] = LineList()
+        new.extend(copy.deepcopy(v, memo) for v in self)
         new.__dict__.update(copy.deepcopy(self.__dict__, memo))
         return new
 
