@@ -14,8 +14,7 @@ from typing import Any, Mapping
 
 from .diagram import Diagram
 from .loader import parse_builder, read_builder
-from .ssp.package import is_ssp
-from .ssp.reader import read_ssp
+from .ssp.names import is_ssp
 
 
 def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
@@ -35,6 +34,8 @@ def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
     its SSD gives none.
     """
     if is_ssp(path):
+        from .ssp.reader import read_ssp
+
         return read_ssp(path, trust=trust, step=step).build(overrides, origins=origins)
     if step is not None:
         from .issues import DiagramError, Issue

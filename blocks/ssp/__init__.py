@@ -10,8 +10,19 @@ step-size annotations of libcosim and OMSimulator, and blocks' own stepping one)
 ``units`` (``ssd:Units`` from the FMUs).
 """
 
-from .package import SSD_NAME, is_ssp
-from .reader import read_ssp
-from .writer import export_ssp
+import importlib
+from typing import Any
 
-__all__ = ["SSD_NAME", "export_ssp", "is_ssp", "read_ssp"]
+_HOME = {"SSD_NAME": ".names", "is_ssp": ".names", "read_ssp": ".reader", "export_ssp": ".writer"}
+"""Where each public name lives, imported when first used (PEP 562): ``blocks.ssp.names``
+alone is what every diagram load needs."""
+
+__all__ = sorted(_HOME)
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _HOME:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_HOME[name], __name__), name)
+    globals()[name] = value
+    return value

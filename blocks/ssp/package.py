@@ -22,9 +22,7 @@ from urllib.parse import unquote, urlparse
 from .. import scratch
 from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, file_kind, open_regular
 from ..safepath import inside
-
-SSD_NAME = "SystemStructure.ssd"
-"""The SSD every SSP holds at its root (SSP 1.0, 4.1)."""
+from .names import SSD_NAME
 
 _unpacked: dict[str, Path] = {}
 _lock = threading.Lock()
@@ -74,13 +72,6 @@ class Package:
     def relative(self, path: Path) -> str:
         """``path`` relative to the SSD's folder, posix: what a diagram's FMU path says."""
         return path.resolve().relative_to(self.ssd.parent.resolve()).as_posix()
-
-
-def is_ssp(path: str | Path) -> bool:
-    """Whether ``path`` names an SSP: a ``.ssp`` file, an ``.ssd`` file, or a folder with a
-    SystemStructure.ssd."""
-    p = Path(path)
-    return p.suffix.lower() in (".ssp", ".ssd") or (p.is_dir() and (p / SSD_NAME).is_file())
 
 
 def open_package(path: str | Path) -> Package:

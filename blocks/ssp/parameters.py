@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, Callable
 
 from .package import Package, PackageError
-from .xml import XmlError, child, children, elements, local, parse_file, q
+from .xml import XmlError, child, children, elements, local, q
 
 FLOATS = ("Real", "Float64", "Float32")
 INTEGERS = ("Integer", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64")

@@ -35,7 +35,7 @@ from ..atomic_file import write_atomically
 from ..diagram import Diagram
 from ..issues import DiagramError, Issue
 from ..timebase import format_duration
-from .package import SSD_NAME
+from .names import SSD_NAME
 from .steps import add_base_step, add_feedthrough, add_step_hint, add_system_step, number
 from .units import add_units, unit_definitions
 from .xml import PREFIXES, q
