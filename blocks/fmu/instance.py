@@ -27,6 +27,7 @@ import collections
 import functools
 import itertools
 import os
+import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +44,9 @@ from .ports import Group
 from .start_values import Assignment
 
 _serials = itertools.count(1)
+_loading = threading.Lock()
+"""Held while fmpy loads a binary: it changes the process's working folder into the
+binary's and back, so two threads loading at once would leave it in one of theirs."""
 
 
 @dataclass
@@ -132,15 +136,16 @@ class Instance:
         name = f"{model.identifier}#{self.serial}"
         kwargs = {"guid": model.guid, "modelIdentifier": model.identifier,
                   "unzipDirectory": str(model.dir), "instanceName": name}
-        cwd = os.getcwd()
-        try:  # fmpy changes into the binary's folder to load it, and not back if that fails
-            slave = self._load(fmpy, kwargs)
-        except Exception as exc:
-            raise BlockError(f"cannot load the binary of {model.shown} "
-                             f"(binaries/{model.library.parent.name}/{model.library.name}): {exc}") from None
-        finally:
-            if os.getcwd() != cwd:
-                os.chdir(cwd)
+        with _loading:
+            cwd = os.getcwd()
+            try:  # fmpy changes into the binary's folder to load it, and not back if that fails
+                slave = self._load(fmpy, kwargs)
+            except Exception as exc:
+                raise BlockError(f"cannot load the binary of {model.shown} "
+                                 f"(binaries/{model.library.parent.name}/{model.library.name}): {exc}") from None
+            finally:
+                if os.getcwd() != cwd:
+                    os.chdir(cwd)
         self.slave = slave
         self._make()
 

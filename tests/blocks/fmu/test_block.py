@@ -185,6 +185,48 @@ def test_extracted_files_go_away_with_the_block(fmus):
     assert not folder.exists()
 
 
+def test_fmus_loaded_in_many_threads_at_once_leave_the_working_folder_alone(fmus, monkeypatch):
+    """fmpy changes into an FMU's binary folder to load it and back: threads loading at
+    once must not leave the process in one FMU's extracted folder (removed with its block).
+    The binaries here load in microseconds; a large one's load is made to take 20 ms."""
+    import ctypes
+    import threading
+    import time
+    from concurrent.futures import ThreadPoolExecutor
+
+    import fmpy.fmi1
+
+    class SlowLoader:
+        """A loader that takes 20 ms and counts how many loads overlap (each changes the
+        working folder, so they must not)."""
+        loading = overlapped = 0
+
+        def LoadLibrary(self, path):
+            self.loading += 1
+            self.overlapped = max(self.overlapped, self.loading)
+            time.sleep(0.02)
+            self.loading -= 1
+            return ctypes.cdll.LoadLibrary(path)
+
+    loader = SlowLoader()
+    monkeypatch.setattr(fmpy.fmi1, "cdll", loader)
+    here = os.getcwd()
+    threads = 8
+    start = threading.Barrier(threads)
+
+    def run(version: int):
+        d = diagram(fmus.fmi2 if version == 2 else fmus.fmi3, t_end="0.2 s", log="[f.y]", params="isolation: none")
+        start.wait()
+        return simulate(d).complete
+
+    with ThreadPoolExecutor(threads) as pool:
+        for _ in range(3):
+            assert all(pool.map(run, [2, 3] * (threads // 2)))
+            gc.collect()
+            assert os.getcwd() == here
+    assert loader.overlapped == 1
+
+
 def test_fmi3_arrays_float32_and_input_defaults(fmus):
     d = loads_diagram(f"""
 time: {{t_end: 0.5 s}}
