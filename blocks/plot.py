@@ -10,6 +10,7 @@ application registers (the hand's task phases).
 from __future__ import annotations
 
 import textwrap
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
 
@@ -57,24 +58,52 @@ def plot_signals(results: Results, path: str | Path, signals: Sequence[str] | No
     Raises ``SelectionError`` (a ValueError) for a selection of nothing logged. Returns
     the files written.
     """
-    selections = list(signals) if signals else list(results)
-    if not selections:
-        raise ValueError("no signals to plot: the run logged none (add a 'log:' list to the diagram)")
-    if len(selections) > MAX_PLOT_AXES:
-        check_plot_size(len(selections), 0)
-    axes = [axis for s in selections for axis in by_unit(results, select(results, s))]
-    check_plot_size(len(axes), sum(len(tr.columns) for traces in axes for tr in traces))
-    events = run_markers(results.info)[0] if markers is True else list(markers or [])
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    pages = balanced(axes, AXES_PER_PAGE)
-    written = []
-    for number, page in enumerate(pages, start=1):
-        fig = figure(results, page, title, events)
-        out = path if len(pages) == 1 else path.with_name(f"{path.stem}-{number}{path.suffix}")
+    pages = Pages.of(results, path, signals, title, markers)
+    return [pages.draw(number) for number in range(1, len(pages) + 1)]
+
+
+@dataclass
+class Pages:
+    """A plot laid out in pages before any is drawn (``plot_signals`` explains what it
+    draws), so that its pages can be drawn one by one, in any order or process."""
+
+    results: Results
+    path: Path
+    axes: list[list[list[Trace]]]
+    """Per page, per axis, the traces it draws."""
+    title: str | None
+    events: list[Marker]
+
+    @classmethod
+    def of(cls, results: Results, path: str | Path, signals: Sequence[str] | None = None,
+           title: str | None = None, markers: bool | Sequence[Marker] = True) -> "Pages":
+        """The pages of ``plot_signals(results, path, signals, title, markers)``, checked
+        (``SelectionError``, ``PlotSizeError``), ``path``'s folder made."""
+        selections = list(signals) if signals else list(results)
+        if not selections:
+            raise ValueError("no signals to plot: the run logged none (add a 'log:' list to the diagram)")
+        if len(selections) > MAX_PLOT_AXES:
+            check_plot_size(len(selections), 0)
+        axes = [axis for s in selections for axis in by_unit(results, select(results, s))]
+        check_plot_size(len(axes), sum(len(tr.columns) for traces in axes for tr in traces))
+        events = run_markers(results.info)[0] if markers is True else list(markers or [])
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return cls(results, path, balanced(axes, AXES_PER_PAGE), title, events)
+
+    def __len__(self) -> int:
+        return len(self.axes)
+
+    def file(self, number: int) -> Path:
+        """Where page ``number`` (from 1) goes: ``path`` itself for a one-page plot."""
+        return self.path if len(self) == 1 else self.path.with_name(f"{self.path.stem}-{number}{self.path.suffix}")
+
+    def draw(self, number: int) -> Path:
+        """Draw page ``number`` (from 1) into its file; returns the file."""
+        fig = figure(self.results, self.axes[number - 1], self.title, self.events)
+        out = self.file(number)
         fig.savefig(out, dpi=DPI, pil_kwargs=PNG)
-        written.append(out)
-    return written
+        return out
 
 
 def balanced(items: list, most: int) -> list[list]:

@@ -82,6 +82,19 @@ def check_mat_names(diagram) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    """``run``; with ``--plot`` a plotter process (``blocks.plot_process``) gets ready to
+    draw while the diagram loads and runs."""
+    from blocks.plot_process import PlotProcess
+
+    plotter = PlotProcess.start() if args.plot else None
+    try:
+        return simulate_and_save(args, plotter)
+    finally:
+        if plotter is not None:
+            plotter.close()
+
+
+def simulate_and_save(args: argparse.Namespace, plotter) -> int:
     """Simulate and save. The output folder is checked before the run (plots included);
     Ctrl-C or SIGTERM stops the run and its results so far are saved, and no signal cuts
     the saving short (``blocks.stop``). Plots are drawn once the files are saved: a signal
@@ -133,7 +146,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.plot and saved.folder is not None:
             if stops.received is None:
                 try:
-                    save_plots(results, saved)
+                    save_plots(results, saved, plotter)
                 except KeyboardInterrupt:
                     plots_note = f"; plots stopped by {stops.received or 'SIGINT'}"
             else:

@@ -14,9 +14,13 @@ import shutil
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from blocks import Results
 from blocks.results_folder import PLOTS, check_links, prepare, replacing_plots, writing
+
+if TYPE_CHECKING:
+    from blocks.plot_process import PlotProcess
 
 
 @dataclass
@@ -71,20 +75,25 @@ def save_run(results: Results, out: Path, csv: bool, temp_prefix: str = "results
     return Saved(spare, problem=f"cannot save the results in {out}: {reason}; saved them in {spare} instead")
 
 
-def save_plots(results: Results, saved: Saved) -> None:
+def save_plots(results: Results, saved: Saved, plotter: PlotProcess | None = None) -> None:
     """Draw the saved results' plots into their folder's ``plots/`` (replacing the earlier
-    run's as a set); a stop request ends the drawing and leaves no plot of this run. A
-    folder that cannot take them sets ``saved.problem``."""
+    run's as a set), by ``plotter`` if there is one, else here; a stop request ends the
+    drawing and leaves no plot of this run. A folder that cannot take them, or a plotter
+    that fails, sets ``saved.problem``."""
     from blocks.plot import plot_signals
+    from blocks.plot_process import PlotProcessError
 
     if not len(results):
         return
     try:
         with replacing_plots(saved.folder) as staged:
-            made = plot_signals(results, staged / "signals.png")
+            target = staged / "signals.png"
+            made = plot_signals(results, target) if plotter is None else plotter.draw(saved.folder, target)
         saved.plots = [saved.folder / PLOTS / p.name for p in made]
     except OSError as exc:
         saved.problem = f"the results are saved in {saved.folder}, but not their plots: {describe(exc)}"
+    except PlotProcessError as exc:
+        saved.problem = f"the results are saved in {saved.folder}, but not their plots: {exc}"
 
 
 def describe(exc: OSError) -> str:

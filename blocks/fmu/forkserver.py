@@ -17,10 +17,8 @@ import select
 import signal
 import socket
 
+from ..forked import die_with
 from .launcher import REAP_SECONDS
-
-_PR_SET_PDEATHSIG = 1
-
 
 def main(fd: int) -> None:
     """The launcher's life: import what the hosts need, then fork one per request until the
@@ -74,9 +72,7 @@ def _fork(sock: socket.socket, host, fds: list[int]) -> bytes:
         code = 0
         try:
             sock.close()
-            _die_with_parent()
-            if os.getppid() != launcher:  # the launcher ended before the request took hold
-                os._exit(1)
+            die_with(launcher)
             host.serve(*fds)
         except BaseException:
             code = 1
@@ -84,14 +80,6 @@ def _fork(sock: socket.socket, host, fds: list[int]) -> bytes:
     for f in fds:
         os.close(f)
     return str(pid).encode()
-
-
-def _die_with_parent() -> None:
-    """Ask the kernel for SIGKILL when the launcher exits (Linux: PR_SET_PDEATHSIG)."""
-    import ctypes
-
-    libc = ctypes.CDLL(None, use_errno=True)
-    libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
 
 
 def _reap(pid: int) -> bytes:

@@ -31,10 +31,10 @@ log: [ramp.y]
 
 
 def run(tmp_path: Path, at: str, send: str, *options: str, diagram: str = SHORT,
-        call: int = 1) -> subprocess.CompletedProcess:
+        call: int = 1, to: str = "self") -> subprocess.CompletedProcess:
     (tmp_path / "d.yaml").write_text(diagram, encoding="utf-8")
     env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{REPO}", SIGNAL_AT=at, SIGNAL_SEND=send,
-               SIGNAL_CALL=str(call))
+               SIGNAL_CALL=str(call), SIGNAL_TO=to)
     proc = subprocess.run([sys.executable, "-m", "hierhand", "run", "d.yaml", "-o", "out", *options],
                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
     assert "Traceback" not in proc.stderr, proc.stderr
@@ -69,10 +69,64 @@ def test_sigterm_while_a_complete_run_is_saved_does_not_exit_0(tmp_path):
     assert Results.load(tmp_path / "out").complete
 
 
-def test_sigint_while_plotting_stops_the_plots_and_keeps_the_results(tmp_path):
-    proc = run(tmp_path, "blocks.plot:figure", "SIGINT", "--plot")
-    assert proc.returncode == 130, proc.stderr
-    assert "plots stopped by SIGINT" in proc.stderr
+PAGES = "name: pages\ntime: {t_end: 20 ms}\nblocks:\n" + "".join(
+    f"  r{i}: {{type: Ramp, period: 1 ms, params: {{slope: {i}.0}}}}\n" for i in range(1, 15)) + \
+    "log: [" + ", ".join(f"r{i}.y" for i in range(1, 15)) + "]\n"
+"""A run whose plot is three pages: the plotter draws one and forks a drawer for each other."""
+
+
+def left_running(mark: str) -> list[int]:
+    """The processes still running (zombies aside) whose environment holds ``mark``."""
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit() or int(entry.name) == os.getpid():
+            continue
+        try:
+            if mark.encode() in (entry / "environ").read_bytes() and \
+                    (entry / "stat").read_text().rsplit(")", 1)[1].split()[0] != "Z":
+                found.append(int(entry.name))
+        except OSError:
+            continue
+    return found
+
+
+@pytest.mark.parametrize("send, code", [("SIGINT", 130), ("SIGTERM", 143)])
+@pytest.mark.parametrize("diagram", [SHORT, PAGES], ids=["one page", "three pages"])
+def test_a_signal_while_plotting_stops_the_plots_keeps_the_results_and_leaves_no_process(
+        tmp_path, monkeypatch, send, code, diagram):
+    """The pages are drawn by forked processes; the signal reaches the run's process from
+    the first page's drawing, as a Ctrl-C or a kill does."""
+    monkeypatch.setenv("PLOT_TEST_MARK", str(tmp_path))
+    proc = run(tmp_path, "blocks.plot:figure", send, "--plot", diagram=diagram, to="main")
+    assert proc.returncode == code, proc.stderr
+    assert f"plots stopped by {send}" in proc.stderr
     assert Results.load(tmp_path / "out").complete
     assert not (tmp_path / "out" / "plots").exists()
     assert [p.name for p in (tmp_path / "out").iterdir() if p.name.startswith(".")] == []
+    assert left_running(f"PLOT_TEST_MARK={tmp_path}") == []
+
+
+def test_plots_drawn_beside_the_run_are_those_drawn_in_its_process(tmp_path):
+    """``run --plot`` draws in forked processes; ``plot`` of the same results, in its own,
+    draws the same pixels."""
+    from PIL import Image
+
+    (tmp_path / "d.yaml").write_text(PAGES, encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=str(REPO))
+    for argv in (["run", "d.yaml", "-o", "out", "--plot"], ["plot", "out", "-o", "again.png"]):
+        done = subprocess.run([sys.executable, "-m", "hierhand", *argv], cwd=tmp_path, env=env,
+                              capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+    drawn = sorted((tmp_path / "out" / "plots").iterdir())
+    assert [p.name for p in drawn] == ["signals-1.png", "signals-2.png", "signals-3.png"]
+    for number, page in enumerate(drawn, start=1):
+        with Image.open(page) as a, Image.open(tmp_path / f"again-{number}.png") as b:
+            assert a.size == b.size and a.tobytes() == b.tobytes(), page.name
+
+
+def test_a_plotter_killed_by_a_signal_keeps_the_results_and_says_the_plots_are_missing(tmp_path):
+    proc = run(tmp_path, "blocks.plot:figure", "SIGKILL", "--plot", diagram=PAGES)
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr == (f"hierhand: the results are saved in out, but not their plots: the process drawing "
+                           "the plots ended unexpectedly (killed by SIGKILL)\n")
+    assert Results.load(tmp_path / "out").complete and not (tmp_path / "out" / "plots").exists()

@@ -9,7 +9,9 @@ signal itself, and ``SIGNAL_SEND`` to the signals (``SIGTERM,SIGINT``; default S
 
 The signals are sent by the process to itself at exactly that point, so a test of what a
 signal does in each phase (imports, loading, simulating, saving, plotting) needs no sleep
-and does not depend on the machine's speed.
+and does not depend on the machine's speed. With ``SIGNAL_TO=main`` a process forked by
+the one under test (the plotter of ``run --plot``) sends them to that one instead, as a
+Ctrl-C or ``kill`` reaches the program while its helper works.
 """
 
 import importlib.abc
@@ -20,6 +22,7 @@ import sys
 _AT = os.environ.get("SIGNAL_AT", "")
 _SEND = [getattr(signal, name) for name in os.environ.get("SIGNAL_SEND", "SIGINT").split(",")]
 _CALL = int(os.environ.get("SIGNAL_CALL", "1"))
+_TO = os.getpid() if os.environ.get("SIGNAL_TO") == "main" else None
 _calls = 0
 
 
@@ -28,7 +31,7 @@ def _fire() -> None:
     _calls += 1
     if _calls == _CALL:
         for signum in _SEND:
-            os.kill(os.getpid(), signum)
+            os.kill(os.getpid() if _TO is None else _TO, signum)
 
 
 class _Watch(importlib.abc.MetaPathFinder):
