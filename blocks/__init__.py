@@ -9,7 +9,6 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 import importlib
 import sys
 import types
-from typing import Any
 
 _EXPORTS = {
     ".block": ("Block", "BlockError", "EndRun", "ParameterError"),
@@ -39,7 +38,7 @@ class _Package(types.ModuleType):
     the module ``blocks.simulate`` sets the package's attribute to the module, which would
     hide the function; the function stays."""
 
-    def __setattr__(self, name: str, value: Any) -> None:
+    def __setattr__(self, name: str, value: object) -> None:
         if isinstance(value, types.ModuleType) and name in _HOME and hasattr(value, name):
             value = getattr(value, name)
         super().__setattr__(name, value)
@@ -48,7 +47,7 @@ class _Package(types.ModuleType):
 sys.modules[__name__].__class__ = _Package
 
 
-def __getattr__(name: str) -> Any:
+def __getattr__(name: str) -> object:
     module = _HOME.get(name)
     if module is None:
         raise AttributeError(f"module 'blocks' has no attribute {name!r}")

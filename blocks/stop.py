@@ -16,12 +16,10 @@ at start-up is one line and the exit code too, not a traceback.
 
 from __future__ import annotations
 
-import contextlib
 import os
 import signal
 import sys
-import threading
-from typing import Callable, Iterator
+from collections.abc import Callable
 
 EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
 """128 + the signal's number, as a shell reports a program that a signal ended."""
@@ -54,9 +52,11 @@ class StopSignals:
         return StopSignals.first
 
     def __enter__(self) -> "StopSignals":
-        if threading.current_thread() is threading.main_thread():
-            for signum in (signal.SIGINT, signal.SIGTERM):
+        for signum in (signal.SIGINT, signal.SIGTERM):
+            try:
                 self._previous[signum] = signal.signal(signum, self._handle)
+            except ValueError:  # not the main thread, where Python delivers signals
+                break
         return self
 
     def __exit__(self, *exc_info) -> None:
@@ -64,14 +64,9 @@ class StopSignals:
             signal.signal(signum, handler)
         self._previous.clear()
 
-    @contextlib.contextmanager
-    def held(self) -> Iterator[None]:
+    def held(self) -> "_Held":
         """Within this block signals are noted, not raised: what it writes is written whole."""
-        self._holding += 1
-        try:
-            yield
-        finally:
-            self._holding -= 1
+        return _Held(self)
 
     def _handle(self, signum: int, frame) -> None:
         name = signal.Signals(signum).name
@@ -81,6 +76,20 @@ class StopSignals:
         StopSignals.first = StopSignals.first or name
         doing = "while the results are saved: stopping once they are" if self._holding else "(already stopping)"
         os.write(2, f"{self.program}: {name} {doing}\n".encode())
+
+
+class _Held:
+    """``StopSignals.held()``: a context (a class, not contextlib's decorator, which this
+    module's start-up would pay to import)."""
+
+    def __init__(self, stops: StopSignals):
+        self.stops = stops
+
+    def __enter__(self) -> None:
+        self.stops._holding += 1
+
+    def __exit__(self, *exc_info) -> None:
+        self.stops._holding -= 1
 
 
 def exit_code(stop: KeyboardInterrupt | str | None) -> int:
