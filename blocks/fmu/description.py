@@ -15,6 +15,7 @@ from __future__ import annotations
 import errno
 import io
 import math
+import threading
 import zipfile
 from dataclasses import dataclass
 from fractions import Fraction
@@ -138,6 +139,11 @@ def variable_unit(v: Any) -> str | None:
     return str(unit) if unit else None
 
 
+_reading = threading.Lock()
+"""Held while fmpy reads a modelDescription: it validates with one lxml schema, which
+threads cannot use at once (a spurious 'Internal error: xmlSchemaPValAttrNodeValue')."""
+
+
 def read_description(path: str | Path, shown: str, validate: bool = True) -> FMUDescription:
     """The modelDescription of the FMU archive ``path`` (``shown`` names it in messages),
     checked against the FMI schema if ``validate``; FMUInfoError if it cannot be read."""
@@ -158,7 +164,8 @@ def read_description(path: str | Path, shown: str, validate: bool = True) -> FMU
         zf.writestr(MODEL_DESCRIPTION, xml)
     alone.seek(0)
     try:
-        md = read_model_description(alone, validate=validate)
+        with _reading:
+            md = read_model_description(alone, validate=validate)
     except Exception as exc:
         problems = getattr(exc, "problems", None)
         text = "; ".join(str(p) for p in problems[:3]) + ("; ..." if len(problems) > 3 else "") \

@@ -215,8 +215,8 @@ def test_fmus_loaded_in_many_threads_at_once_leave_the_working_folder_alone(fmus
     start = threading.Barrier(threads)
 
     def run(version: int):
-        d = diagram(fmus.fmi2 if version == 2 else fmus.fmi3, t_end="0.2 s", log="[f.y]", params="isolation: none")
         start.wait()
+        d = diagram(fmus.fmi2 if version == 2 else fmus.fmi3, t_end="0.2 s", log="[f.y]", params="isolation: none")
         return simulate(d).complete
 
     with ThreadPoolExecutor(threads) as pool:
@@ -225,6 +225,26 @@ def test_fmus_loaded_in_many_threads_at_once_leave_the_working_folder_alone(fmus
             gc.collect()
             assert os.getcwd() == here
     assert loader.overlapped == 1
+
+
+def test_fmu_diagrams_loaded_and_run_in_many_threads_at_once_all_complete(fmus):
+    """Each thread loads (reading and validating the modelDescription) and runs its own
+    diagram, the FMU in a process of its own, all starting at once."""
+    import threading
+    from concurrent.futures import ThreadPoolExecutor
+
+    threads = 8
+    start = threading.Barrier(threads)
+
+    def run(version: int):
+        start.wait()
+        r = simulate(diagram(fmus.fmi2 if version == 2 else fmus.fmi3, t_end="0.2 s", log="[f.y]"))
+        return r.complete or r.status
+
+    with ThreadPoolExecutor(threads) as pool:
+        for _ in range(6):
+            outcomes = list(pool.map(run, [2, 3] * (threads // 2)))
+            assert outcomes == [True] * threads, outcomes
 
 
 def test_fmi3_arrays_float32_and_input_defaults(fmus):
