@@ -170,6 +170,7 @@ def _plotter(parent: int, requests: int, replies: int) -> None:
     try:
         _detached(parent)
         os.setpgid(0, 0)
+        gc.disable()  # a short life, one page each: collections would only cost time (and copy pages)
         _warm()
         line = _read_line(requests)
         if line is None:  # the run ended without plots
@@ -199,8 +200,6 @@ def _warm() -> None:
     ax.legend(handles=ax.plot([0, 1], label="x"), fontsize="small")
     fig.suptitle("warm")
     FigureCanvasAgg(fig).draw()
-    gc.collect()
-    gc.freeze()  # the drawers' collections leave the imported objects (and their pages) alone
 
 
 def _draw(folder: Path, path: Path) -> list[Path]:
