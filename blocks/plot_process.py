@@ -17,12 +17,14 @@ the caller raises again as such, or any other failure's text).
 
 from __future__ import annotations
 
+import contextlib
 import gc
 import json
 import os
 import signal
 import sys
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 from .forked import die_with
@@ -68,11 +70,13 @@ class PlotProcess:
         os.close(replies[1])
         return cls(pid, requests[1], replies[0])
 
-    def draw(self, folder: Path, path: Path) -> list[Path]:
-        """The files of the plot of the results saved in ``folder``, drawn to ``path``
-        (``plot_signals``'s naming); the OSError a drawer met, or ``PlotProcessError``.
-        A stop request (a signal) while they are drawn goes on up; ``close`` then kills them."""
-        request = json.dumps({"folder": str(folder), "path": str(path)}) + "\n"
+    def draw(self, folder: Path, path: Path, signals: list[str] | None = None, markers: bool = True) -> list[Path]:
+        """The files of ``plot_signals(results, path, signals, markers=markers)`` for the
+        results saved in ``folder``; the OSError or ValueError (a selection of nothing
+        logged) a drawer met, or ``PlotProcessError``. A stop request (a signal) while they
+        are drawn goes on up; ``close`` then kills them."""
+        request = json.dumps({"folder": str(folder), "path": str(path), "signals": signals,
+                              "markers": bool(markers)}) + "\n"
         try:
             try:
                 os.write(self._requests, request.encode())
@@ -119,6 +123,18 @@ class PlotProcess:
         return _how(status)
 
 
+@contextlib.contextmanager
+def plotter_beside(wanted: bool = True) -> Iterator[PlotProcess | None]:
+    """A started plotter (None if not ``wanted`` or where it cannot be forked), closed at
+    the block's end whatever happens."""
+    plotter = PlotProcess.start() if wanted else None
+    try:
+        yield plotter
+    finally:
+        if plotter is not None:
+            plotter.close()
+
+
 def _how(status: int) -> str:
     if os.WIFSIGNALED(status):
         return f"killed by {signal.Signals(os.WTERMSIG(status)).name}"
@@ -141,6 +157,8 @@ def _files(reply: dict) -> list[Path]:
         return [Path(f) for f in reply["files"]]
     if reply.get("kind") == "OSError":
         raise OSError(reply["errno"], reply["strerror"], reply["filename"])
+    if reply.get("kind") == "ValueError":
+        raise ValueError(reply["text"])
     raise PlotProcessError(reply["text"])
 
 
@@ -153,6 +171,8 @@ def _outcome(call) -> dict:
             return {"kind": "error", "text": str(exc)}
         return {"kind": "OSError", "errno": exc.errno, "strerror": exc.strerror,
                 "filename": None if exc.filename is None else str(exc.filename)}
+    except (ValueError, KeyError) as exc:  # what the caller reports as bad input
+        return {"kind": "ValueError", "text": exc.args[0] if isinstance(exc, KeyError) and exc.args else str(exc)}
     except BaseException as exc:
         return {"kind": "error", "text": f"{type(exc).__name__}: {exc}"}
 
@@ -176,7 +196,8 @@ def _plotter(parent: int, requests: int, replies: int) -> None:
         if line is None:  # the run ended without plots
             os._exit(0)
         request = json.loads(line)
-        reply = _outcome(lambda: _draw(Path(request["folder"]), Path(request["path"])))
+        reply = _outcome(lambda: _draw(Path(request["folder"]), Path(request["path"]), request["signals"],
+                                       request["markers"]))
         os.write(replies, (json.dumps(reply) + "\n").encode())
     except BaseException:
         os._exit(1)
@@ -202,12 +223,12 @@ def _warm() -> None:
     FigureCanvasAgg(fig).draw()
 
 
-def _draw(folder: Path, path: Path) -> list[Path]:
+def _draw(folder: Path, path: Path, signals: list[str] | None, markers: bool) -> list[Path]:
     """The plot of the results in ``folder``: page 1 here, every other in a forked drawer."""
     from .plot import Pages
     from .results import Results
 
-    pages = Pages.of(Results.load(folder), path)
+    pages = Pages.of(Results.load(folder), path, signals, markers=markers)
     me = os.getpid()
     drawers = []
     for number in range(2, len(pages) + 1):

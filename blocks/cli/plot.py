@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from .options import png_output
-from .program import EXIT_OK, UsageError
+from .program import EXIT_FAILED, EXIT_OK, UsageError
 
 SELECTION_HELP = ("an axis: a signal (plant.q), elements of it by label or 0-based index "
                   "(plant.q[fore.1], plant.q[0:3], plant.q[thumb.1,fore.1]), or several such "
@@ -33,10 +33,22 @@ def add(sub, program) -> argparse.ArgumentParser:
 
 
 def cmd_plot(args: argparse.Namespace) -> int:
-    """Plot the chosen selections (default: every signal) and print the files written."""
+    """Plot the chosen selections (default: every signal) and print the files written.
+    The selections are checked here; the pages are drawn by a plotter process
+    (``blocks.plot_process``, one process per page) where there is one, else here."""
+    from blocks.plot_process import plotter_beside
+
+    with plotter_beside() as plotter:
+        return plot_folder(args, plotter)
+
+
+def plot_folder(args: argparse.Namespace, plotter) -> int:
     from blocks import Results
-    from blocks.plot import plot_signals
+    from blocks.plot import Pages, plot_signals
     from blocks.plot_markers import markers
+    from blocks.plot_process import PlotProcessError
+
+    from .run_output import describe
 
     out = png_output(args.output) if args.output is not None else args.run_dir / "plots" / "signals.png"
     results = Results.load(args.run_dir)
@@ -46,9 +58,17 @@ def cmd_plot(args: argparse.Namespace) -> int:
         for note in notes:
             print(f"{args.program.name}: note: {note}", file=sys.stderr)
     try:
-        written = plot_signals(results, out, args.signals, markers=events)
+        if plotter is None:
+            written = plot_signals(results, out, args.signals, markers=events)
+        else:
+            Pages.of(results, out, args.signals, markers=events)  # bad selections: said before matplotlib loads
+            written = plotter.draw(args.run_dir, out, args.signals, markers=not args.no_markers)
     except (KeyError, ValueError) as exc:
-        raise UsageError(str(exc).strip("'\"")) from None
+        raise UsageError(exc.args[0] if isinstance(exc, KeyError) and exc.args else str(exc)) from None
+    except (OSError, PlotProcessError) as exc:
+        print(f"{args.program.name}: the plots could not be written: "
+              f"{describe(exc) if isinstance(exc, OSError) else exc}", file=sys.stderr)
+        return EXIT_FAILED
     for path in written:
         print(f"wrote {path}")
     return EXIT_OK

@@ -84,14 +84,10 @@ def check_mat_names(diagram) -> None:
 def cmd_run(args: argparse.Namespace) -> int:
     """``run``; with ``--plot`` a plotter process (``blocks.plot_process``) gets ready to
     draw while the diagram loads and runs."""
-    from blocks.plot_process import PlotProcess
+    from blocks.plot_process import plotter_beside
 
-    plotter = PlotProcess.start() if args.plot else None
-    try:
+    with plotter_beside(args.plot) as plotter:
         return simulate_and_save(args, plotter)
-    finally:
-        if plotter is not None:
-            plotter.close()
 
 
 def simulate_and_save(args: argparse.Namespace, plotter) -> int:

@@ -46,6 +46,7 @@ def test_elements_by_label_and_overlays_make_one_png(run_dir, tmp_path):
 
 @pytest.mark.parametrize("selection, word", [
     ("mux.y[speed]", "signal 'mux.y' has no element 'speed'; its elements: ref, wave"),
+    ("nope", "error: 'nope' is not a signal (block.port)"),
     ("mux.y[5]", "index 5 is out of range"), ("mux.y,nope.y", "signal 'nope.y' was not logged"),
 ])
 def test_a_bad_selection_is_one_line_and_exit_2(run_dir, tmp_path, selection, word):
@@ -54,3 +55,10 @@ def test_a_bad_selection_is_one_line_and_exit_2(run_dir, tmp_path, selection, wo
     lines = proc.stderr.strip().splitlines()
     assert len(lines) == 1 and word in lines[0] and "Traceback" not in proc.stderr
     assert not (tmp_path / "p.png").exists()
+
+
+def test_a_plot_that_cannot_be_written_is_one_line_and_exit_1(run_dir, tmp_path):
+    (tmp_path / "file").write_text("not a folder")
+    proc = blocks_cli("plot", run_dir, "-o", tmp_path / "file" / "p.png", cwd=tmp_path)
+    assert proc.returncode == 1
+    assert proc.stderr == f"blocks: the plots could not be written: File exists: {tmp_path / 'file'}\n"
