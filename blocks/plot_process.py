@@ -68,6 +68,10 @@ class PlotProcess:
             _plotter(parent, requests[0], replies[1])
         os.close(requests[0])
         os.close(replies[1])
+        try:  # the child makes its group too: whichever runs first, killpg finds it
+            os.setpgid(pid, pid)
+        except OSError:
+            pass
         return cls(pid, requests[1], replies[0])
 
     def draw(self, folder: Path, path: Path, signals: list[str] | None = None, markers: bool = True) -> list[Path]:
@@ -118,7 +122,11 @@ class PlotProcess:
         """Wait for the plotter to end: how it ended, in words."""
         if self._ended:
             return "ended"
-        _, status = os.waitpid(self.pid, 0)
+        try:
+            _, status = os.waitpid(self.pid, 0)
+        except ChildProcessError:  # reaped already (SIGCHLD ignored by the program)
+            self._ended = True
+            return "ended"
         self._ended = True
         return _how(status)
 
