@@ -90,10 +90,9 @@ def save_plots(results: Results, saved: Saved, plotter: PlotProcess | None = Non
             target = staged / "signals.png"
             made = plot_signals(results, target) if plotter is None else plotter.draw(saved.folder, target)
         saved.plots = [saved.folder / PLOTS / p.name for p in made]
-    except OSError as exc:
-        saved.problem = f"the results are saved in {saved.folder}, but not their plots: {describe(exc)}"
-    except PlotProcessError as exc:
-        saved.problem = f"the results are saved in {saved.folder}, but not their plots: {exc}"
+    except (OSError, PlotProcessError) as exc:
+        why = describe(exc) if isinstance(exc, OSError) else exc
+        saved.problem = f"the results are saved in {saved.folder}, but not their plots: {why}"
 
 
 def describe(exc: OSError) -> str:
