@@ -82,17 +82,33 @@ def test_asking_for_spawned_processes_keeps_the_sweep_from_forking_a_local_one(t
 
 
 NAP_MODULE = '''
+import os
 import time
 
 from blocks import Block
 
+_runs = 0
+
+
+def _on_a_worker() -> bool:
+    try:
+        from distributed import get_worker
+
+        get_worker()
+        return True
+    except (ImportError, ValueError):
+        return False
+
 
 class Nap(Block):
     """y = u; each run sleeps ``nap`` seconds at its first output: runs of a known length
-    that leave the cores free."""
+    that leave the cores free. With a ``mark`` file, a run on a Dask worker makes it, and a
+    process's third and later runs elsewhere wait for it (a minute at most): the local
+    process cannot run every point before the cluster runs one, however loaded the machine."""
 
-    def __init__(self, nap: float = 0.0):
+    def __init__(self, nap: float = 0.0, mark: str = ""):
         self.nap = float(nap)
+        self.mark = mark
         self.inputs = {"u": 1}
         self.outputs = {"y": 1}
         self.feedthrough = True
@@ -101,8 +117,16 @@ class Nap(Block):
         return [True]
 
     def output(self, t, state, inputs):
+        global _runs
         if state[0]:
+            _runs += 1
             time.sleep(self.nap)
+            if self.mark and _on_a_worker():
+                open(self.mark, "w").close()
+            elif self.mark and _runs >= 3:
+                deadline = time.monotonic() + 60
+                while not os.path.exists(self.mark) and time.monotonic() < deadline:
+                    time.sleep(0.005)
             state[0] = False
         return {"y": inputs["u"].copy()}
 '''
@@ -112,7 +136,7 @@ name: nap
 time: {t_end: 3 ms}
 blocks:
   src: {type: Constant, params: {value: 1.0}}
-  nap: {type: "python:nap_block:Nap", period: 1 ms, params: {nap: 0.04}}
+  nap: {type: "python:nap_block:Nap", period: 1 ms, params: {nap: 0.04, mark: MARK}}
 connections:
   - src.y -> nap.u
 log: [nap.y]
@@ -122,7 +146,7 @@ log: [nap.y]
 @pytest.mark.skipif(default_workers() < 2, reason="with one core a cluster never pays off")
 def test_the_cluster_takes_over_from_the_local_process_and_no_point_runs_twice(tmp_path):
     (tmp_path / "nap_block.py").write_text(NAP_MODULE, encoding="utf-8")
-    (tmp_path / "nap.yaml").write_text(NAP_DIAGRAM, encoding="utf-8")
+    (tmp_path / "nap.yaml").write_text(NAP_DIAGRAM.replace("MARK", f"'{tmp_path / 'worker-ran'}'"), encoding="utf-8")
     points = grid_points({"src.value": list(range(40))})  # 1.6 s of runs: worth a cluster
     default = run_sweep(tmp_path / "nap.yaml", points, ["y=final(nap.y)"], tmp_path / "default", progress=False,
                         trust=True)
