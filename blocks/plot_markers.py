@@ -24,6 +24,9 @@ from typing import Any, Callable, Iterable
 
 from .plugins import load_group
 
+MARKER_COLOUR = "dimgray"
+"""The colour of every marker, on signal plots and on the application's figures."""
+
 ENTRY_POINT_GROUP = "blocks.plot_markers"
 
 MarkerSource = Callable[[dict], Iterable[Any]]

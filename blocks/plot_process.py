@@ -1,10 +1,9 @@
-"""A run's plots drawn beside it: a process forked as ``run --plot`` starts imports
-matplotlib and loads its fonts while the diagram loads and runs, then draws the saved
+"""A run's plots drawn beside it: a process forked as ``run --plot`` starts imports the
+drawing code and loads its fonts while the diagram loads and runs, then draws the saved
 results' pages, one process per page, so that the pictures cost little more than the run.
 
-Importing matplotlib takes about as long as a short run, and each page takes about as
-long again; in a process of its own the import overlaps the run, and the pages overlap
-each other, on a machine with two cores or more. ``PlotProcess.start`` returns None where
+In a process of its own the imports overlap the run, and the pages overlap each other,
+on a machine with two cores or more. ``PlotProcess.start`` returns None where
 processes cannot be forked (not Linux), and the caller draws in its own process.
 
 The plotter and its drawers ignore SIGINT (a Ctrl-C at the terminal reaches them too: the
@@ -213,22 +212,15 @@ def _plotter(parent: int, requests: int, replies: int) -> None:
 
 
 def _warm() -> None:
-    """Import what drawing needs (the installed marker sources too) and draw a little
-    text, which loads the fonts."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    from . import plot, results  # noqa: F401 (imported once here, ready in every drawer)
+    """Import what drawing needs (the installed marker sources too) and load the fonts."""
+    from . import plot, plot_paint, results  # noqa: F401 (imported once here, ready in every drawer)
+    from .plot_canvas import text_size
     from .plot_markers import marker_sources
+    from .plot_page import LARGE, SIZE, SMALL, X_SMALL
 
     marker_sources()  # what a source that fails to load says comes with the plot
-
-    fig = Figure(figsize=(1, 1))
-    ax = fig.subplots()
-    ax.set_ylabel("warm (s)")
-    ax.legend(handles=ax.plot([0, 1], label="x"), fontsize="small")
-    fig.suptitle("warm")
-    FigureCanvasAgg(fig).draw()
+    for size in (SIZE, SMALL, X_SMALL, LARGE):
+        text_size("warm (s)", size)
 
 
 def _draw(folder: Path, path: Path, signals: list[str] | None, markers: bool) -> list[Path]:

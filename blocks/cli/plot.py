@@ -61,7 +61,7 @@ def plot_folder(args: argparse.Namespace, plotter) -> int:
         if plotter is None:
             written = plot_signals(results, out, args.signals, markers=events)
         else:
-            Pages.of(results, out, args.signals, markers=events)  # bad selections: said before matplotlib loads
+            Pages.of(results, out, args.signals, markers=events)  # bad selections: said before a page is drawn
             written = plotter.draw(args.run_dir, out, args.signals, markers=not args.no_markers)
     except (KeyError, ValueError) as exc:
         raise UsageError(exc.args[0] if isinstance(exc, KeyError) and exc.args else str(exc)) from None

@@ -10,11 +10,9 @@ import signal
 import numpy as np
 import pytest
 
-pytest.importorskip("matplotlib")
-
-from blocks import Results  # noqa: E402
-from blocks.plot import plot_signals  # noqa: E402
-from blocks.plot_process import FORKS, PlotProcess, PlotProcessError  # noqa: E402
+from blocks import Results
+from blocks.plot import plot_signals
+from blocks.plot_process import FORKS, PlotProcess, PlotProcessError
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="plots are drawn in forked processes on Linux only")
 
