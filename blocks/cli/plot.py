@@ -35,7 +35,7 @@ def add(sub, program) -> argparse.ArgumentParser:
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot the chosen selections (default: every signal) and print the files written.
     The selections are checked here; the pages are drawn by a plotter process
-    (``blocks.plot_process``, one process per page) where there is one, else here."""
+    (``blocks.plot_process``, the pages shared out between a process per core) where there is one, else here."""
     from blocks.plot_process import plotter_beside
 
     with plotter_beside() as plotter:
