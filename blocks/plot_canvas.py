@@ -80,6 +80,47 @@ def text_size(text: str, size_pt: float) -> tuple[float, float]:
     return max(f.getlength(line) for line in lines), _pitch(size_pt) * len(lines)
 
 
+ELLIPSIS = "\u2026"
+
+
+def fit(text: str, width: float, size_pt: float, lines: int = 1) -> str:
+    """``text`` wrapped (at spaces where it can, within words where it must) into lines
+    at most ``width`` pixels wide, at most ``lines`` of them, the last cut short with an
+    ellipsis if the text is longer: what fits where a label has to go."""
+    f = font(size_pt)
+    out: list[str] = []
+    rest = " ".join(text.split())
+    while rest and len(out) < lines:
+        if f.getlength(rest) <= width:
+            out.append(rest)
+            rest = ""
+            break
+        cut = _longest_fitting(rest, width, f)
+        space = rest.rfind(" ", 0, cut + 1)
+        if space > 0:
+            cut = space
+        out.append(rest[:cut].rstrip())
+        rest = rest[cut:].lstrip()
+    if rest:
+        last = out[-1] if out else ""
+        while last and f.getlength(last + ELLIPSIS) > width:
+            last = last[:-1]
+        out[-1:] = [last.rstrip() + ELLIPSIS]
+    return "\n".join(out)
+
+
+def _longest_fitting(text: str, width: float, f) -> int:
+    """How many of ``text``'s first characters fit in ``width`` pixels (at least one)."""
+    lo, hi = 1, len(text)
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if f.getlength(text[:mid]) <= width:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
 def _pitch(size_pt: float) -> float:
     return LINE_SPACING * points(size_pt)
 

@@ -11,13 +11,12 @@ only turns it into pixels.
 
 from __future__ import annotations
 
-import textwrap
 from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
 
-from .plot_canvas import DPI, points, text_size
+from .plot_canvas import DPI, fit, points, text_size
 from .plot_markers import Marker
 from .plot_select import Trace, select
 from .plot_ticks import Ticks, data_range, ticks
@@ -25,7 +24,10 @@ from .results import Results
 
 FIGURE_WIDTH = 11.0
 AXES_HEIGHT = 2.3
-TITLE_WIDTH = 110
+TITLE_LINES = 2     # at most, of the title
+NOTE_LINES = 3      # at most, of the status or end note under it
+LABEL_LINES = 2     # at most, of an axis label's name (its unit takes one more)
+LEGEND_WIDTH = 3.5  # inches, at most, of a legend entry's text
 STOP_MARGIN = 0.02
 LEFT = 1.25         # inches left of the axes: tick labels and a two-line axis label
 BOTTOM = 0.55       # below the last axis: its tick labels and the time label
@@ -124,15 +126,16 @@ def layout(results: Results, selections: Sequence[str | list[Trace]], title: str
     dashed line marks, with a dot on each element's last sample."""
     panels_traces = [select(results, s) if isinstance(s, str) else list(s) for s in selections]
     end, stop = time_span(results)
-    heading = title or results.info.get("diagram", "")
+    width = round(FIGURE_WIDTH * DPI)
+    heading = fit(title or results.info.get("diagram", ""), 0.95 * width, LARGE, TITLE_LINES)
     note = results.end_note if results.complete else results.status
     if note:
-        heading += "\n" + textwrap.fill(f"[{note}]", TITLE_WIDTH)
+        heading += "\n" + fit(f"[{note}]", 0.95 * width, LARGE, NOTE_LINES)
     n = len(panels_traces)
     top = 0.25 + TITLE_LINE * (heading.count("\n") + 1)
     entries = [_entries(results, traces) for traces in panels_traces]
     right = max([0.3 * DPI] + [_legend_size(labels)[0] + 0.15 * DPI for labels in entries])
-    width, height = round(FIGURE_WIDTH * DPI), round((top + BOTTOM + AXES_HEIGHT * n) * DPI)
+    height = round((top + BOTTOM + AXES_HEIGHT * n) * DPI)
     x0, x1 = LEFT * DPI, width - right
     axes_height = (AXES_HEIGHT * n - GAP * (n - 1)) / n * DPI
     xlim = _time_limits(results, panels_traces, end, stop)
@@ -145,7 +148,7 @@ def layout(results: Results, selections: Sequence[str | list[Trace]], title: str
         values = np.concatenate([c.v for c in curves]) if curves else np.empty(0)
         ylim = data_range(values)
         panel = Panel(box, xlim, ylim, xticks, ticks(*ylim, max(2, int(axes_height / Y_TICK_SPACING))),
-                      _axis_label(", ".join(tr.title for tr in traces), units), curves, dots=dots,
+                      _axis_label(", ".join(tr.title for tr in traces), units, axes_height), curves, dots=dots,
                       time_labels=k == n - 1)
         legend = [c for c in curves if c.label is not None]
         if 1 < len(legend) <= MAX_LEGEND:
@@ -172,7 +175,8 @@ def _time_limits(results: Results, panels_traces, end: float | None, stop: float
 
 
 def _entries(results: Results, traces: list[Trace]) -> list[str | None]:
-    """The legend label of each line of a panel (None: unlabelled)."""
+    """The legend label of each line of a panel (None: unlabelled), cut short past
+    LEGEND_WIDTH inches."""
     overlaid = len(traces) > 1
     labels = []
     for tr in traces:
@@ -186,7 +190,7 @@ def _entries(results: Results, traces: list[Trace]) -> list[str | None]:
                 labels.append((tr.title if width == 1 else f"{tr.signal}[{tr.labels[j]}]") + unit)
             else:
                 labels.append(tr.labels[j] + unit if width > 1 else None)
-    return labels
+    return [label if label is None else fit(label, LEGEND_WIDTH * DPI, SMALL) for label in labels]
 
 
 def _legend_size(labels: Sequence[str | None]) -> tuple[float, float]:
@@ -227,8 +231,13 @@ def _curves(results: Results, traces: list[Trace], end: float | None, stop: floa
     return curves, dots, shown_units
 
 
-def _axis_label(name: str, units: list[str]) -> str:
-    return axis_label(textwrap.fill(name, 40), units or None)
+def _axis_label(name: str, units: list[str], height: float) -> str:
+    """A panel's axis label (``axis_label``), each line no longer than the panel is high."""
+    label = axis_label(fit(name, height, SIZE, LABEL_LINES), units or None)
+    if units:
+        name_lines, _, unit_line = label.rpartition("\n")
+        label = name_lines + "\n" + fit(unit_line, height, SIZE)
+    return label
 
 
 def envelope(t: np.ndarray, v: np.ndarray, columns: int) -> tuple[np.ndarray, np.ndarray]:

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .plot_canvas import Canvas, points, rgb
+from .plot_canvas import Canvas, fit, points, rgb
 from .plot_markers import MARKER_COLOUR
 from .plot_page import (LABEL_PAD, LARGE, LEGEND_COLUMN, LEGEND_HANDLE, LEGEND_PAD, LEGEND_PITCH, SIZE, SMALL,
                         TICK_LENGTH, TICK_PAD, X_SMALL, Page, Panel)
@@ -30,7 +30,8 @@ def paint(page: Page) -> Canvas:
     for m in page.markers:
         x, _ = first.to_pixels(m.start, 0.0)
         if first.box[0] <= x <= first.box[2]:
-            canvas.text(x + points(2), first.box[1] + points(2), m.label, X_SMALL, rgb(MARKER_COLOUR),
+            label = fit(m.label, first.box[3] - first.box[1] - points(4), X_SMALL)
+            canvas.text(x + points(2), first.box[1] + points(2), label, X_SMALL, rgb(MARKER_COLOUR),
                         ha="left", va="top", rotation=90, backdrop=rgb("white", 0.7))
     if page.stop is not None:
         x, _ = first.to_pixels(page.stop, 0.0)

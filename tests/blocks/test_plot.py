@@ -244,3 +244,25 @@ def test_extreme_values_are_drawn_on_a_finite_axis_without_a_warning(values):
     assert np.isfinite([lo, hi]).all() and lo < hi
     finite = [v for v in values if np.isfinite(v)]
     assert all(lo <= v <= hi for v in finite)
+
+
+def test_labels_of_any_length_stay_on_the_page_and_leave_room_for_the_data():
+    from blocks.plot_canvas import text_size
+    from blocks.plot_page import LARGE, SIZE
+
+    t = np.arange(10) * 0.1
+    long = "b" * 150
+    run = Results({f"{long}.y": (t, np.ones((10, 3))), "a.q": (t, np.ones((10, 2)))},
+                  {"diagram": "d " * 300, "t_end": 1.0, "status": "failed at t=0.5 s: " + "boom " * 300,
+                   "t_stop": 0.5, "element_labels": {f"{long}.y": ["x" * 400, "y", "z"]},
+                   "units": {"a.q": [f"unit{i} " * 20 for i in range(2)]}})
+    page = layout(run, list(run))
+    assert max(text_size(line, LARGE)[0] for line in page.title.split("\n")) <= page.width
+    assert page.title.count("\n") <= 4
+    for panel in page.panels:
+        x0, y0, x1, y1 = panel.box
+        assert x1 - x0 > 0.5 * page.width  # the data keeps half the page's width at least
+        assert max(text_size(line, SIZE)[0] for line in panel.ylabel.split("\n")) <= y1 - y0
+        if panel.legend_box is not None:
+            assert panel.legend_box[2] <= page.width
+    paint(page)

@@ -97,7 +97,7 @@ def test_a_signal_while_plotting_stops_the_plots_keeps_the_results_and_leaves_no
     """The pages are drawn by forked processes; the signal reaches the run's process from
     the first page's drawing, as a Ctrl-C or a kill does."""
     monkeypatch.setenv("PLOT_TEST_MARK", str(tmp_path))
-    proc = run(tmp_path, "blocks.plot_page:layout", send, "--plot", diagram=diagram, to="main")
+    proc = run(tmp_path, "blocks.plot:Pages.draw", send, "--plot", diagram=diagram, to="main")
     assert proc.returncode == code, proc.stderr
     assert f"plots stopped by {send}" in proc.stderr
     assert Results.load(tmp_path / "out").complete
@@ -126,7 +126,7 @@ def test_plots_drawn_beside_the_run_are_those_drawn_in_its_process(tmp_path):
 
 
 def test_a_plotter_killed_by_a_signal_keeps_the_results_and_says_the_plots_are_missing(tmp_path):
-    proc = run(tmp_path, "blocks.plot_page:layout", "SIGKILL", "--plot", diagram=PAGES)
+    proc = run(tmp_path, "blocks.plot:Pages.draw", "SIGKILL", "--plot", diagram=PAGES)
     assert proc.returncode == 1, proc.stderr
     assert proc.stderr == (f"hierhand: the results are saved in out, but not their plots: the process drawing "
                            "the plots ended unexpectedly (killed by SIGKILL)\n")
