@@ -11,7 +11,12 @@ and ``timeout`` stop a program: its partial results are kept the same way.
 
 ``launch`` installs the handlers before a command line imports its modules (this module
 needs only the standard library, and ``blocks`` imports its parts lazily), so a signal
-at start-up is one line and the exit code too, not a traceback.
+at start-up is one line and the exit code too, not a traceback. A command's executable
+(``blocks/csrc/launcher.c``) blocks both signals before the interpreter starts, so that one
+sent while Python itself starts waits, pending; ``launch`` unblocks them once its handlers
+are in place, and such a signal is then the same one line. Unblocking them is harmless
+where nothing blocked them (``python -m``), and whatever the program forks or spawns
+afterwards starts with them unblocked.
 """
 
 from __future__ import annotations
@@ -23,6 +28,9 @@ from collections.abc import Callable
 
 EXIT_CODES = {"SIGINT": 130, "SIGTERM": 143}
 """128 + the signal's number, as a shell reports a program that a signal ended."""
+
+STOPS = {signal.SIGINT, signal.SIGTERM}
+"""The signals that are requests to stop."""
 
 
 class StopRequest(KeyboardInterrupt):
@@ -103,9 +111,12 @@ def launch(program: str, command: Callable[[], Callable[[], object]]) -> None:
     """Run a command line: ``command()`` imports it and returns its entry function, which
     is then called. SIGINT and SIGTERM are stop requests from before the import to the
     exit; one that stops the program outside a command's own handling (during the
-    imports, say) ends it with one line and its exit code."""
+    imports, say) ends it with one line and its exit code. Both are unblocked once their
+    handlers are installed: one that came while they were blocked (the launcher blocks
+    them while Python starts) is handled then."""
     with StopSignals(program):
         try:
+            signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPS)
             entry = command()
             entry()
         except KeyboardInterrupt as stop:

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from blocks import Results
+from tests.blocked_start import blocked, blocked_stops
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX signals")
 
@@ -131,3 +132,28 @@ def test_a_plotter_killed_by_a_signal_keeps_the_results_and_says_the_plots_are_m
     assert proc.stderr == (f"hierhand: the results are saved in out, but not their plots: the process drawing "
                            "the plots ended unexpectedly (killed by SIGKILL)\n")
     assert Results.load(tmp_path / "out").complete and not (tmp_path / "out" / "plots").exists()
+
+
+@pytest.mark.parametrize("send, code", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_signal_that_came_while_python_started_is_one_line(tmp_path, send, code):
+    """As the ``hierhand`` executable starts Python: the signals blocked, this one pending."""
+    (tmp_path / "d.yaml").write_text(SHORT, encoding="utf-8")
+    proc = subprocess.run(blocked([sys.executable, "-m", "hierhand", "run", "d.yaml", "-o", "out"], pending=send),
+                          cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(REPO)), capture_output=True, text=True,
+                          timeout=120)
+    assert (proc.returncode, proc.stderr) == (code, "hierhand: interrupted\n")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("diagram", [SHORT, PAGES], ids=["one page", "three pages"])
+def test_the_plotters_start_with_the_signals_unblocked(tmp_path, diagram):
+    """Though the run started with them blocked (as the ``hierhand`` executable starts it),
+    the processes that draw its plots can be stopped by SIGINT and SIGTERM."""
+    (tmp_path / "d.yaml").write_text(diagram, encoding="utf-8")
+    env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{REPO}", SIGNAL_AT="blocks.plot:Pages.draw",
+               SIGNAL_RECORD=str(tmp_path / "masks"))
+    proc = subprocess.run(blocked([sys.executable, "-m", "hierhand", "run", "d.yaml", "-o", "out", "--plot"]),
+                          cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    masks = (tmp_path / "masks").read_text().splitlines()
+    assert masks and [blocked_stops(line) for line in masks] == [[]] * len(masks)

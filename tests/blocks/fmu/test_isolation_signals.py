@@ -1,7 +1,8 @@
 """Signals while an isolated FMU never returns: Ctrl-C and SIGTERM stop the run (exit 130
 and 143) with its results so far, and no process nor temporary file is left behind, also when the run itself
 is killed. The FMU hangs in doStep at t = 0.3 s after writing its process's id and its
-parent's (the launcher) into a FIFO the test reads: the sign that it hangs now."""
+parent's (the launcher) into a FIFO the test reads: the sign that it hangs now. And the FMU's
+processes can be stopped by those signals though the run started with them blocked."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from blocks.fmu.model import PROCESS_ISOLATION
+from tests.blocked_start import blocked, blocked_stops
 
 fmpy = pytest.importorskip("fmpy")
 
@@ -24,6 +26,7 @@ from .build import misbehaving_fmu  # noqa: E402
 pytestmark = pytest.mark.skipif(not PROCESS_ISOLATION, reason="FMUs run in processes of their own only on Linux")
 
 ROOT = Path(__file__).resolve().parents[3]
+HOOK = ROOT / "tests" / "blocks" / "cli" / "signal_hook"
 WAIT = 120.0
 """Seconds a test waits for a sign (the FMU ready, a process ended) before it fails."""
 
@@ -94,3 +97,24 @@ def test_killing_the_run_ends_its_fmu_processes(tmp_path, misbehaving):
     proc.kill()
     proc.communicate(timeout=WAIT)
     assert ended(launcher) and ended(host)
+
+
+def test_the_fmu_processes_start_with_the_signals_unblocked(tmp_path, fmus):
+    """The run starts with SIGINT and SIGTERM blocked, as the ``hierhand`` executable starts
+    Python; the FMU's process (forked by the launcher the run spawns) has them unblocked."""
+    (tmp_path / "d.yaml").write_text(f"""\
+name: isolated
+time: {{t_end: 1 s}}
+blocks:
+  src: {{type: Step, period: 0.1 s, params: {{time: 0.2}}}}
+  plant: {{type: FMU, period: 0.1 s, params: {{path: {fmus.fmi2}, isolation: process}}}}
+connections: [src.y -> plant.u]
+log: [plant.y]
+""")
+    env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{ROOT}", SIGNAL_AT="blocks.fmu.host:serve",
+               SIGNAL_RECORD=str(tmp_path / "masks"), BLOCKS_SCRATCH="")
+    proc = subprocess.run(blocked([sys.executable, "-m", "blocks", "run", "d.yaml", "-o", "out", "-q"]), cwd=tmp_path,
+                          env=env, capture_output=True, text=True, timeout=WAIT)
+    assert proc.returncode == 0, proc.stderr
+    masks = (tmp_path / "masks").read_text().splitlines()
+    assert len(masks) == 1 and blocked_stops(masks[0]) == [], masks
