@@ -186,7 +186,10 @@ def _local_cluster(workers: int | None, method: str | None):
     from distributed import LocalCluster
 
     from .. import scratch
+    from ..forked import own_std_streams_after_fork
     from .worker_plugin import IgnoreCtrlC
+
+    own_std_streams_after_fork()  # workers are forked from a thread while others may be writing
 
     settings = {**LOCAL_CLUSTER_CONFIG, "distributed.worker.multiprocessing-method": start_method(method),
                 "temporary-directory": str(scratch.folder("dask-"))}  # the scheduler's and workers' folders
