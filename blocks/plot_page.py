@@ -27,7 +27,7 @@ AXES_HEIGHT = 2.3
 TITLE_LINES = 2     # at most, of the title
 NOTE_LINES = 3      # at most, of the status or end note under it
 LABEL_LINES = 2     # at most, of an axis label's name (its unit takes one more)
-LEGEND_WIDTH = 3.5  # inches, at most, of a legend entry's text
+LEGEND_WIDTH = 3.0  # inches, at most, of a legend's text (of each column's, over its columns)
 STOP_MARGIN = 0.02
 LEFT = 1.25         # inches left of the axes: tick labels and a two-line axis label
 BOTTOM = 0.55       # below the last axis: its tick labels and the time label
@@ -176,7 +176,7 @@ def _time_limits(results: Results, panels_traces, end: float | None, stop: float
 
 def _entries(results: Results, traces: list[Trace]) -> list[str | None]:
     """The legend label of each line of a panel (None: unlabelled), cut short past
-    LEGEND_WIDTH inches."""
+    LEGEND_WIDTH inches over the legend's columns."""
     overlaid = len(traces) > 1
     labels = []
     for tr in traces:
@@ -190,7 +190,8 @@ def _entries(results: Results, traces: list[Trace]) -> list[str | None]:
                 labels.append((tr.title if width == 1 else f"{tr.signal}[{tr.labels[j]}]") + unit)
             else:
                 labels.append(tr.labels[j] + unit if width > 1 else None)
-    return [label if label is None else fit(label, LEGEND_WIDTH * DPI, SMALL) for label in labels]
+    columns = 1 if sum(label is not None for label in labels) <= LEGEND_ROWS else 2
+    return [label if label is None else fit(label, LEGEND_WIDTH * DPI / columns, SMALL) for label in labels]
 
 
 def _legend_size(labels: Sequence[str | None]) -> tuple[float, float]:

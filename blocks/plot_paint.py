@@ -67,7 +67,7 @@ def _panel(canvas: Canvas, page: Page, panel: Panel) -> None:
         inner.line(np.array([[a, y0], [a, y1]]) - shift, RED, 1, _dashes("--", 1.5))
     canvas.paste(inner, x0, y0)
     canvas.box(x0, y0, x1, y1, outline=BLACK)
-    _ticks(canvas, panel, xt, yt)
+    _ticks(canvas, page, panel, xt, yt)
     for t, values in panel.dots:
         xs, ys = panel.to_pixels(np.full(len(values), t), values)
         for x, y in zip(xs, ys):
@@ -77,7 +77,7 @@ def _panel(canvas: Canvas, page: Page, panel: Panel) -> None:
         _legend(canvas, panel)
 
 
-def _ticks(canvas: Canvas, panel: Panel, xt: np.ndarray, yt: np.ndarray) -> None:
+def _ticks(canvas: Canvas, page: Page, panel: Panel, xt: np.ndarray, yt: np.ndarray) -> None:
     x0, y0, x1, y1 = panel.box
     length, pad = points(TICK_LENGTH), points(TICK_LENGTH + TICK_PAD)
     for x in xt:
@@ -98,7 +98,7 @@ def _ticks(canvas: Canvas, panel: Panel, xt: np.ndarray, yt: np.ndarray) -> None
             bottom = max(bottom, box[3])
         if panel.xticks.offset:
             canvas.text(x1, bottom, panel.xticks.offset, SIZE, ha="right", va="top")
-        canvas.text((x0 + x1) / 2, bottom + points(LABEL_PAD), "time (s)", SIZE, ha="center", va="top")
+        canvas.text((x0 + x1) / 2, bottom + points(LABEL_PAD), page.time_label, SIZE, ha="center", va="top")
 
 
 def _legend(canvas: Canvas, panel: Panel) -> None:

@@ -252,9 +252,10 @@ def test_labels_of_any_length_stay_on_the_page_and_leave_room_for_the_data():
 
     t = np.arange(10) * 0.1
     long = "b" * 150
-    run = Results({f"{long}.y": (t, np.ones((10, 3))), "a.q": (t, np.ones((10, 2)))},
+    run = Results({f"{long}.y": (t, np.ones((10, 3))), "a.q": (t, np.ones((10, 2))), "c.v": (t, np.ones((10, 20)))},
                   {"diagram": "d " * 300, "t_end": 1.0, "status": "failed at t=0.5 s: " + "boom " * 300,
-                   "t_stop": 0.5, "element_labels": {f"{long}.y": ["x" * 400, "y", "z"]},
+                   "t_stop": 0.5, "element_labels": {f"{long}.y": ["x" * 400, "y", "z"],
+                                                     "c.v": [f"{k}" + "w" * 300 for k in range(20)]},
                    "units": {"a.q": [f"unit{i} " * 20 for i in range(2)]}})
     page = layout(run, list(run))
     assert max(text_size(line, LARGE)[0] for line in page.title.split("\n")) <= page.width
