@@ -21,14 +21,16 @@ from __future__ import annotations
 import importlib.util
 import os
 import sys
-from distutils.ccompiler import new_compiler
-from distutils.command.build_scripts import build_scripts
-from distutils.sysconfig import customize_compiler
 from pathlib import Path
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
+
+# after setuptools, which makes these its own copy of distutils (Python 3.12 has none)
+from distutils.ccompiler import new_compiler  # noqa: E402
+from distutils.command.build_scripts import build_scripts  # noqa: E402
+from distutils.sysconfig import customize_compiler  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import importlib.util
 from pathlib import Path
+from typing import BinaryIO
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
@@ -162,9 +163,8 @@ class Canvas:
         if backdrop is not None:
             pad = points(1.0)
             self.box(x0 - pad, y0 - pad, x0 + bw + pad, y0 + bh + pad, fill=backdrop)
-        align = "center" if ha == "center" else ha
         if rotation == 0:
-            self._lines(self._draw, x0, y0, text, size_pt, colour, w, align)
+            self._lines(self._draw, x0, y0, text, size_pt, colour, w, ha)
         else:
             mask = Image.new("L", (max(1, round(w)), max(1, round(h))), 0)
             self._lines(ImageDraw.Draw(mask), 0.0, 0.0, text, size_pt, 255, w, "center")
@@ -193,8 +193,9 @@ class Canvas:
         part._draw = ImageDraw.Draw(part.image, "RGBA")
         return part
 
-    def save(self, path: Path) -> None:
-        self.image.save(path, format="PNG", dpi=(DPI, DPI), **PNG)
+    def save(self, file: Path | BinaryIO) -> None:
+        """The page as PNG, into a file or a binary stream."""
+        self.image.save(file, format="PNG", dpi=(DPI, DPI), **PNG)
 
 
 def _finite_pieces(xy: np.ndarray) -> list[np.ndarray]:

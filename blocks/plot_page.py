@@ -153,7 +153,7 @@ def layout(results: Results, selections: Sequence[str | list[Trace]], title: str
         legend = [c for c in curves if c.label is not None]
         if 1 < len(legend) <= MAX_LEGEND:
             panel.legend = legend
-            panel.legend_columns = 1 if len(legend) <= LEGEND_ROWS else 2
+            panel.legend_columns = _legend_columns(len(legend))
             lw, lh = _legend_size([c.label for c in legend])
             left = x1 + 0.01 * (x1 - x0)
             panel.legend_box = (left, y0, left + lw, y0 + lh)
@@ -180,8 +180,7 @@ def _entries(results: Results, traces: list[Trace]) -> list[str | None]:
     overlaid = len(traces) > 1
     labels = []
     for tr in traces:
-        all_units = results.units(tr.signal)
-        units = [all_units[c] for c in tr.columns] if all_units is not None else None
+        units = _units(results, tr)
         mixed = units is not None and len(set(units)) > 1
         width = len(tr.columns)
         for j in range(width):
@@ -190,8 +189,18 @@ def _entries(results: Results, traces: list[Trace]) -> list[str | None]:
                 labels.append((tr.title if width == 1 else f"{tr.signal}[{tr.labels[j]}]") + unit)
             else:
                 labels.append(tr.labels[j] + unit if width > 1 else None)
-    columns = 1 if sum(label is not None for label in labels) <= LEGEND_ROWS else 2
+    columns = _legend_columns(sum(label is not None for label in labels))
     return [label if label is None else fit(label, LEGEND_WIDTH * DPI / columns, SMALL) for label in labels]
+
+
+def _units(results: Results, trace: Trace) -> list[str] | None:
+    """The units of a trace's elements (None: its block gave none)."""
+    units = results.units(trace.signal)
+    return None if units is None else [units[c] for c in trace.columns]
+
+
+def _legend_columns(entries: int) -> int:
+    return 1 if entries <= LEGEND_ROWS else 2
 
 
 def _legend_size(labels: Sequence[str | None]) -> tuple[float, float]:
@@ -200,7 +209,7 @@ def _legend_size(labels: Sequence[str | None]) -> tuple[float, float]:
     if not 1 < len(shown) <= MAX_LEGEND:
         return 0.0, 0.0
     em = points(SMALL)
-    columns = 1 if len(shown) <= LEGEND_ROWS else 2
+    columns = _legend_columns(len(shown))
     rows = -(-len(shown) // columns)
     column = (LEGEND_HANDLE + LEGEND_PAD) * em + max(text_size(label, SMALL)[0] for label in shown)
     return columns * column + (columns - 1) * LEGEND_COLUMN * em, rows * LEGEND_PITCH * em
@@ -223,8 +232,7 @@ def _curves(results: Results, traces: list[Trace], end: float | None, stop: floa
             t, v = np.append(t, end), np.vstack([v, v[-1:]])
         t, v = envelope(t, v, columns)
         width = v.shape[1]
-        all_units = results.units(tr.signal)
-        shown_units += [all_units[c] for c in tr.columns] if all_units is not None else []
+        shown_units += _units(results, tr) or []
         trace_styles = styles[drawn:drawn + width] if overlaid else line_styles(list(tr.labels))
         for j in range(width):
             curves.append(Curve(t, v[:, j], trace_styles[j], labels[drawn + j]))

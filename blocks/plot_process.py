@@ -231,7 +231,7 @@ def _warm() -> None:
                   {"diagram": "warm", "status": "failed at t=1 s: warm", "t_end": 2.0, "t_stop": 1.0,
                    "element_labels": {"w.y": ["a.1", "a.2"]}, "units": {"w.y": "m"}})
     page = layout(run, ["w.y"], markers=[Marker(0.2, 0.2, "", "warm"), Marker(0.4, 0.6, "span", "warm")])
-    paint(page).image.save(io.BytesIO(), format="PNG")
+    paint(page).save(io.BytesIO())
 
 
 def _draw(folder: Path, path: Path, signals: list[str] | None, markers: bool) -> list[Path]:

@@ -107,18 +107,23 @@ def test_a_failed_run_marks_the_last_sample_of_every_element():
                 assert is_colour(pixels[round(y), round(x)], rgb("tab:red"))
         x, _ = panel.to_pixels(page.stop, 0.0)
         column = pixels[round(panel.box[3]) - 40:round(panel.box[3]) - 1, round(x) - 1:round(x) + 2].reshape(-1, 3)
-        assert 0 < sum(is_colour(p, rgb("tab:red")) for p in column) < len(column) / 3  # dashed
+        assert 0 < colour_mask(column, rgb("tab:red")).sum() < len(column) / 3  # dashed
+
+
+def colour_mask(pixels, colour, tolerance: int = 40) -> np.ndarray:
+    """Where ``pixels`` (an array of RGB, of any shape) are ``colour``, within ``tolerance``."""
+    return np.all(np.abs(np.asarray(pixels)[..., :3].astype(int) - np.asarray(colour[:3])) <= tolerance, axis=-1)
 
 
 def is_colour(pixel, colour, tolerance: int = 40) -> bool:
-    return bool(np.all(np.abs(np.asarray(pixel[:3], dtype=int) - np.asarray(colour[:3])) <= tolerance))
+    return bool(colour_mask(pixel, colour, tolerance))
 
 
 def test_a_complete_run_has_no_marks():
     page = layout(described(), ["b.q"])
     assert page.panels[0].dots == [] and page.stop is None
     pixels = np.asarray(paint(page).image)
-    assert not any(is_colour(p, rgb("tab:red"), 10) for row in pixels for p in row[::3])
+    assert not colour_mask(pixels[:, ::3], rgb("tab:red"), 10).any()
 
 
 def test_plot_signals_writes_the_png(tmp_path):
@@ -138,7 +143,7 @@ def test_an_axis_of_selected_elements_and_one_of_overlaid_signals():
 def grey_in(pixels, x0: float, x1: float, y0: float, y1: float) -> int:
     """How many pixels of the box are the markers' grey (their lines and words)."""
     box = pixels[round(y0):round(y1), round(x0):round(x1)].reshape(-1, 3)
-    return sum(is_colour(p, rgb(MARKER_COLOUR), 25) for p in box)
+    return int(colour_mask(box, rgb(MARKER_COLOUR), 25).sum())
 
 
 def test_markers_are_drawn_on_every_axis_and_named_once():
@@ -205,7 +210,7 @@ def test_a_curve_is_painted_where_its_values_are_and_only_inside_its_panel():
     page = layout(run, ["a.y"])
     (panel,) = page.panels
     pixels = np.asarray(paint(page).image)
-    blue = np.all(np.abs(pixels.astype(int) - rgb("C0")) <= 40, axis=2)
+    blue = colour_mask(pixels, rgb("C0"))
     x0, y0, x1, y1 = panel.box
     rows = {value: round(float(panel.to_pixels(0.0, value)[1])) for value in (0.0, 1.0, 3.0)}
     left, middle, right = (round(float(panel.to_pixels(s, 0.0)[0])) for s in (0.1, 0.5, 0.9))
@@ -224,7 +229,7 @@ def test_non_finite_values_break_the_curve_and_leave_the_range_to_the_finite_one
     page = layout(run, ["a.y"])
     assert page.panels[0].ylim == pytest.approx((-0.1, 2.1))
     pixels = np.asarray(paint(page).image)
-    blue = np.all(np.abs(pixels.astype(int) - rgb("C0")) <= 40, axis=2)
+    blue = colour_mask(pixels, rgb("C0"))
     gap = round(float(page.panels[0].to_pixels(0.625, 0.0)[0]))
     assert not blue[:, gap].any() and blue.any()
 
