@@ -12,7 +12,7 @@ compiler: ``blocks/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the op-table core, th
 library's kernels and an FMI wrapper: any diagram of library blocks) and
 ``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the same with the hand's kernels). They
 link libc and libm only; their FMI headers come from fmpy (a build requirement), the
-headers an importer builds against too. The file lists are ``blocks/native_sources.py``
+headers an importer builds against too. The file lists are ``blocks/engine/native_sources.py``
 and ``hierhand/native_sources.py``, which the exporter reads for an FMU's ``sources/``.
 """
 

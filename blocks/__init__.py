@@ -7,44 +7,28 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 """
 
 import importlib
-import sys
-import types
 
 _EXPORTS = {
     ".block": ("Block", "BlockError", "EndRun", "ParameterError"),
-    ".builder": ("DiagramBuilder",),
-    ".diagram": ("Diagram",),
+    ".builder.diagram_builder": ("DiagramBuilder",),
+    ".builder.diagram": ("Diagram",),
     ".issues": ("DiagramError", "Issue"),
-    ".load": ("load_diagram", "loads_diagram"),
-    ".loader": ("read_builder",),
-    ".results": ("Results", "ResultsError"),
-    ".schedule": ("Schedule", "build_schedule"),
-    ".simulate": ("SimulationError", "simulate"),
-    ".stop": ("StopRequest",),
+    ".diagram_file.load": ("load_diagram", "loads_diagram"),
+    ".diagram_file.reader": ("read_builder",),
+    ".results.signals": ("Results", "ResultsError"),
+    ".engine.schedule": ("Schedule", "build_schedule"),
+    ".engine.simulate": ("SimulationError", "simulate"),
+    ".process.stop": ("StopRequest",),
     ".timebase": ("parse_duration",),
-    ".yamlwriter": ("WriteError", "dump_diagram", "save_diagram"),
+    ".diagram_file.writer": ("WriteError", "dump_diagram", "save_diagram"),
 }
 """Where each public name lives. They are imported when first used (PEP 562), so that
-importing a light part of the package (``blocks.stop``, which a command line installs its
+importing a light part of the package (``blocks.process.stop``, which a command line installs its
 signal handlers from before anything else) does not import numpy and the rest."""
 
 _HOME = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = sorted(_HOME)
-
-
-class _Package(types.ModuleType):
-    """The package, whose function ``simulate`` shares its name with its module: importing
-    the module ``blocks.simulate`` sets the package's attribute to the module, which would
-    hide the function; the function stays."""
-
-    def __setattr__(self, name: str, value: object) -> None:
-        if isinstance(value, types.ModuleType) and name in _HOME and hasattr(value, name):
-            value = getattr(value, name)
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package
 
 
 def __getattr__(name: str) -> object:

@@ -13,7 +13,7 @@ import sys
 if sys.path and sys.path[0] in ("", os.getcwd()) and not sys.flags.safe_path:
     del sys.path[0]
 
-from blocks.stop import launch  # noqa: E402  (after the path is safe)
+from blocks.process.stop import launch  # noqa: E402  (after the path is safe)
 
 
 def _command():

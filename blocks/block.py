@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 import numpy as np
 
 if TYPE_CHECKING:
-    from .kernel import Kernel
+    from blocks.engine.kernel import Kernel
 
 Signal = np.ndarray
 """A port value: a 1-D float64 array of the port's declared width."""
@@ -108,7 +108,7 @@ class Block:
     and implement ``output`` (and ``update`` / ``initial_state`` if they have state).
     Parameters are the keyword arguments of ``__init__``, with their defaults; the
     ``Parameters`` section (numpydoc) of the class docstring documents them, which
-    ``hierhand blocks`` shows (see ``blocks.paramdocs``).
+    ``hierhand blocks`` shows (see ``blocks.typeinfo``).
 
     Block references. A parameter named in ``block_params`` takes another block of the
     same diagram, as Drake's controllers take the ``MultibodyPlant`` they model: in the
@@ -215,7 +215,7 @@ class Block:
         return state, {p: np.asarray(v, dtype=float).reshape(n, self.outputs[p]) for p, v in rows.items()}
 
     def kernel(self) -> Kernel | None:
-        """The block's compiled step functions (``blocks.kernel.Kernel``), which the
+        """The block's compiled step functions (``blocks.engine.kernel.Kernel``), which the
         executor calls in C instead of ``output`` / ``update`` / ``advance``; None (the
         default) runs the Python methods. Called once per run, after ``bind``."""
         return None
@@ -255,7 +255,7 @@ class Block:
         pose; ``""`` for an element of unknown unit); None, the default, when the block
         does not know. Plots put it beside the signal's name and run.json keeps it
         (``units``), and a connection whose other end declares another unit is a load
-        error (``blocks.annotations``). A diagram may give the ports a block leaves None
+        error (``blocks.builder.annotations``). A diagram may give the ports a block leaves None
         units of their own (``units: {b.y: rad}``)."""
         return None
 

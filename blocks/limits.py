@@ -43,7 +43,7 @@ MAX_RESULTS_BYTES = 64 * 1024**3
 """Largest ``signals.npz`` a results folder may hold (64 GiB): a run writes what it logs,
 so this is only a bound against a file that is not one; what bounds a hostile file is
 that its arrays may hold at most 200 times its size once decompressed, checked from each
-array's header before anything is allocated (``blocks.npzfile``)."""
+array's header before anything is allocated (``blocks.results.npzfile``)."""
 
 MAX_PLOT_AXES = 120
 """Most axes one ``plot`` (or ``run --plot``) draws: 20 pages of six. A run that logs more

@@ -32,7 +32,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from blocks.results import held_index
+from blocks.results.signals import held_index
 
 from .tasks.phases import FINGER_WORDS, Phase, phase_at, task_phases
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import hierhand
 from blocks import Diagram, DiagramBuilder
-from blocks import native_sources as framework_sources
+from blocks.engine import native_sources as framework_sources
 from blocks.fmu_export import FmuExportError, KernelSet, export_fmu, installed_binary
 
 from . import _native, native_sources

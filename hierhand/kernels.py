@@ -1,7 +1,7 @@
 """The hierhand blocks' compiled kernels: their records, and contexts built from them.
 
 The kernels are kernel types in C (``hierhand/csrc/kernels.h``): a constructor that
-builds a context from a record of doubles (``blocks.kernel.KernelRecord``), and adapters
+builds a context from a record of doubles (``blocks.engine.kernel.KernelRecord``), and adapters
 that call the very functions the blocks' Python methods call, so either path gives the
 same bits. A block's ``kernel()`` writes its record and makes a ``Context`` of it through
 that constructor, the one an exported FMU calls to rebuild the block from the same record
@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from blocks.kernel import Follow, KernelRecord, Link, Tunable
+from blocks.engine.kernel import Follow, KernelRecord, Link, Tunable
 
 from . import _native
 

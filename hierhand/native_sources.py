@@ -3,10 +3,10 @@
 One list, so that the extension, the FMU binaries built at install and the ``sources/``
 folder of an exported FMU always hold the same files. Paths are relative to the
 repository root (``CSRC``); an export copies its files flat into ``sources/``. Like
-``blocks.native_sources`` this module imports nothing of the packages, so that setup.py
+``blocks.engine.native_sources`` this module imports nothing of the packages, so that setup.py
 can read it before anything is built.
 
-hierhand's FMU binary is the framework's (``blocks.native_sources.fmu_sources``) with the
+hierhand's FMU binary is the framework's (``blocks.engine.native_sources.fmu_sources``) with the
 hand's kernel types: the plant core and the controllers' laws, their kernels
 (``kernels.c``) and the kernel-set file ``fmu_kernels.c`` that lists them beside the
 library's, so any diagram of library and hand blocks leaves as an FMU.
@@ -41,7 +41,7 @@ EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + ["python/py_common.h
 
 def fmu_sources(framework: list[str]) -> list[str]:
     """Every file (repository paths) of hierhand's FMU binary of one FMI version: the
-    framework's (``framework``, from ``blocks.native_sources.fmu_sources``), the hand's
+    framework's (``framework``, from ``blocks.engine.native_sources.fmu_sources``), the hand's
     kernels and its kernel-set file; C files first, then headers."""
     c_files = [p for p in framework if p.endswith(".c")] + _paths(CORE + CONTROL + [KERNEL_SET])
     return c_files + [p for p in framework if not p.endswith(".c")] + _paths(CORE_HEADERS + CONTROL_HEADERS)

@@ -2,7 +2,7 @@
 
 The ``hierhand`` executable (the framework's launcher, ``blocks/csrc/launcher.c``, built by
 setup.py) and ``python -m hierhand`` call ``main``, which installs the stop handlers
-(``blocks.stop``) and only then imports the command line, so a Ctrl-C while numpy,
+(``blocks.process.stop``) and only then imports the command line, so a Ctrl-C while numpy,
 matplotlib or a diagram load is one line and exit code 130, not a traceback. The
 executable starts Python with SIGINT and SIGTERM blocked, and ``main`` unblocks them once
 they are handled, so that a Ctrl-C while the interpreter itself starts is that line too;
@@ -11,7 +11,7 @@ they are handled, so that a Ctrl-C while the interpreter itself starts is that l
 
 from __future__ import annotations
 
-from blocks.stop import launch
+from blocks.process.stop import launch
 
 
 def _command():

@@ -4,7 +4,7 @@ One module per command (or group): ``run``, ``validate``, ``graph``, ``plot``, `
 (the group, with ``export`` and ``info``), ``sweep`` (``sweep`` and ``sweep-plot``) and
 ``block_types`` (``blocks``); ``options`` holds the diagram options they share,
 ``program`` the parser, the error handling and the exit codes, ``run_output`` what
-``run`` needs to save its results whatever happens (and ``blocks.stop`` the signals).
+``run`` needs to save its results whatever happens (and ``blocks.process.stop`` the signals).
 
 ``python -m blocks`` runs ``PROGRAM``, the generic commands alone; an application builds
 its own ``Program`` from ``GENERIC_COMMANDS``' members and its commands (``hierhand`` does).

@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 from typing import Any, Sequence
 
-from ..yamlsource import load_yaml_value
+from blocks.diagram_file.yaml_source import load_yaml_value
 from .program import UsageError
 
 

@@ -35,8 +35,8 @@ def add(sub, program) -> argparse.ArgumentParser:
 def cmd_plot(args: argparse.Namespace) -> int:
     """Plot the chosen selections (default: every signal) and print the files written.
     The selections are checked here; the pages are drawn by a plotter process
-    (``blocks.plot_process``, the pages shared out between a process per core) where there is one, else here."""
-    from blocks.plot_process import plotter_beside
+    (``blocks.plot.beside_run``, the pages shared out between a process per core) where there is one, else here."""
+    from blocks.plot.beside_run import plotter_beside
 
     with plotter_beside() as plotter:
         return plot_folder(args, plotter)
@@ -44,9 +44,9 @@ def cmd_plot(args: argparse.Namespace) -> int:
 
 def plot_folder(args: argparse.Namespace, plotter) -> int:
     from blocks import Results
-    from blocks.plot import Pages, plot_signals
-    from blocks.plot_markers import markers
-    from blocks.plot_process import PlotProcessError
+    from blocks.plot.pages import Pages, plot_signals
+    from blocks.plot.markers import markers
+    from blocks.plot.beside_run import PlotProcessError
 
     from .run_output import describe
 

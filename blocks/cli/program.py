@@ -117,7 +117,7 @@ def main(program: Program, argv: Sequence[str] | None = None) -> int:
         print(f"{program.name}: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt as exc:
-        from blocks.stop import exit_code
+        from blocks.process.stop import exit_code
 
         print(f"{program.name}: interrupted", file=sys.stderr)
         return exit_code(exc)

@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..status_line import StatusLine
+from blocks.process.status_line import StatusLine
 from .options import diagram_args, end_time, load
 from .program import EXIT_FAILED, EXIT_OK, UsageError
 
@@ -58,7 +58,7 @@ class ProgressBar:
 
 def check_formats(args: argparse.Namespace) -> None:
     """UsageError for a --csv-digits or --decimate out of range, before anything is loaded."""
-    from blocks.results import check_digits
+    from blocks.results.signals import check_digits
 
     if args.csv_digits is not None:
         if not args.csv:
@@ -73,7 +73,7 @@ def check_formats(args: argparse.Namespace) -> None:
 
 def check_mat_names(diagram) -> None:
     """UsageError, before the run, for a logged signal that a MAT file cannot name."""
-    from blocks.results_mat import MatNameError, mat_paths
+    from blocks.results.mat import MatNameError, mat_paths
 
     try:
         mat_paths(e.signal for e in diagram.log)
@@ -82,9 +82,9 @@ def check_mat_names(diagram) -> None:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """``run``; with ``--plot`` a plotter process (``blocks.plot_process``) gets ready to
+    """``run``; with ``--plot`` a plotter process (``blocks.plot.beside_run``) gets ready to
     draw while the diagram loads and runs."""
-    from blocks.plot_process import plotter_beside
+    from blocks.plot.beside_run import plotter_beside
 
     with plotter_beside(args.plot) as plotter:
         return simulate_and_save(args, plotter)
@@ -93,17 +93,17 @@ def cmd_run(args: argparse.Namespace) -> int:
 def simulate_and_save(args: argparse.Namespace, plotter) -> int:
     """Simulate and save. The output folder is checked before the run (plots included);
     Ctrl-C or SIGTERM stops the run and its results so far are saved, and no signal cuts
-    the saving short (``blocks.stop``). Plots are drawn once the files are saved: a signal
+    the saving short (``blocks.process.stop``). Plots are drawn once the files are saved: a signal
     then stops the drawing (the results stay), and after an interrupt they are skipped. A
     signal that comes while a complete run is saved ends the command with its exit code
     once the files are written. A run that a block ends early (``EndRun``) is complete: it
     says where and why, even with -q. A failed or interrupted run that replaces a complete
     one says where the complete one's files went."""
     from blocks import DiagramError, simulate
-    from blocks.plot import PlotSizeError, check_plot_size
-    from blocks.results_folder import OutputFolderError
+    from blocks.plot.pages import PlotSizeError, check_plot_size
+    from blocks.results.folder import OutputFolderError
     from blocks.safepath import folder_name
-    from blocks.stop import StopSignals, exit_code
+    from blocks.process.stop import StopSignals, exit_code
 
     from .run_output import check_output, remove_if_empty, save_plots, save_run
 

@@ -2,7 +2,7 @@
 
 The output folder is checked before the run (created, a folder, writable), so a bad
 ``-o`` costs nothing; the files and plots are then written as one set
-(``blocks.results_folder``). Should writing still fail (a full disk, a folder removed
+(``blocks.results.folder``). Should writing still fail (a full disk, a folder removed
 meanwhile), the results go to a fresh temporary folder and the message says where: a long
 run is not lost at its last step.
 """
@@ -17,10 +17,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from blocks import Results
-from blocks.results_folder import PLOTS, check_links, prepare, replacing_plots, writing
+from blocks.results.folder import PLOTS, check_links, prepare, replacing_plots, writing
 
 if TYPE_CHECKING:
-    from blocks.plot_process import PlotProcess
+    from blocks.plot.beside_run import PlotProcess
 
 
 @dataclass
@@ -80,8 +80,8 @@ def save_plots(results: Results, saved: Saved, plotter: PlotProcess | None = Non
     run's as a set), by ``plotter`` if there is one, else here; a stop request ends the
     drawing and leaves no plot of this run. A folder that cannot take them, or a plotter
     that fails, sets ``saved.problem``."""
-    from blocks.plot import plot_signals
-    from blocks.plot_process import PlotProcessError
+    from blocks.plot.pages import plot_signals
+    from blocks.plot.beside_run import PlotProcessError
 
     if not len(results):
         return

@@ -134,7 +134,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
                                 axes=axes, origins=origins(args.grid, args.random, args.points, points),
                                 start_method=method, keep_results=args.keep_results, step=args.step)
         except SweepInterrupted as stop:
-            from blocks.stop import exit_code
+            from blocks.process.stop import exit_code
 
             print(f"{prog}: sweep interrupted: {stop.stored} of {stop.total} points are in {stop.csv} "
                   "(hint: run the same command again to run the rest)", file=sys.stderr)

@@ -57,8 +57,8 @@ def cmd_validate(args: argparse.Namespace) -> int:
     if not s.event_ticks.size and s.advanced:
         print(f"  no other events: {', '.join(sorted(s.advanced))} advanced from t = 0 to t_end")
     if args.plan:
-        from blocks.optable import op_table
-        from blocks.optable_text import describe_table
+        from blocks.engine.optable import op_table
+        from blocks.engine.optable_text import describe_table
 
         t_end = t_end if t_end is not None else end_time(args, diagram)
         print(describe_table(op_table(diagram, build_schedule(diagram, t_end))))

@@ -91,7 +91,7 @@ typedef int (*blk_advance_fn)(const void *ctx, double t, double *state, const do
 
 /* Kernel types: a kernel that a program without Python (an exported FMU) rebuilds.
  *
- * Python describes a block's kernel by a record (blocks.kernel.KernelRecord): the name of
+ * Python describes a block's kernel by a record (blocks.engine.kernel.KernelRecord): the name of
  * its type and a flat array of doubles, the block's parameters in the type's own order,
  * which the type's construct turns into a context, checking them as the block does when it
  * is made (the checks are the type's, so one definition serves the block and the FMU). An

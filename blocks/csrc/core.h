@@ -1,6 +1,6 @@
 /* core.h: the op table of a run and the one interpreter of it, in C99 with libc only.
  *
- * A loaded diagram compiles to an op table (blocks/optable.py): plain int64 arrays and
+ * A loaded diagram compiles to an op table (blocks/engine/optable.py): plain int64 arrays and
  * one float64 array, no pointers, so it can be saved, shipped and read back. This core
  * runs such a table over kernels given as function pointers and contexts (the calling
  * convention of blocks_kernel.h): the outputs, updates and advances of the blocks, the

@@ -3,7 +3,7 @@
  * FMU's own C functions, with no Python in between.
  *
  * Its context is one run's int64 table (FMU_* slots, then the ports), made and filled by
- * blocks/fmu/kernel.py, which binds it to the run's FMU instance. The kernel keeps the
+ * blocks/fmu/compiled_step.py, which binds it to the run's FMU instance. The kernel keeps the
  * FMU's time and outputs there (the values array), so it writes through its context.
  * Everything but the steady step goes to the Python side, slow(kind, t, status), which
  * does what the block's Python methods do from that point on, with the same messages: the
@@ -17,7 +17,7 @@
  * and FMI 2's log proxy re-armed; after doStep, interrupt.check() raises a Ctrl-C that an
  * FMU callback noted (blocks/fmu/interrupt.py).
  *
- * An instance hosted in a process of its own (FMU_CHANNEL, blocks/fmu/hosted.py) steps
+ * An instance hosted in a process of its own (FMU_CHANNEL, blocks/fmu/isolation/client.py) steps
  * the same way through its channel instead (hosted_step): the inputs into the channel's
  * values, one round trip (fmu_host.c), the outputs out of them; the host makes the FMI
  * calls (fmu_calls.h, shared with this file). Anything but a plain success goes to slow

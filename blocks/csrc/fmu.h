@@ -1,5 +1,5 @@
 /* The FMU block's compiled kernel (fmu.c): the layout of its per-run context, for
- * blocks._native, which hands the layout and the functions to blocks/fmu/kernel.py. The
+ * blocks._native, which hands the layout and the functions to blocks/fmu/compiled_step.py. The
  * same table describes an FMU instance to the host that runs it in a process of its own
  * (fmu_host.c), which fills the FMU's slots and FMU_TRACE*; the run's kernel of such an
  * instance fills FMU_CHANNEL and FMU_SOCKET instead of the FMU's functions. */

@@ -1,13 +1,13 @@
 /* Both ends of the channel to an FMU instance hosted in a process of its own (fmu_host.h).
  *
  * The run's end: blk_host_post and blk_host_wait, which the FMU block's kernel (fmu.c)
- * calls for each steady step and blocks/fmu/hosted.py for everything else. The wait spins
+ * calls for each steady step and blocks/fmu/isolation/client.py for everything else. The wait spins
  * for HOST_SPIN_NS, then sleeps on the reply counter in slices of HOST_SLICE_NS; between
  * slices it looks for the host's end of the socket pair closing (its process ended), for
  * the time the call may take, and, with the GIL taken back, runs the signal handlers, so
  * that Ctrl-C and SIGTERM stop a run whose FMU never returns.
  *
- * The host's end (blocks/fmu/host.py): serve waits for the next request the same way
+ * The host's end (blocks/fmu/isolation/server.py): serve waits for the next request the same way
  * (HOST_IDLE_SPIN_NS, then slices of HOST_IDLE_NS, ending when the run's process is gone;
  * the spins of both sides adapt, see spin) and answers a steady
  * step of a co-simulation FMU with Float64 ports by itself, through the FMU's functions

@@ -1,5 +1,5 @@
 /* The channel between a run and an FMU instance hosted in a process of its own (fmu_host.c;
- * blocks/fmu/hosted.py and blocks/fmu/host.py are its two ends in Python).
+ * blocks/fmu/isolation/client.py and blocks/fmu/isolation/server.py are its two ends in Python).
  *
  * The channel is one shared-memory region: this header, then the input values, then the
  * output values (float64, port after port in the block's order). A request is one bump of

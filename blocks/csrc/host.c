@@ -1,6 +1,6 @@
 /* blocks._native: the CPython host of the op-table core (core.h), and single kernel calls.
  *
- * A Run holds one run of an op table (blocks/optable.py) bound by blocks/host.py: the
+ * A Run holds one run of an op table (blocks/engine/optable.py) bound by blocks/engine/native_run.py: the
  * tables, the run's arena, log buffers and counters (numpy arrays it keeps alive), one
  * kernel row per block, and for each block without a kernel its Python methods. run()
  * hands all of it to blk_run_table, which interprets the whole run in one call, and
@@ -10,7 +10,7 @@
  *   last saw them get a new array in its input mapping (or the old one overwritten when
  *   nobody else holds it); its output() result is checked and the ports of the step
  *   copied into the arena; update() sets its state or raises EndRun (the request to end
- *   the run, state and all); advance() goes through blocks/python_blocks.py. An
+ *   the run, state and all); advance() goes through blocks/engine/python_blocks.py. An
  *   exception is kept for the outcome (BLK_RAISED). The rules are python_blocks.py's;
  *   an output that fails the fast check goes there for its message.
  * - end: a kernel's request to end the run is its error factory's EndRun (another

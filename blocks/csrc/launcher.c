@@ -5,7 +5,7 @@
  * can handle it, kills the process silently or prints a KeyboardInterrupt traceback. This
  * program blocks both signals first, and a blocked signal stays blocked, and pending, across
  * execve: a signal that comes while Python starts waits until the program's Python side
- * (blocks/stop.py, ``launch``) has installed its handlers and unblocks them, and then is one
+ * (blocks/process/stop.py, ``launch``) has installed its handlers and unblocks them, and then is one
  * line and the signal's exit code, as a signal at any later moment is.
  *
  * It runs ``PYTHON -P -c CODE ARGV0 ARGS...``, where CODE sets ``sys.argv`` to this
@@ -16,7 +16,7 @@
  * LAUNCH_PYTHON, the interpreter that built it. If none can be run it says so in one line,
  * naming each it tried, and exits 127 (none found) or 126 (one found but not runnable).
  *
- * The build defines (blocks/native_sources.py, ``launcher_macros``):
+ * The build defines (blocks/engine/native_sources.py, ``launcher_macros``):
  *   LAUNCH_PROGRAM      the command's name, which begins its messages ("hierhand")
  *   LAUNCH_MODULE       the module of its entry function ("hierhand.start")
  *   LAUNCH_FUNCTION     the entry function, called without arguments ("main")

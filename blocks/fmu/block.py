@@ -25,12 +25,12 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..block import Block, BlockError, EndRun, ParameterError, Signal
-from ..kernel import Kernel
+from blocks.engine.kernel import Kernel
 from ..timebase import format_duration
 from . import interrupt
 from .description import FMUNotFound, open_fmu_file
 from .instance import Instance
-from .kernel import fmu_kernel
+from blocks.fmu.compiled_step import fmu_kernel
 from .log_messages import status_name
 from .model import INTERFACES, ISOLATIONS, float_or_none, isolation_choice
 from .pool import PooledModel
@@ -435,7 +435,7 @@ class FMU(Block):
             raise self._failure(inst, _reason(exc, t, self._step)) from None
 
     def kernel(self) -> Kernel | None:
-        """The steady step in C (``blocks.fmu.kernel``) when every port is Float64; an FMU
+        """The steady step in C (``blocks.fmu.compiled_step``) when every port is Float64; an FMU
         with ports of other types, or read with ``feedthrough``, runs in Python."""
         return None if self._direct else fmu_kernel(self)
 

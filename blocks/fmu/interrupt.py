@@ -17,7 +17,7 @@ like a broken FMU. So the FMU block:
   into a failure: a noted interrupt is raised there as the KeyboardInterrupt it was, so
   the executor stops the run as interrupted and keeps the results so far.
 
-The FMU's compiled kernel (``blocks.fmu.kernel``) does the same from C: before a step it
+The FMU's compiled kernel (``blocks.fmu.compiled_step``) does the same from C: before a step it
 arms again when ``sys.unraisablehook`` is not ``hook``, after each doStep it calls
 ``check``, and a KeyboardInterrupt raised there ends the run as interrupted.
 """

@@ -24,13 +24,13 @@ import weakref
 import zipfile
 from pathlib import Path
 
-from .. import scratch
+from blocks.process import scratch
 from ..block import BlockError
 from .archive import ArchiveError, extract_archive
 from .description import MODEL_DESCRIPTION
 from .cosimulation import CoSimulation2, CoSimulation3
 from .exchange import ModelExchange2, ModelExchange3
-from .hosted import HostedInstance
+from blocks.fmu.isolation.client import HostedInstance
 from .instance import Binary, Instance
 from .model import Model
 

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ..kernel import address
+from blocks.engine.kernel import address
 from ..timebase import format_duration
 from . import interrupt
 from .native import native

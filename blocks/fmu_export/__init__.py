@@ -32,9 +32,9 @@ import zipfile
 from fractions import Fraction
 from pathlib import Path
 
-from ..atomic_file import write_atomically
-from ..compiled import native
-from ..diagram import Diagram
+from blocks.results.atomic_file import write_atomically
+from blocks.engine.compiled import native
+from blocks.builder.diagram import Diagram
 from .description import build_description, model_description
 from .kernel_sets import FmuExportError, KernelSet, installed_binary, kernel_sets, set_for
 from .plan import Plan, plan_export

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from .. import native_sources
+from blocks.engine import native_sources
 from ..plugins import load_group
 
 GROUP = "blocks.fmu_kernel_sets"

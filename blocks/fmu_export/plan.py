@@ -26,12 +26,18 @@ from typing import Any
 
 import numpy as np
 
-from ..binding import Binding
-from ..diagram import Diagram
+from blocks.engine.binding import Binding
+from blocks.builder.diagram import Diagram
 from ..issues import DiagramError
-from ..kernel import KernelRecord
-from ..optable import MAX_TICKS, OpTable, stepping_table
-from ..schedule import Schedule, between_program, build_schedule, initial_outputs_program, lazy_outputs_program
+from blocks.engine.kernel import KernelRecord
+from blocks.engine.optable import MAX_TICKS, OpTable, stepping_table
+from blocks.engine.schedule import (
+    Schedule,
+    between_program,
+    build_schedule,
+    initial_outputs_program,
+    lazy_outputs_program,
+)
 from ..timebase import DurationError, parse_duration
 
 OPEN_END = MAX_TICKS // 2

@@ -13,7 +13,7 @@ import sys
 
 import numpy as np
 
-from ..compiled import native
+from blocks.engine.compiled import native
 from .plan import Plan
 from .variables import Variables
 

@@ -22,9 +22,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..diagram import Diagram
+from blocks.builder.diagram import Diagram
 from ..issues import DiagramError
-from ..optable import B_FIRST_INPUT, B_FIRST_PORT, I_OFFSET, P_OFFSET
+from blocks.engine.optable import B_FIRST_INPUT, B_FIRST_PORT, I_OFFSET, P_OFFSET
 from .plan import Plan
 
 VR_TIME = 0

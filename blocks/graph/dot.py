@@ -3,8 +3,8 @@ legend; expanded, each subsystem a cluster around its blocks."""
 
 from __future__ import annotations
 
-from ..diagram import Diagram
-from ..schedule import Schedule
+from blocks.builder.diagram import Diagram
+from blocks.engine.schedule import Schedule
 from .layout import layered
 from .ports import input_ports, output_ports
 from .rates import tint

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..diagram import Diagram
-from ..schedule import Schedule
+from blocks.builder.diagram import Diagram
+from blocks.engine.schedule import Schedule
 from .layout import Layered, group_of, layered
 from .ports import input_ports, output_ports
 from .rates import tint
@@ -441,7 +441,7 @@ def svg_text(diagram: Diagram, schedule: Schedule | None = None, expand: bool = 
     """The wiring as SVG text (planned over the diagram's own t_end when no schedule is given)."""
     import io
 
-    from ..schedule import build_schedule
+    from blocks.engine.schedule import build_schedule
 
     fig = draw(diagram, schedule if schedule is not None else build_schedule(diagram, None), expand)
     out = io.StringIO()

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from ..diagram import Connection
+from blocks.builder.diagram import Connection
 from .ports import input_ports, is_feedthrough, output_ports
 from .view import Picture
 

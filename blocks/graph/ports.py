@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ..diagram import Connection
+from blocks.builder.diagram import Connection
 from .view import Picture
 
 

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..diagram import Diagram
-from ..schedule import Schedule
+from blocks.builder.diagram import Diagram
+from blocks.engine.schedule import Schedule
 from ..timebase import format_duration
 
 

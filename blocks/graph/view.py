@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..diagram import Composite, Connection, Diagram
-from ..schedule import Schedule
+from blocks.builder.diagram import Composite, Connection, Diagram
+from blocks.engine.schedule import Schedule
 from .rates import MIXED_COLOR, Rate, rate_colors, rate_line
 
 NOTE_CHARS = 34

@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from blocks.compiled import failure
-from blocks.kernel import Kernel, KernelRecord, Tunable, address
+from blocks.engine.compiled import failure
+from blocks.engine.kernel import Kernel, KernelRecord, Tunable, address
 
 NOMEM = 1
 """library.c's failure code when a kernel gets no memory for its scratch vectors."""

@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from blocks.limits import MAX_DATA_BYTES
-from blocks.npzfile import read_npz
-from blocks.yamlsource import YamlSourceError, read_yaml_file
+from blocks.results.npzfile import read_npz
+from blocks.diagram_file.yaml_source import YamlSourceError, read_yaml_file
 
 TIME_PREFIX = "time:"
 

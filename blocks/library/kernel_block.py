@@ -18,9 +18,9 @@ from typing import Any, ClassVar, Iterable, Mapping
 
 import numpy as np
 
-from blocks import compiled
+from blocks.engine import compiled
 from blocks.block import Block, BlockError, EndRun, Signal
-from blocks.kernel import END_RUN, Kernel
+from blocks.engine.kernel import END_RUN, Kernel
 from blocks.library import _kernels
 
 NOMEM, SINGULAR, OUT_OF_RANGE = 1, 2, 3

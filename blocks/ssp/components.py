@@ -17,9 +17,9 @@ from __future__ import annotations
 
 from fractions import Fraction
 
-from ..builder import DiagramBuilder
-from ..diagram import Composite, Connection, Diagram
-from ..records import Site
+from blocks.builder.diagram_builder import DiagramBuilder
+from blocks.builder.diagram import Composite, Connection, Diagram
+from blocks.builder.records import Site
 
 
 def component_diagram(diagram: Diagram, name: str, period: Fraction | None = None) -> Diagram:

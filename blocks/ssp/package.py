@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from urllib.parse import unquote, urlparse
 
-from .. import scratch
+from blocks.process import scratch
 from ..fmu.archive import ArchiveError, NotARegularFile, extract_archive, file_kind, open_regular
 from ..safepath import inside
 from .names import SSD_NAME

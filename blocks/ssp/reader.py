@@ -36,12 +36,12 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from ..build_context import known, suggest
-from ..builder import DiagramBuilder
+from blocks.builder.context import known, suggest
+from blocks.builder.diagram_builder import DiagramBuilder
 from ..fmu.ports import port_name, port_of
 from ..issues import DiagramError, Issue
-from ..records import Site
-from ..scopes import NAME
+from blocks.builder.records import Site
+from blocks.builder.scopes import NAME
 from ..timebase import DurationError, parse_duration
 from .package import Package, PackageError, open_package
 from .parameters import BindingError, binding_values

@@ -31,8 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from ..atomic_file import write_atomically
-from ..diagram import Diagram
+from blocks.results.atomic_file import write_atomically
+from blocks.builder.diagram import Diagram
 from ..issues import DiagramError, Issue
 from ..timebase import format_duration
 from .names import SSD_NAME
@@ -189,7 +189,7 @@ def _inherited_period(diagram: Diagram, name: str) -> Fraction | None:
     """The period at which block ``name``, which inherits its rate, fires in ``diagram``
     (its hits evenly spaced from t = 0; one that fires only at t = 0 holds its output, any
     period does: the hyperperiod); None when its hits are not evenly spaced."""
-    from ..schedule import build_schedule
+    from blocks.engine.schedule import build_schedule
 
     schedule = build_schedule(diagram, None)
     hits = np.flatnonzero(schedule.masks[name][:schedule.hyperperiod])

@@ -10,12 +10,12 @@ it is what the sweep's point hashes are made from, so a changed params file or F
 new points rather than reusing old rows.
 
 In each process that runs points the bundle is written once into a private temporary
-folder (``folder``, in the scratch root of ``blocks.scratch``, which the sweep's process
+folder (``folder``, in the scratch root of ``blocks.process.scratch``, which the sweep's process
 removes at its exit, also after a runner was killed under it), keyed by its hash, each file checked against its sha256 first. The
 files keep the layout the diagram expects: the diagram's folder is a subfolder deep enough
 that ``../fmu/X.fmu`` lands inside the bundle folder; a file named by an absolute path goes
 to ``abs/<sha256>/NAME``. The diagram is then loaded from its text with ``files`` mapping
-each reference to its copy (``blocks.load.loads_diagram``), and with the client's file name
+each reference to its copy (``blocks.diagram_file.load.loads_diagram``), and with the client's file name
 and folder, so its parameters and run.json name the paths the user gave. The Dask
 execution sends the files to every worker once with a worker plugin
 (``worker_plugin.DiagramFiles``) and the tasks carry only the ``manifest`` (no file
@@ -35,13 +35,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
-from blocks import scratch
-from blocks.loader import CODE_DIR_KEY
+from blocks.process import scratch
+from blocks.diagram_file.reader import CODE_DIR_KEY
 
 from .errors import SweepError
 
 TEMP_PREFIX = "bundle-"
-"""Prefix of the temporary folders bundles are written into (in the scratch root, ``blocks.scratch``)."""
+"""Prefix of the temporary folders bundles are written into (in the scratch root, ``blocks.process.scratch``)."""
 
 
 class BundleError(SweepError):
@@ -122,7 +122,7 @@ def make_bundle(path: str | Path, files: Mapping[str, Path], text: str | None = 
     ``Diagram.files``); ``text``: the diagram's text if already read. An SSP is bundled as
     its archive alone (its FMUs are inside), with ``step`` (``--step``)."""
     from blocks.ssp import is_ssp
-    from blocks.yamlsource import read_yaml_file
+    from blocks.diagram_file.yaml_source import read_yaml_file
 
     path = Path(path)
     if is_ssp(path):

@@ -185,8 +185,8 @@ def _local_cluster(workers: int | None, method: str | None):
     import dask
     from distributed import LocalCluster
 
-    from .. import scratch
-    from ..forked import own_std_streams_after_fork
+    from blocks.process import scratch
+    from blocks.process.forked import own_std_streams_after_fork
     from .worker_plugin import IgnoreCtrlC
 
     own_std_streams_after_fork()  # workers are forked from a thread while others may be writing

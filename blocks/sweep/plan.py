@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..api_args import boolean
+from blocks.builder.api_args import boolean
 from ..safepath import link_out_of
 from .bundle import bundle_for, discard
 from .errors import SweepError

@@ -21,7 +21,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from blocks.limits import MAX_SWEEP_POINTS
-from blocks.yamlsource import YamlSourceError, load_yaml_value, read_yaml_file
+from blocks.diagram_file.yaml_source import YamlSourceError, load_yaml_value, read_yaml_file
 
 from .errors import SweepError
 

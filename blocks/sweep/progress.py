@@ -8,7 +8,7 @@ from __future__ import annotations
 import time
 from typing import TextIO
 
-from ..status_line import StatusLine
+from blocks.process.status_line import StatusLine
 
 
 class SweepProgress:

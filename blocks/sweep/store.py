@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 from typing import Any, Sequence
 
-from ..atomic_file import write_atomically
+from blocks.results.atomic_file import write_atomically
 from .errors import SweepError
 
 SWEEP_CSV = "sweep.csv"
@@ -30,7 +30,7 @@ OK, FAILED = "ok", "failed"
 
 def check_folder(directory: Path) -> None:
     """SweepError unless ``directory`` can hold a sweep's files, all of them inside it."""
-    from ..results_folder import OutputFolderError, prepare
+    from blocks.results.folder import OutputFolderError, prepare
     from ..safepath import link_out_of
 
     try:

@@ -60,7 +60,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from blocks import Block
-from blocks.kernel import Kernel, Tunable
+from blocks.engine.kernel import Kernel, Tunable
 
 from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
 from ..model.hand_source import ModelsTheHand, hand_of

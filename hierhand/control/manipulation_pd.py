@@ -43,7 +43,7 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
-from blocks.kernel import Kernel, Tunable
+from blocks.engine.kernel import Kernel, Tunable
 
 from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
 from ..model.hand_source import ModelsTheHand, hand_of

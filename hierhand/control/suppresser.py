@@ -11,7 +11,7 @@ import numpy as np
 
 from blocks import Block
 from blocks.arrays import flat_float64, float_array
-from blocks.kernel import Kernel, Tunable
+from blocks.engine.kernel import Kernel, Tunable
 
 from ..kernels import KERNELS, context_of, record
 from ..model.port_info import DescribesHandPorts

@@ -30,7 +30,7 @@ class ModelsTheHand:
     ``hand``, and a documentation instance on the default hand (``hierhand blocks``).
 
     A block that says more about its ``hand`` documents it in its own docstring, which
-    wins (``blocks.paramdocs`` reads the nearest class first).
+    wins (``blocks.typeinfo`` reads the nearest class first).
 
     Parameters
     ----------

@@ -10,7 +10,7 @@ This module checks the file's shape (sections, keys, lists, numbers); what value
 hand's numbers may take (positive masses, mu_d <= mu_s, ...) is judged by the C core
 (``hand_params.c``), the same check an exported FMU applies to its parameters.
 
-A hand file is read like a diagram (``blocks.yamlsource``: the same limits, and the line
+A hand file is read like a diagram (``blocks.diagram_file.yaml_source``: the same limits, and the line
 of every key), so each problem is reported at the line of the field it names; the
 diagram loader does the same for a plant's params file through ``ParameterError``.
 """
@@ -28,7 +28,7 @@ import numpy as np
 import yaml
 
 from blocks import Issue, ParameterError
-from blocks.yamlsource import YamlSourceError, line_at, load_yaml, read_yaml_file
+from blocks.diagram_file.yaml_source import YamlSourceError, line_at, load_yaml, read_yaml_file
 
 from .. import _native
 from .hand_vector import hand_file_path, hand_vector, parameter_names
@@ -195,7 +195,7 @@ def _fresh(x: Any) -> Any:
 
 def read_hand_file(path: str | Path) -> dict[str, Any]:
     """A hand file's raw content, a mapping with the line of every key (see
-    ``blocks.yamlsource``); HandFileError at the line where it cannot be read as one."""
+    ``blocks.diagram_file.yaml_source``); HandFileError at the line where it cannot be read as one."""
     try:
         data = load_yaml(read_yaml_file(path))
     except YamlSourceError as exc:

@@ -18,7 +18,7 @@ import numpy as np
 
 from blocks.arrays import float_array
 from blocks.block import Block, BlockError
-from blocks.kernel import Kernel, KernelRecord
+from blocks.engine.kernel import Kernel, KernelRecord
 
 from .. import _native
 from ..kernels import KERNELS, PLANT_SEGMENT, context_of, hand_segment, hand_tunables, inertia_follows, record

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from blocks import Block, BlockError, EndRun
-from blocks.kernel import END_RUN, Kernel
+from blocks.engine.kernel import END_RUN, Kernel
 from blocks.registry import block_types
 
 from .kernel_library import function

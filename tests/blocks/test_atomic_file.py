@@ -7,7 +7,7 @@ import stat
 
 import pytest
 
-from blocks.atomic_file import atomic_writer, write_atomically
+from blocks.results.atomic_file import atomic_writer, write_atomically
 
 
 def test_text_and_bytes_replace_the_file(tmp_path):

@@ -26,7 +26,7 @@ def structure(d: blocks.Diagram) -> dict:
     connections, logged signals, end time and the diagram's own ports."""
     return {
         "name": d.name, "t_end": d.t_end,
-        "blocks": [(n, s.type_name, s.period, s.offset, blocks.diagram.jsonable(s.params), dict(s.block.inputs),
+        "blocks": [(n, s.type_name, s.period, s.offset, blocks.builder.diagram.jsonable(s.params), dict(s.block.inputs),
                     dict(s.block.outputs), s.references) for n, s in d.blocks.items()],
         "connections": sorted((c.src, c.dst, c.delay, c.initial) for c in d.connections),
         "log": [(e.signal, e.decimate) for e in d.log],

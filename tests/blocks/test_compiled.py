@@ -1,4 +1,4 @@
-"""Blocks with compiled kernels (blocks/compiled.py), run by the C core (blocks/csrc/core.c).
+"""Blocks with compiled kernels (blocks/engine/compiled.py), run by the C core (blocks/csrc/core.c).
 
 A diagram runs the same whether a block goes through its kernel or its Python methods:
 the same logged samples to the last bit, the same status when a block fails, the same
@@ -139,7 +139,7 @@ def test_ctrl_c_in_a_long_compiled_advance_stops_after_the_chunk_it_came_in(nogi
     ADVANCE_CHUNK hits; SIGINT in the third chunk stops the run at its end, everything up
     to there logged. The same with the GIL released around the chunks (a nogil kernel,
     while another thread waits): the check between chunks takes it back."""
-    from blocks.optable import ADVANCE_CHUNK
+    from blocks.engine.optable import ADVANCE_CHUNK
 
     text = f"""
 time: {{t_end: 1000 s}}

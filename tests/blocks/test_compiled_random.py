@@ -16,7 +16,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import blocks
-import blocks.compiled
+import blocks.engine.compiled
 
 from .test_diagram_fuzz import FUZZ_SETTINGS, wired_document
 from .test_reference import loaded
@@ -25,8 +25,8 @@ from .test_reference import loaded
 def run(diagram, t_end, compiled: bool, monkeypatch, engine: str = "native"):
     with monkeypatch.context() as m:
         if not compiled:
-            m.setattr(blocks.compiled, "usable_kernel", lambda *args: None)
-        return blocks.simulate(diagram, t_end=t_end, engine=engine)
+            m.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
+        return blocks.engine.simulate(diagram, t_end=t_end, engine=engine)
 
 
 @settings(max_examples=500, **FUZZ_SETTINGS)

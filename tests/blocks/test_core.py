@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from blocks import build_schedule, loads_diagram, simulate
-from blocks.optable import L_WIDTH, op_table
+from blocks.engine.optable import L_WIDTH, op_table
 
 from .compiled_blocks import Leak, Scale, Stopper, register
 from .fmu.build import compiler

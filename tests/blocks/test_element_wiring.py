@@ -83,7 +83,7 @@ def test_contiguous_selections_read_the_source_in_place_and_others_are_assembled
   - c.y[3,0,1] -> h.u
 log: [h.y]
 """)
-    table = blocks.optable.op_table(d, blocks.build_schedule(d, d.t_end))
+    table = blocks.engine.optable.op_table(d, blocks.build_schedule(d, d.t_end))
     feeds = dict(zip(table.names.blocks, table.names.feeds))
     assert feeds["g"] == ("source",) and feeds["h"] == ("assembled",) and feeds["m"] == ("source", "source")
     assert run_both(d)["h.y"][1][-1].tolist() == [4.0, 1.0, 2.0]

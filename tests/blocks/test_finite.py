@@ -14,7 +14,7 @@ import blocks
 from blocks import Block, loads_diagram, simulate
 from blocks.cli import PROGRAM
 from blocks.cli.program import main
-from blocks.finite import NonFiniteOutput
+from blocks.engine.finite import NonFiniteOutput
 
 REPO = Path(__file__).resolve().parents[2]
 TOY = REPO / "diagrams" / "toy.yaml"

@@ -17,7 +17,7 @@ REPO = Path(__file__).resolve().parents[2]
 SCENARIO = r'''
 import fcntl, logging, os, sys, termios, threading, time
 
-from blocks.forked import own_std_streams_after_fork
+from blocks.process.forked import own_std_streams_after_fork
 
 if sys.argv[1] == "own":
     own_std_streams_after_fork()

@@ -65,7 +65,7 @@ def import_graph() -> nx.DiGraph:
 
 def test_the_import_reader_sees_imports_inside_functions_and_relative_ones():
     assert "blocks.library" in imported("blocks.registry")  # inside block_types()
-    assert "blocks.block" in imported("blocks.construct")  # from .block import ...
+    assert "blocks.block" in imported("blocks.builder.construct")  # from .block import ...
     assert "blocks.fmu.interrupt" in imported("blocks.fmu.block")  # from . import interrupt
     assert "blocks.timebase" in imported("blocks.fmu.block")  # from ..timebase import ...
 
@@ -93,8 +93,8 @@ def test_the_blocks_modules_import_each_other_without_a_cycle():
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c + [c[0]]) for c in cycles)
 
 
-LAYERS = ["blocks.issues", "blocks.diagram", "blocks.records", "blocks.schedule", "blocks.assemble", "blocks.builder",
-          "blocks.loader", "blocks.load", "blocks.simulate"]
+LAYERS = ["blocks.issues", "blocks.builder.diagram", "blocks.builder.records", "blocks.engine.schedule", "blocks.builder.assemble", "blocks.builder.diagram_builder",
+          "blocks.diagram_file.reader", "blocks.diagram_file.load", "blocks.engine.simulate"]
 """The core modules from the lowest layer up: data, what a diagram records, planner, the
 checks that make a Diagram, the builder (checks + planner), its YAML front end, load
 (front end + builder), executor."""

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import pytest
 
-from blocks import native_sources
+from blocks.engine import native_sources
 from tests.blocked_start import blocked
 
 pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the launcher is built on Linux")

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from blocks import DiagramError, load_diagram, loads_diagram
-from blocks.param_paths import PathError, set_path
+from blocks.builder.param_paths import PathError, set_path
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFS = "python:tests.blocks.blockdefs"

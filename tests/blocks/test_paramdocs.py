@@ -6,7 +6,7 @@ import pytest
 
 from blocks import Block
 from blocks.library import LIBRARY
-from blocks.paramdocs import ParamDoc, parameter_docs, parse_parameters
+from blocks.typeinfo import ParamDoc, parameter_docs, parse_parameters
 from blocks.registry import block_types
 from blocks.typeinfo import describe_type
 

@@ -7,11 +7,11 @@ import numpy as np
 import pytest
 
 from blocks import Results
-from blocks.plot import Pages, plot_signals
-from blocks.plot_canvas import rgb
-from blocks.plot_markers import MARKER_COLOUR
-from blocks.plot_page import envelope, layout
-from blocks.plot_paint import paint
+from blocks.plot.pages import Pages, plot_signals
+from blocks.plot.canvas import rgb
+from blocks.plot.markers import MARKER_COLOUR
+from blocks.plot.page_layout import envelope, layout
+from blocks.plot.paint import paint
 
 FAILED = "failed at t=0.005 s: block 'f' (Gain) output: boom"
 
@@ -147,7 +147,7 @@ def grey_in(pixels, x0: float, x1: float, y0: float, y1: float) -> int:
 
 
 def test_markers_are_drawn_on_every_axis_and_named_once():
-    from blocks.plot_markers import Marker
+    from blocks.plot.markers import Marker
 
     events = [Marker(0.002, 0.002, "", "s: step at 0.002 s"), Marker(0.003, 0.004, "moving", "moved")]
     page = layout(described(), ["b.q", "b.r"], markers=events)
@@ -181,7 +181,7 @@ def test_a_signal_of_mixed_units_is_an_axis_per_unit_and_pages_are_balanced(tmp_
 
 
 def test_an_axis_per_unit_is_labelled_with_that_unit_alone():
-    from blocks.plot_select import by_unit, select
+    from blocks.plot.select import by_unit, select
 
     r = described()
     panels = layout(r, by_unit(r, select(r, "b.pose"))).panels
@@ -252,8 +252,8 @@ def test_extreme_values_are_drawn_on_a_finite_axis_without_a_warning(values):
 
 
 def test_labels_of_any_length_stay_on_the_page_and_leave_room_for_the_data():
-    from blocks.plot_canvas import text_size
-    from blocks.plot_page import LARGE, SIZE
+    from blocks.plot.canvas import text_size
+    from blocks.plot.page_layout import LARGE, SIZE
 
     t = np.arange(10) * 0.1
     long = "b" * 150

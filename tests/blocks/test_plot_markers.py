@@ -1,6 +1,6 @@
 """Event markers: the framework's Step times, sources registered from Python, one marker
 per event, and a broken source left out with its reason instead of breaking the plot (the
-hand's phases through the blocks.plot_markers entry point: tests/hierhand/tasks/test_phases.py)."""
+hand's phases through the blocks.plot.markers entry point: tests/hierhand/tasks/test_phases.py)."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import pytest
 
 import blocks
-from blocks import plot_markers
-from blocks.plot_markers import Marker, markers, register_markers, unregister_markers
+from blocks.plot.pages import markers as plot_markers
+from blocks.plot.markers import Marker, markers, register_markers, unregister_markers
 
 
 def info_of(diagram) -> dict:

@@ -1,4 +1,4 @@
-"""Plots drawn in forked processes (blocks/plot_process.py): the pages of ``plot_signals``,
+"""Plots drawn in forked processes (blocks/plot/beside_run.py): the pages of ``plot_signals``,
 a failure brought back as the caller would meet it here, and nothing left running."""
 
 from __future__ import annotations
@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from blocks import Results
-from blocks.plot import plot_signals
-from blocks.plot_process import FORKS, PlotProcess, PlotProcessError
+from blocks.plot.pages import plot_signals
+from blocks.plot.beside_run import FORKS, PlotProcess, PlotProcessError
 
 pytestmark = pytest.mark.skipif(not FORKS, reason="plots are drawn in forked processes on Linux only")
 
@@ -70,17 +70,17 @@ def test_an_os_error_in_a_drawer_is_raised_here_as_that_os_error(tmp_path):
 
 
 def test_a_drawer_killed_by_a_signal_fails_the_plots_naming_the_signal(tmp_path, monkeypatch):
-    import blocks.plot
+    import blocks.plot.pages
 
     saved(tmp_path / "run", signals=13)  # three pages: the last in a drawer of its own on two cores
-    draw = blocks.plot.Pages.draw
+    draw = blocks.plot.pages.Pages.draw
 
     def dies_on_page_3(pages, number):
         if number == 3:
             os.kill(os.getpid(), signal.SIGKILL)
         return draw(pages, number)
 
-    monkeypatch.setattr(blocks.plot.Pages, "draw", dies_on_page_3)  # the forks inherit it
+    monkeypatch.setattr(blocks.plot.pages.Pages, "draw", dies_on_page_3)  # the forks inherit it
     plotter = PlotProcess.start()
     drawer = "a page" if len(os.sched_getaffinity(0)) > 1 else "the plots"  # one core: all in the plotter
     try:

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from blocks import Results
-from blocks.plot_select import SelectionError, select, split_signals
+from blocks.plot.select import SelectionError, select, split_signals
 
 
 def results() -> Results:

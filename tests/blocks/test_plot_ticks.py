@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from blocks.plot_ticks import MINUS, data_range, ticks
+from blocks.plot.ticks import MINUS, data_range, ticks
 
 
 def read_back(label: str, beside: str) -> float:

@@ -1,4 +1,4 @@
-"""Python blocks as ops of the table (blocks/python_blocks.py, and its fast twin in
+"""Python blocks as ops of the table (blocks/engine/python_blocks.py, and its fast twin in
 blocks/csrc/host.c): what a block gets and what it may return, the same in both engines.
 
 - An input array a block keeps is never changed afterwards: a changed value comes in a

@@ -22,7 +22,7 @@ from hypothesis import Phase, find, given, settings
 from hypothesis import strategies as st
 
 import blocks
-import blocks.compiled
+import blocks.engine.compiled
 from blocks import load_diagram, loads_diagram, simulate
 
 from .compiled_blocks import register
@@ -106,7 +106,7 @@ def three_ways(diagram, t_end, monkeypatch):
     native = simulate(diagram, t_end=t_end, engine="native")
     reference = simulate(diagram, t_end=t_end, engine="reference")
     with monkeypatch.context() as m:
-        m.setattr(blocks.compiled, "usable_kernel", lambda *args: None)
+        m.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
         python = simulate(diagram, t_end=t_end, engine="native")
     return native, reference, python
 
@@ -176,7 +176,7 @@ def test_without_the_compiled_extension_every_block_runs_in_python_in_the_refere
     diagram = load_diagram(ROOT / "diagrams" / "toy.yaml")
     compiled = simulate(diagram)
     with monkeypatch.context() as m:
-        m.setattr(blocks.compiled, "native", lambda: None)
+        m.setattr(blocks.engine.compiled, "native", lambda: None)
         python = simulate(diagram)
         with pytest.raises(ValueError, match="engine 'native' needs the compiled extension blocks._native"):
             simulate(diagram, engine="native")

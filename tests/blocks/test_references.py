@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from blocks import DiagramError, loads_diagram, simulate
-from blocks.references import Reference, build_order, chain_text
+from blocks.builder.references import Reference, build_order, chain_text
 
 ROOT = Path(__file__).resolve().parents[2]
 DEFS = "python:tests.blocks.blockdefs"

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from blocks import Results, ResultsError
-from blocks.results_folder import OutputFolderError, prepare, writing
+from blocks.results.folder import OutputFolderError, prepare, writing
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 import blocks
 from blocks import build_schedule, loads_diagram
-from blocks.schedule import _Planner
+from blocks.engine.schedule import _Planner
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -100,7 +100,7 @@ blocks:
 connections: [src.y -> a.u0, a.y -> b.u, b.y -> a.u1]
 log: [a.y, b.y]
 """)
-    r = blocks.simulate(d)
+    r = blocks.engine.simulate(d)
     np.testing.assert_allclose(r["a.y"][1][:, 0], [0.0, 0.002, 0.005])
     np.testing.assert_allclose(r["b.y"][1][:, 0], [0.0, 0.001])
 
@@ -117,7 +117,7 @@ blocks:
 
 def test_huge_logs_are_refused_before_the_run():
     with pytest.raises(blocks.DiagramError, match="GiB"):
-        blocks.simulate(toy(), t_end="1e6 s")
+        blocks.engine.simulate(toy(), t_end="1e6 s")
 
 
 @settings(max_examples=200, deadline=None)

@@ -1,4 +1,4 @@
-"""The program's temporary folder (blocks/scratch.py): private, shared with the processes a
+"""The program's temporary folder (blocks/process/scratch.py): private, shared with the processes a
 process starts, removed by the one that made it, and never one a variable merely names."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from blocks import scratch
+from blocks.process import scratch
 
 REPO = Path(__file__).resolve().parents[2]
 CHILD = "from blocks import scratch; print(scratch.folder('child-'), scratch.root())"

@@ -360,7 +360,7 @@ def test_every_advance_chunk_starts_at_its_exact_tick_time():
     """A span of several ADVANCE_CHUNK hits: each chunk gets ``k * base_tick`` of its first
     tick, computed from the integer k (adding up chunks of 4096 periods of 0.1 ms in
     floats gives 1.2288000000000001 s, not 1.2288 s, for the fourth chunk)."""
-    from blocks.optable import ADVANCE_CHUNK
+    from blocks.engine.optable import ADVANCE_CHUNK
 
     r = accumulate_ones("ChunkStart", "0.1 ms", "1.6384 s")
     t, y = r["acc.y"]
@@ -373,7 +373,7 @@ def test_every_advance_chunk_starts_at_its_exact_tick_time():
 def test_an_interrupt_inside_one_long_advance_span_records_the_time_reached():
     """No other block fires after t = 0, so the whole run is one advance span, made of
     chunks of ADVANCE_CHUNK hits; Ctrl-C in the third chunk stops it after two."""
-    from blocks.optable import ADVANCE_CHUNK
+    from blocks.engine.optable import ADVANCE_CHUNK
 
     r = accumulate_ones("InterruptedAccumulator", "1 ms", "1000 s", "{calls: 3}")
     reached = 2 * ADVANCE_CHUNK * 1e-3

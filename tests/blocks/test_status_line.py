@@ -2,7 +2,7 @@
 
 import io
 
-from blocks.status_line import StatusLine
+from blocks.process.status_line import StatusLine
 from blocks.sweep.progress import SweepProgress
 
 

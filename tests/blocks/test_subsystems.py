@@ -300,8 +300,8 @@ def test_a_file_that_includes_itself_is_refused_with_the_chain(tmp_path):
 
 def test_the_input_limits_hold_for_every_file(tmp_path, monkeypatch):
     import blocks.limits
-    import blocks.scopes
-    import blocks.yamlsource  # the limits are read where they are used
+    import blocks.builder.scopes
+    import blocks.diagram_file.yaml_source  # the limits are read where they are used
 
     chain = {f"d{i}.yaml": f"blocks:\n  next: {{diagram: d{i + 1}.yaml}}\n" for i in range(40)}
     chain["d40.yaml"] = "blocks:\n  g: {type: Constant}\n"
@@ -313,12 +313,12 @@ def test_the_input_limits_hold_for_every_file(tmp_path, monkeypatch):
     doubling = {f"x{i}.yaml": f"blocks:\n  a: {{diagram: x{i + 1}.yaml}}\n  b: {{diagram: x{i + 1}.yaml}}\n"
                 for i in range(12)}
     doubling["x12.yaml"] = "blocks:\n  g: {type: Constant}\n"
-    monkeypatch.setattr(blocks.scopes, "MAX_SUBSYSTEM_BLOCKS", 1000)
+    monkeypatch.setattr(blocks.builder.scopes, "MAX_SUBSYSTEM_BLOCKS", 1000)
     path = write(tmp_path / "doubling", doubling)
     issues = problems(path)
     assert issues == [f"{path}:2: the subsystems add more than 1000 blocks (hint: the limit guards against files "
                       "that include each other many times over)"]
-    monkeypatch.setattr(blocks.yamlsource, "MAX_YAML_BYTES", 100)
+    monkeypatch.setattr(blocks.diagram_file.yaml_source, "MAX_YAML_BYTES", 100)
     path = write(tmp_path / "big", {"top.yaml": "blocks:\n  s: {diagram: big.yaml}\n",
                                     "big.yaml": "blocks:\n" + "".join(f"  g{i}: {{type: Constant}}\n" for i in range(9))})
     assert problems(path) == [f"{path}:2: subsystem 's': diagram 'big.yaml': file larger than 100 bytes (hint: the "

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from blocks import Block, load_diagram, loads_diagram, simulate
-from blocks.kernel import Kernel
+from blocks.engine.kernel import Kernel
 from blocks.registry import block_types
 
 from .kernel_library import function

@@ -14,7 +14,15 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from blocks.limits import MAX_ALIAS_VALUES, MAX_YAML_BYTES, MAX_YAML_DEPTH
-from blocks.yamlsource import LineDict, LineList, YamlSourceError, line_at, line_of, load_yaml, read_yaml_file
+from blocks.diagram_file.yaml_source import (
+    LineDict,
+    LineList,
+    YamlSourceError,
+    line_at,
+    line_of,
+    load_yaml,
+    read_yaml_file,
+)
 
 TEXT = """\
 # a comment on line 1

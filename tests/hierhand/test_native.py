@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from blocks import native_sources as framework_sources
+from blocks.engine import native_sources as framework_sources
 from blocks.block import BlockError
 from hierhand import _native, native_sources
 from hierhand.model import Hand, HandPlant

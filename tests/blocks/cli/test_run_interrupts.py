@@ -100,7 +100,7 @@ def test_a_second_ctrl_c_cannot_lose_the_results(tmp_path, second):
     """A second Ctrl-C right behind the first (the two may reach the process as one), or
     one that the process sends itself when it starts writing the results: noted there,
     and the results are whole."""
-    hook = {"PYTHONPATH": f"{HOOK}{os.pathsep}{REPO}", "SIGNAL_AT": "blocks.results:Results.write_files"}
+    hook = {"PYTHONPATH": f"{HOOK}{os.pathsep}{REPO}", "SIGNAL_AT": "blocks.results.signals:Results.write_files"}
     proc, out = start(tmp_path, "--csv", env=hook if second == "while saving" else None)
     proc.send_signal(signal.SIGINT)
     if second == "at once":

@@ -50,7 +50,7 @@ def test_a_signal_during_the_start_up_imports_is_one_line(tmp_path, send, code):
 
 
 def test_sigterm_while_the_diagram_loads_is_one_line_and_143(tmp_path):
-    proc = run(tmp_path, "blocks.loader:read_builder", "SIGTERM")
+    proc = run(tmp_path, "blocks.diagram_file.reader:read_builder", "SIGTERM")
     assert proc.returncode == 143 and proc.stderr == "hierhand: interrupted\n", proc.stderr
 
 
@@ -63,7 +63,7 @@ def test_sigterm_then_sigint_while_simulating_exits_as_the_first_asks(tmp_path):
 
 
 def test_sigterm_while_a_complete_run_is_saved_does_not_exit_0(tmp_path):
-    proc = run(tmp_path, "blocks.results:Results.write_files", "SIGTERM")
+    proc = run(tmp_path, "blocks.results.signals:Results.write_files", "SIGTERM")
     assert proc.returncode == 143, proc.stderr
     assert "SIGTERM while the results are saved" in proc.stderr
     assert "SIGTERM after the run: its results are complete in out" in proc.stderr
@@ -98,7 +98,7 @@ def test_a_signal_while_plotting_stops_the_plots_keeps_the_results_and_leaves_no
     """The pages are drawn by forked processes; the signal reaches the run's process from
     the first page's drawing, as a Ctrl-C or a kill does."""
     monkeypatch.setenv("PLOT_TEST_MARK", str(tmp_path))
-    proc = run(tmp_path, "blocks.plot:Pages.draw", send, "--plot", diagram=diagram, to="main")
+    proc = run(tmp_path, "blocks.plot.pages:Pages.draw", send, "--plot", diagram=diagram, to="main")
     assert proc.returncode == code, proc.stderr
     assert f"plots stopped by {send}" in proc.stderr
     assert Results.load(tmp_path / "out").complete
@@ -127,7 +127,7 @@ def test_plots_drawn_beside_the_run_are_those_drawn_in_its_process(tmp_path):
 
 
 def test_a_plotter_killed_by_a_signal_keeps_the_results_and_says_the_plots_are_missing(tmp_path):
-    proc = run(tmp_path, "blocks.plot:Pages.draw", "SIGKILL", "--plot", diagram=PAGES)
+    proc = run(tmp_path, "blocks.plot.pages:Pages.draw", "SIGKILL", "--plot", diagram=PAGES)
     assert proc.returncode == 1, proc.stderr
     assert proc.stderr == (f"hierhand: the results are saved in out, but not their plots: the process drawing "
                            "the plots ended unexpectedly (killed by SIGKILL)\n")
@@ -150,7 +150,7 @@ def test_the_plotters_start_with_the_signals_unblocked(tmp_path, diagram):
     """Though the run started with them blocked (as the ``hierhand`` executable starts it),
     the processes that draw its plots can be stopped by SIGINT and SIGTERM."""
     (tmp_path / "d.yaml").write_text(diagram, encoding="utf-8")
-    env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{REPO}", SIGNAL_AT="blocks.plot:Pages.draw",
+    env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{REPO}", SIGNAL_AT="blocks.plot.pages:Pages.draw",
                SIGNAL_RECORD=str(tmp_path / "masks"))
     proc = subprocess.run(blocked([sys.executable, "-m", "hierhand", "run", "d.yaml", "-o", "out", "--plot"]),
                           cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)

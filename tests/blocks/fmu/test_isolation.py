@@ -1,4 +1,4 @@
-"""FMUs in processes of their own ('isolation: process', blocks/fmu/hosted.py, host.py).
+"""FMUs in processes of their own ('isolation: process', blocks/fmu/isolation/client.py, host.py).
 
 An isolated FMU gives the samples it gives in the run's process, to the last bit, on every
 path (the steady step in C on both sides, the Python paths, model exchange). An FMU that
@@ -355,7 +355,7 @@ def test_a_well_behaved_misbehaving_fmu_is_the_first_order_fmu(tmp_path, misbeha
 
 
 def _kill_the_launcher_between_runs(path, queue) -> None:
-    from blocks.fmu.launcher import Launcher
+    from blocks.fmu.isolation.launcher import Launcher
 
     d = diagram(path, params="isolation: process")
     first = simulate(d)

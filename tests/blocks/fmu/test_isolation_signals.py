@@ -111,7 +111,7 @@ blocks:
 connections: [src.y -> plant.u]
 log: [plant.y]
 """)
-    env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{ROOT}", SIGNAL_AT="blocks.fmu.host:serve",
+    env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{ROOT}", SIGNAL_AT="blocks.fmu.isolation.server:serve",
                SIGNAL_RECORD=str(tmp_path / "masks"), BLOCKS_SCRATCH="")
     proc = subprocess.run(blocked([sys.executable, "-m", "blocks", "run", "d.yaml", "-o", "out", "-q"]), cwd=tmp_path,
                           env=env, capture_output=True, text=True, timeout=WAIT)

@@ -1,4 +1,4 @@
-"""The FMU block's compiled kernel (blocks/csrc/fmu.c, blocks/fmu/kernel.py).
+"""The FMU block's compiled kernel (blocks/csrc/fmu.c, blocks/fmu/compiled_step.py).
 
 A diagram runs the same whether the FMU steps through its kernel or its Python methods:
 the same samples to the last bit, the same status when the FMU fails (also inside a
@@ -18,7 +18,7 @@ import pytest
 
 from blocks import Results, loads_diagram, simulate
 from blocks.fmu import FMU
-from blocks.fmu import kernel as fmu_kernel
+from blocks.fmu import compiled_step as fmu_kernel
 
 fmpy = pytest.importorskip("fmpy")
 

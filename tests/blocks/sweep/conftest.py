@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from blocks import scratch
+from blocks.process import scratch
 
 
 @dataclass(frozen=True)

@@ -2,7 +2,7 @@
 group, workers included): one line and exit code 130, no traceback from any process, only
 whole rows in sweep.csv, no process left behind, and the same command then runs the rest.
 SIGTERM to the sweep's process alone (as a batch system or ``timeout`` sends it), and a
-point that kills the process running it: nothing left in TMPDIR (``blocks.scratch``), no
+point that kills the process running it: nothing left in TMPDIR (``blocks.process.scratch``), no
 process left."""
 
 from __future__ import annotations

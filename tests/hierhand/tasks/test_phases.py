@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 import blocks
-from blocks.plot_markers import ENTRY_POINT_GROUP, markers
+from blocks.plot.markers import ENTRY_POINT_GROUP, markers
 from hierhand.model import load_hand
 from hierhand.tasks.phases import phase_at, task_phases
 

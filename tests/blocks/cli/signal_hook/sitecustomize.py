@@ -4,7 +4,7 @@ Put this folder first on PYTHONPATH and set ``SIGNAL_AT`` to where the process s
 signal itself, and ``SIGNAL_SEND`` to the signals (``SIGTERM,SIGINT``; default SIGINT):
 
 - ``import:numpy``: when the process starts to import ``numpy`` (its start-up);
-- ``blocks.loader:read_builder`` or ``blocks.results:Results.write_files``: at the first
+- ``blocks.diagram_file.reader:read_builder`` or ``blocks.results.signals:Results.write_files``: at the first
   call of that function or method, before it runs (``SIGNAL_CALL=N``: at its N-th call).
 
 The signals are sent by the process to itself at exactly that point, so a test of what a
