@@ -5,7 +5,7 @@ the bare C core of the plant over the same 0.1 ms steps.
 
 Reports, as medians of --repeat runs after one warm-up run:
 
-- full: ``blocks.load_diagram`` + ``blocks.engine.simulate`` (ms per simulated second and the
+- full: ``blocks.load_diagram`` + ``blocks.simulate`` (ms per simulated second and the
   real-time factor, simulated / wall time);
 - simulate only, the diagram loaded once;
 - the bare C core (``hierhand._native.advance``): the same number of plant steps from the
@@ -119,7 +119,7 @@ def profile_simulate(diagram, t_end, top: int = 10) -> None:
 
     prof = cProfile.Profile()
     prof.enable()
-    blocks.engine.simulate(diagram, t_end=t_end)
+    blocks.simulate(diagram, t_end=t_end)
     prof.disable()
     print(f"cProfile of one simulate (top {top} by tottime; profiling inflates Python-side costs):")
     pstats.Stats(prof).sort_stats("tottime").print_stats(top)
@@ -139,10 +139,10 @@ def main() -> None:
 
     def full():
         d = blocks.load_diagram(REGRASP)
-        return blocks.engine.simulate(d)
+        return blocks.simulate(d)
 
     def simulate_only():
-        return blocks.engine.simulate(diagram)
+        return blocks.simulate(diagram)
 
     t_full, res = timed(full, args.repeat)
     t_sim, _ = timed(simulate_only, args.repeat)

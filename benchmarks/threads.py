@@ -1,7 +1,7 @@
 """Threads: re-grasp runs serially against the same runs in a thread pool.
 
 Each run loads diagrams/regrasp.yaml and simulates its 1 s (``blocks.load_diagram`` +
-``blocks.engine.simulate``), as a user's ThreadPoolExecutor or a Dask worker's threads would.
+``blocks.simulate``), as a user's ThreadPoolExecutor or a Dask worker's threads would.
 The executor releases the GIL while it runs kernels that need none (``Kernel.nogil``:
 the hand's and the library's), so threads run in parallel for the compiled stretches;
 loading, planning and the Python between C calls still take turns on the GIL.
@@ -31,7 +31,7 @@ REGRASP = Path(__file__).resolve().parent.parent / "diagrams" / "regrasp.yaml"
 
 
 def regrasp(_: int = 0) -> blocks.Results:
-    return blocks.engine.simulate(blocks.load_diagram(REGRASP))
+    return blocks.simulate(blocks.load_diagram(REGRASP))
 
 
 def same(a: blocks.Results, b: blocks.Results) -> bool:

@@ -1,7 +1,7 @@
 """A validated diagram as plain data: blocks, connections, logged signals, end time.
 
 The builder (``blocks.builder.diagram_builder``, which the YAML loader drives) makes a ``Diagram``; the
-planner (``blocks.engine.schedule``) and the executor (``blocks.engine.simulate``) read it. A Diagram is
+planner (``blocks.engine.schedule``) and the executor (``blocks.simulate``) read it. A Diagram is
 flat: the blocks of its subsystems are blocks of its own, named by their path
 (``ctrl.integ``), so the planner and executor see one diagram. What the files wrote, the
 subsystems with their ports and wires, is kept beside it (``root``, ``subsystems``) for

@@ -65,7 +65,7 @@ def test_at_t0_the_output_follows_its_source_through_a_lazy_gain_then_lags_one_h
     assert "g" in s.lazy
     assert [b for b, _ in s.initial.evaluate] == ["src", "g", "d"]
     assert s.initial_held == ()
-    np.testing.assert_allclose(blocks.engine.simulate(d)["d.y"][1][:, 0], [10.0, 10.0, 12.0, 14.0])
+    np.testing.assert_allclose(blocks.simulate(d)["d.y"][1][:, 0], [10.0, 10.0, 12.0, 14.0])
 
 
 def test_a_loop_through_the_initial_feedthrough_holds_the_input_at_t0_only():
@@ -74,7 +74,7 @@ def test_a_loop_through_the_initial_feedthrough_holds_the_input_at_t0_only():
     assert build_schedule(d, d.t_end).initial_held == held
     assert build_schedule(d, None).initial_held == held
     # t = 0: d sees its default -1; then d.y is the previous s = src + 0.5 * d.y
-    np.testing.assert_allclose(blocks.engine.simulate(d)["d.y"][1][:, 0], [-1.0, 4.5, 8.25, 11.125])
+    np.testing.assert_allclose(blocks.simulate(d)["d.y"][1][:, 0], [-1.0, 4.5, 8.25, 11.125])
 
 
 def test_validate_notes_the_initial_feedthrough_and_the_held_input(tmp_path, capsys):
@@ -116,7 +116,7 @@ connections: [src.y -> s.u0, s.y -> d.u, d.y -> g.u, g.y -> s.u1, {extra}]
 def test_per_port_initial_feedthrough_orders_only_the_ports_that_read_at_t0():
     def run(wires: str):
         d = gain_and_ramp("StartsFromOneInput", wires, "d.y, d.z")
-        r = blocks.engine.simulate(d)
+        r = blocks.simulate(d)
         return build_schedule(d, d.t_end), r["d.y"][1][:, 0], r["d.z"][1][:, 0]
 
     # z does not read w at t = 0, so d.y -> g -> d.w is no loop; y(0) follows src

@@ -42,7 +42,7 @@ def test_a_long_chain_written_bottom_up_plans_in_order_and_runs_to_the_closed_fo
     for program in (plan.initial, *plan.programs, plan.final):
         assert [b for b, ports in program.evaluate] == chain
         assert all(ports is None for _, ports in program.evaluate)
-    results = blocks.engine.simulate(diagram)
+    results = blocks.simulate(diagram)
     assert results.status == "complete"
     for i in (CHAIN // 2, CHAIN - 1):
         t, y = results[f"g{i}.y"]
@@ -80,6 +80,6 @@ def test_an_inherited_block_fires_at_zero_only_if_a_source_does_whatever_the_fil
         diagram = blocks.loads_diagram(text)
         plan = blocks.build_schedule(diagram, diagram.t_end)
         assert not any(plan.fires_at_zero.values()), order
-        results = blocks.engine.simulate(diagram)
+        results = blocks.simulate(diagram)
         for signal in ("b3.y", "b4.y"):
             np.testing.assert_array_equal(results[signal][0], [0.001, 0.003])

@@ -98,8 +98,8 @@ def test_two_diagrams_with_modules_of_the_same_name_do_not_shadow_each_other(tmp
     path_before, modules_before = list(sys.path), set(sys.modules)
     first = blocks.load_diagram(make(tmp_path / "a", 2.0), trust=True)
     second = blocks.load_diagram(make(tmp_path / "b", 5.0), trust=True)
-    y1 = blocks.engine.simulate(first)["scale.y"][1][:, 0]
-    y2 = blocks.engine.simulate(second)["scale.y"][1][:, 0]
+    y1 = blocks.simulate(first)["scale.y"][1][:, 0]
+    y2 = blocks.simulate(second)["scale.y"][1][:, 0]
     assert list(y1) == [2.0] * 3 and list(y2) == [5.0] * 3
     assert sys.path == path_before
     assert "blocks_mine" not in sys.modules
@@ -110,7 +110,7 @@ def test_two_diagrams_with_modules_of_the_same_name_do_not_shadow_each_other(tmp
     assert type(again.blocks["scale"].block) is type(first.blocks["scale"].block)
     (tmp_path / "a" / "blocks_mine.py").write_text(MODULE.format(k=7.0) + "\n# edited\n", encoding="utf-8")
     edited = blocks.load_diagram(tmp_path / "a" / "diagram.yaml", trust=True)
-    assert list(blocks.engine.simulate(edited)["scale.y"][1][:, 0]) == [7.0] * 3
+    assert list(blocks.simulate(edited)["scale.y"][1][:, 0]) == [7.0] * 3
 
 
 def test_the_diagrams_folder_comes_before_the_python_path(tmp_path: Path, monkeypatch):
@@ -119,13 +119,13 @@ def test_the_diagrams_folder_comes_before_the_python_path(tmp_path: Path, monkey
     make(on_path, 11.0, module="scaler_mod")
     monkeypatch.syspath_prepend(str(on_path))
     local = blocks.load_diagram(make(tmp_path / "model", 4.0, module="scaler_mod"), trust=True)
-    assert list(blocks.engine.simulate(local)["scale.y"][1][:, 0]) == [4.0] * 3
+    assert list(blocks.simulate(local)["scale.y"][1][:, 0]) == [4.0] * 3
     # a diagram without the module beside it gets the one on the path
     other = tmp_path / "other"
     other.mkdir()
     (other / "diagram.yaml").write_text(DIAGRAM.format(module="scaler_mod"), encoding="utf-8")
     from_path = blocks.load_diagram(other / "diagram.yaml", trust=True)
-    assert list(blocks.engine.simulate(from_path)["scale.y"][1][:, 0]) == [11.0] * 3
+    assert list(blocks.simulate(from_path)["scale.y"][1][:, 0]) == [11.0] * 3
 
 
 def test_a_package_beside_the_diagram_with_relative_imports(tmp_path: Path):
@@ -138,7 +138,7 @@ def test_a_package_beside_the_diagram_with_relative_imports(tmp_path: Path):
         "from blocks import Block", "from blocks import Block\n\nfrom .gains import K"), encoding="utf-8")
     (folder / "diagram.yaml").write_text(DIAGRAM.format(module="mypkg.scale"), encoding="utf-8")
     diagram = blocks.load_diagram(folder / "diagram.yaml", trust=True)
-    assert list(blocks.engine.simulate(diagram)["scale.y"][1][:, 0]) == [6.0] * 3
+    assert list(blocks.simulate(diagram)["scale.y"][1][:, 0]) == [6.0] * 3
 
 
 def test_a_missing_module_is_one_line_naming_the_line_and_the_folders_searched(tmp_path: Path):

@@ -150,7 +150,7 @@ connections:
 log: [fast.y, slow.y]
 """
     d = blocks.loads_diagram(text, filename="two.yaml", base_dir=tmp_path)
-    r = blocks.engine.simulate(d)
+    r = blocks.simulate(d)
     assert r.complete
     r.save(tmp_path, csv=True)
     header, rows = read_csv(tmp_path / "signals.csv")
@@ -240,7 +240,7 @@ log: [named.y, plain.y]
 
 
 def labelled_run(labels: str) -> Results:
-    return blocks.engine.simulate(blocks.loads_diagram(LABELLED.replace("LABELS", labels), trust=True))
+    return blocks.simulate(blocks.loads_diagram(LABELLED.replace("LABELS", labels), trust=True))
 
 
 def test_csv_columns_use_the_element_labels_a_block_gives(tmp_path):
@@ -280,7 +280,7 @@ log: [same.y, mixed.y, plain.y]
 
 
 def units_run(units: str) -> Results:
-    return blocks.engine.simulate(blocks.loads_diagram(UNITS.replace("UNITS", units), trust=True))
+    return blocks.simulate(blocks.loads_diagram(UNITS.replace("UNITS", units), trust=True))
 
 
 def test_run_json_keeps_the_units_blocks_give_and_results_read_them_back(tmp_path):

@@ -28,7 +28,7 @@ def read(path):
 
 
 def test_mat_file_holds_each_signal_with_times_units_and_element_names(tmp_path):
-    r = blocks.engine.simulate(blocks.loads_diagram(DIAGRAM, trust=True))
+    r = blocks.simulate(blocks.loads_diagram(DIAGRAM, trust=True))
     assert r.complete, r.status
     r.save_mat(tmp_path / "run.mat")
     data = read(tmp_path / "run.mat")

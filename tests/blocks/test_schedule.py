@@ -100,7 +100,7 @@ blocks:
 connections: [src.y -> a.u0, a.y -> b.u, b.y -> a.u1]
 log: [a.y, b.y]
 """)
-    r = blocks.engine.simulate(d)
+    r = blocks.simulate(d)
     np.testing.assert_allclose(r["a.y"][1][:, 0], [0.0, 0.002, 0.005])
     np.testing.assert_allclose(r["b.y"][1][:, 0], [0.0, 0.001])
 
@@ -117,7 +117,7 @@ blocks:
 
 def test_huge_logs_are_refused_before_the_run():
     with pytest.raises(blocks.DiagramError, match="GiB"):
-        blocks.engine.simulate(toy(), t_end="1e6 s")
+        blocks.simulate(toy(), t_end="1e6 s")
 
 
 @settings(max_examples=200, deadline=None)

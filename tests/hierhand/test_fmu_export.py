@@ -515,7 +515,7 @@ def test_regrasp_with_the_exported_plant_matches_the_native_run(fmus, native_reg
 
     diagram = blocks.load_diagram(REPO / "diagrams" / "regrasp_fmu.yaml",
                                   overrides={"plant.path": str(fmus[fmi])})
-    via_fmu = blocks.engine.simulate(diagram)
+    via_fmu = blocks.simulate(diagram)
     assert via_fmu.complete
     for signal in ("plant.q", "plant.obj", "plant.fn"):
         t_native, native_values = native_regrasp[signal]

@@ -31,6 +31,7 @@ import sys
 import threading
 from pathlib import Path
 
+import blocks
 from blocks.block import BlockError
 
 STARTUP_SECONDS = 120.0
@@ -72,7 +73,7 @@ class Launcher:
 
     def __init__(self):
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
-        root = str(Path(__file__).resolve().parents[2])
+        root = str(Path(blocks.__file__).resolve().parent.parent)  # where the blocks package is found
         env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
                    PYTHONPATH=os.pathsep.join([root, *filter(None, [os.environ.get("PYTHONPATH")])]))
         command = [sys.executable, "-P", "-c", f"from blocks.fmu.isolation.forkserver import main; main({theirs.fileno()})"]
