@@ -20,17 +20,11 @@ from __future__ import annotations
 
 import importlib.util
 import os
-import sys
 from pathlib import Path
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
-
-# after setuptools, which makes these its own copy of distutils (Python 3.12 has none)
-from distutils.ccompiler import new_compiler  # noqa: E402
-from distutils.command.build_scripts import build_scripts  # noqa: E402
-from distutils.sysconfig import customize_compiler  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent
 
@@ -109,37 +103,6 @@ class BuildPy(build_py):
 
 SHIPPED_DIAGRAMS = Path("hierhand", "diagrams")
 
-COMMANDS = {"hierhand": "hierhand.start:main"}
-"""Each command (an executable in bin/) and its entry function."""
-
-LAUNCHER = f"{framework.CSRC}/{framework.LAUNCHER}"
-
-
-class BuildCommands(build_scripts):
-    """build_scripts that compiles each command of ``COMMANDS`` from the launcher, with the
-    interpreter running this build as the one it falls back to. The distribution's scripts
-    are the launcher's source, so that every install runs this command and puts what it
-    builds into bin/."""
-
-    def run(self) -> None:
-        compiler = new_compiler()
-        customize_compiler(compiler)
-        build_temp = self.get_finalized_command("build").build_temp
-        for program, entry in COMMANDS.items():
-            macros = framework.launcher_macros(program, entry, sys.executable,
-                                               hint=f"python3 -m {program} runs the same command")
-            objects = compiler.compile([LAUNCHER], output_dir=os.path.join(build_temp, "commands", program),
-                                       macros=macros,
-                                       extra_postargs=framework.CFLAGS + ["-std=c99", "-Wextra", "-g0"])
-            compiler.link_executable(objects, program, output_dir=self.build_dir, extra_postargs=["-s"])
-
-    def get_source_files(self) -> list[str]:
-        return [LAUNCHER]
-
-    def get_outputs(self) -> list[str]:
-        return [os.path.join(self.build_dir, program) for program in COMMANDS]
-
-
 setup(
     ext_modules=[
         Extension(
@@ -159,6 +122,5 @@ setup(
             libraries=["m"],
         )
     ],
-    scripts=[LAUNCHER],
-    cmdclass={"build_ext": BuildNative, "build_py": BuildPy, "build_scripts": BuildCommands},
+    cmdclass={"build_ext": BuildNative, "build_py": BuildPy},
 )

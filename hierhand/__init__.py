@@ -5,7 +5,7 @@ package also provides the ``hierhand`` command line. Its physics and control law
 compiled C (``hierhand/csrc``), built by ``pip install`` into ``hierhand._native``.
 """
 
-from pathlib import Path as _Path
+import os as _os
 
 
 def _check_native() -> None:
@@ -17,9 +17,9 @@ def _check_native() -> None:
                           "'pip install -e .' or 'pip install .' (needs a C compiler and the Python headers)") from None
     from .native_sources import CSRC, sources_digest
 
-    root = _Path(__file__).resolve().parent.parent
-    if (root / CSRC).is_dir() and _native.SOURCES_DIGEST != sources_digest(root):
-        raise ImportError(f"hierhand's C core was built from other sources than those in {root / CSRC}; "
+    root = _os.path.dirname(_os.path.dirname(_os.path.realpath(__file__)))
+    if _os.path.isdir(_os.path.join(root, CSRC)) and _native.SOURCES_DIGEST != sources_digest(root):
+        raise ImportError(f"hierhand's C core was built from other sources than those in {_os.path.join(root, CSRC)}; "
                           "rebuild it with 'pip install -e .'")
 
 

@@ -14,8 +14,8 @@ library's, so any diagram of library and hand blocks leaves as an FMU.
 
 from __future__ import annotations
 
+import os
 import zlib
-from pathlib import Path
 
 CSRC = "hierhand/csrc"
 
@@ -47,16 +47,19 @@ def fmu_sources(framework: list[str]) -> list[str]:
     return c_files + [p for p in framework if not p.endswith(".c")] + _paths(CORE_HEADERS + CONTROL_HEADERS)
 
 
-def sources_digest(root: Path) -> str:
+def sources_digest(root: str | os.PathLike) -> str:
     """A checksum of every C source and header under ``root / CSRC``: the build stamps it
     into the extension, so that a checkout whose C sources changed since the build says so.
-    CRC-32 and Adler-32 of the names and contents (zlib, not hashlib: this runs on every
-    import of hierhand, before the command line can handle Ctrl-C, and OpenSSL takes 10 ms
-    to load; it detects edits, it is not a seal against tampering)."""
-    folder = Path(root) / CSRC
+    CRC-32 and Adler-32 of the names and contents (zlib, not hashlib, and os.path, not
+    pathlib: this runs on every import of hierhand, before the command can handle Ctrl-C,
+    and OpenSSL and pathlib take milliseconds to load; it detects edits, it is not a seal
+    against tampering). Files are taken in the order of their relative paths' parts."""
+    folder = os.path.join(root, CSRC)
+    names = [tuple(os.path.relpath(os.path.join(here, name), folder).split(os.sep))
+             for here, _, files in os.walk(folder) for name in files if name.endswith((".c", ".h"))]
     crc, adler, size = 0, 1, 0
-    for path in sorted(folder.rglob("*")):
-        if path.suffix in (".c", ".h"):
-            data = path.relative_to(folder).as_posix().encode() + b"\0" + path.read_bytes() + b"\0"
-            crc, adler, size = zlib.crc32(data, crc), zlib.adler32(data, adler), size + len(data)
+    for parts in sorted(names):
+        with open(os.path.join(folder, *parts), "rb") as source:
+            data = "/".join(parts).encode() + b"\0" + source.read() + b"\0"
+        crc, adler, size = zlib.crc32(data, crc), zlib.adler32(data, adler), size + len(data)
     return f"{crc:08x}{adler:08x}{size:x}"

@@ -1,12 +1,11 @@
 """The ``hierhand`` command's first code: SIGINT and SIGTERM handled before its imports.
 
-The ``hierhand`` executable (the framework's launcher, ``blocks/csrc/launcher.c``, built by
-setup.py) and ``python -m hierhand`` call ``main``, which installs the stop handlers
-(``blocks.process.stop``) and only then imports the command line, so a Ctrl-C while numpy,
-matplotlib or a diagram load is one line and exit code 130, not a traceback. The
-executable starts Python with SIGINT and SIGTERM blocked, and ``main`` unblocks them once
-they are handled, so that a Ctrl-C while the interpreter itself starts is that line too;
-``python -m hierhand`` cannot cover that moment.
+The ``hierhand`` console script (``[project.scripts]`` in pyproject.toml, which pip writes
+for the interpreter that installs it) and ``python -m hierhand`` call ``main``, whose first
+action is to install the stop handlers (``blocks.process.stop.launch``); only then does it
+import the command line, so a Ctrl-C while numpy, matplotlib or a diagram load is one line
+and exit code 130, not a traceback. A Ctrl-C while Python itself starts, before this code
+runs, is Python's own: a KeyboardInterrupt traceback may print.
 """
 
 from __future__ import annotations

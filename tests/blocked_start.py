@@ -1,10 +1,9 @@
-"""A command started the way the ``hierhand`` executable starts Python: with SIGINT and
-SIGTERM blocked (blocks/csrc/launcher.c), and if asked with one of them already pending.
+"""A command started with SIGINT and SIGTERM blocked, as a parent that blocks them starts
+it (a blocked mask is inherited across exec), and if asked with one of them already pending.
 
 ``blocked(argv)`` is a command line that blocks both signals, sends itself ``pending`` (it
-stays pending, as blocked signals do across exec) and then execs ``argv``. A signal that
-comes while the interpreter starts is exactly this: blocked and pending when the program's
-first code runs. So a test of that moment needs no timing.
+stays pending, as blocked signals do across exec) and then execs ``argv``: blocked and
+pending when the program's first code runs, so a test of that moment needs no timing.
 """
 
 from __future__ import annotations

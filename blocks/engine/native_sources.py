@@ -5,10 +5,6 @@ and the ``sources/`` folder of an exported diagram FMU always hold the same file
 are relative to the repository root (``CSRC``). This module imports nothing of the
 package, so that setup.py can read it before anything is built.
 
-The build also compiles a command's executable from ``LAUNCHER``: a small program that
-blocks SIGINT and SIGTERM and then runs Python on the command's entry, so that a signal
-while the interpreter starts waits for the command's handlers (``launcher.c`` says how).
-
 An exported FMU's binary is the op-table core, the library's kernels, the FMU instance
 and one FMI wrapper, plus a kernel-set file that lists the kernel types the binary holds
 (``export_kernels.c`` for the library alone; an application lists its own beside it).
@@ -17,8 +13,6 @@ and one FMI wrapper, plus a kernel-set file that lists the kernel types the bina
 from __future__ import annotations
 
 import importlib.util
-import os
-import sys
 from pathlib import Path
 
 CSRC = "blocks/csrc"
@@ -34,9 +28,6 @@ EXPORT_HEADERS = ["export_instance.h"]
 FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
 KERNEL_SET = "export_kernels.c"
 """The kernel-set file of a binary holding the library's kernel types only."""
-
-LAUNCHER = "launcher.c"
-"""The C file of a command's executable (``launcher_macros`` configures it)."""
 
 CFLAGS = ["-O2", "-fvisibility=hidden", "-fno-math-errno", "-ffp-contract=off", "-Wall"]
 """-ffp-contract=off: no fused multiply-adds, so every build rounds as the reference does."""
@@ -65,26 +56,3 @@ def fmi_headers() -> str:
     if not (folder / "fmi2Functions.h").is_file() or not (folder / "fmi3Functions.h").is_file():
         raise RuntimeError(f"fmpy's FMI headers are missing from {folder}")
     return str(folder)
-
-
-def launcher_macros(program: str, entry: str, python: str, hint: str) -> list[tuple[str, str]]:
-    """The macros that make ``LAUNCHER`` the executable of command ``program``: it runs
-    ``entry`` (``"module:function"``) with the interpreter beside it (``pythonX.Y`` of this
-    interpreter's version, else python3 or python) or else ``python`` (a path), and ends
-    its one-line message with ``hint`` when no interpreter can be run."""
-    module, _, function = entry.partition(":")
-    if not module or not function.isidentifier():
-        raise ValueError(f"a launcher's entry is 'module:function', not {entry!r}")
-    version = sys.version_info
-    values = {"LAUNCH_PROGRAM": program, "LAUNCH_MODULE": module, "LAUNCH_FUNCTION": function,
-              "LAUNCH_PYTHON_NAME": f"python{version.major}.{version.minor}", "LAUNCH_PYTHON": python,
-              "LAUNCH_HINT": hint}
-    return [(name, c_string(value)) for name, value in values.items()]
-
-
-def c_string(text: str) -> str:
-    """``text`` as a C string literal: its bytes (a path's, as the file system has them),
-    every one outside printable ASCII, and the quote, backslash and question mark (trigraphs),
-    as an octal escape."""
-    plain = set(range(0x20, 0x7F)) - set(b'"\\?')
-    return '"' + "".join(chr(b) if b in plain else f"\\{b:03o}" for b in os.fsencode(text)) + '"'

@@ -11,12 +11,12 @@ and ``timeout`` stop a program: its partial results are kept the same way.
 
 ``launch`` installs the handlers before a command line imports its modules (this module
 needs only the standard library, and ``blocks`` imports its parts lazily), so a signal
-at start-up is one line and the exit code too, not a traceback. A command's executable
-(``blocks/csrc/launcher.c``) blocks both signals before the interpreter starts, so that one
-sent while Python itself starts waits, pending; ``launch`` unblocks them once its handlers
-are in place, and such a signal is then the same one line. Unblocking them is harmless
-where nothing blocked them (``python -m``), and whatever the program forks or spawns
-afterwards starts with them unblocked.
+at start-up is one line and the exit code too, not a traceback. It also unblocks both
+signals once its handlers are in place: a program whose parent started it with them
+blocked (a blocked mask is inherited across exec) can still be stopped, one that came
+while they were blocked is then the same one line, and whatever the program forks or
+spawns afterwards starts with them unblocked. Unblocking them is harmless where nothing
+blocked them.
 """
 
 from __future__ import annotations
@@ -112,8 +112,8 @@ def launch(program: str, command: Callable[[], Callable[[], object]]) -> None:
     is then called. SIGINT and SIGTERM are stop requests from before the import to the
     exit; one that stops the program outside a command's own handling (during the
     imports, say) ends it with one line and its exit code. Both are unblocked once their
-    handlers are installed: one that came while they were blocked (the launcher blocks
-    them while Python starts) is handled then."""
+    handlers are installed: one that came while they were blocked (by the program's
+    parent) is handled then."""
     with StopSignals(program):
         try:
             signal.pthread_sigmask(signal.SIG_UNBLOCK, STOPS)

@@ -135,8 +135,9 @@ def test_a_plotter_killed_by_a_signal_keeps_the_results_and_says_the_plots_are_m
 
 
 @pytest.mark.parametrize("send, code", [("SIGINT", 130), ("SIGTERM", 143)])
-def test_a_signal_that_came_while_python_started_is_one_line(tmp_path, send, code):
-    """As the ``hierhand`` executable starts Python: the signals blocked, this one pending."""
+def test_a_signal_pending_when_started_blocked_is_one_line(tmp_path, send, code):
+    """Started by a parent with the signals blocked, this one pending: it is handled as
+    soon as the handlers are in place."""
     (tmp_path / "d.yaml").write_text(SHORT, encoding="utf-8")
     proc = subprocess.run(blocked([sys.executable, "-m", "hierhand", "run", "d.yaml", "-o", "out"], pending=send),
                           cwd=tmp_path, env=dict(os.environ, PYTHONPATH=str(REPO)), capture_output=True, text=True,
@@ -147,8 +148,8 @@ def test_a_signal_that_came_while_python_started_is_one_line(tmp_path, send, cod
 
 @pytest.mark.parametrize("diagram", [SHORT, PAGES], ids=["one page", "three pages"])
 def test_the_plotters_start_with_the_signals_unblocked(tmp_path, diagram):
-    """Though the run started with them blocked (as the ``hierhand`` executable starts it),
-    the processes that draw its plots can be stopped by SIGINT and SIGTERM."""
+    """Though the run started with them blocked (by its parent), the processes that draw
+    its plots can be stopped by SIGINT and SIGTERM."""
     (tmp_path / "d.yaml").write_text(diagram, encoding="utf-8")
     env = dict(os.environ, PYTHONPATH=f"{HOOK}{os.pathsep}{REPO}", SIGNAL_AT="blocks.plot.pages:Pages.draw",
                SIGNAL_RECORD=str(tmp_path / "masks"))

@@ -100,8 +100,8 @@ def test_killing_the_run_ends_its_fmu_processes(tmp_path, misbehaving):
 
 
 def test_the_fmu_processes_start_with_the_signals_unblocked(tmp_path, fmus):
-    """The run starts with SIGINT and SIGTERM blocked, as the ``hierhand`` executable starts
-    Python; the FMU's process (forked by the launcher the run spawns) has them unblocked."""
+    """The run starts with SIGINT and SIGTERM blocked (by its parent); the FMU's process
+    (forked by the launcher the run spawns) has them unblocked."""
     (tmp_path / "d.yaml").write_text(f"""\
 name: isolated
 time: {{t_end: 1 s}}
