@@ -26,7 +26,7 @@ def run(diagram, t_end, compiled: bool, monkeypatch, engine: str = "native"):
     with monkeypatch.context() as m:
         if not compiled:
             m.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
-        return blocks.engine.simulate(diagram, t_end=t_end, engine=engine)
+        return blocks.simulate(diagram, t_end=t_end, engine=engine)
 
 
 @settings(max_examples=500, **FUZZ_SETTINGS)

@@ -55,7 +55,7 @@ blocks:
 connections: [a.y -> p.u0, b.y -> p.u1]
 log: [p.y]
 """)
-    results = blocks.engine.simulate(diagram, t_end="5 ms")
+    results = blocks.simulate(diagram, t_end="5 ms")
     assert results.status.startswith("failed at t=0.002 s")
     assert "input 'u1' is a singular matrix" in results.status
     np.testing.assert_allclose(results["p.y"][1], [[1.0, 2.0, 3.0, 4.0]] * 2)

@@ -47,7 +47,7 @@ blocks:
 connections: [src.y -> mem.u]
 log: [mem.y, src.y]
 """)
-    results = blocks.engine.simulate(diagram, t_end="10 ms")
+    results = blocks.simulate(diagram, t_end="10 ms")
     t, y = results["mem.y"]
     np.testing.assert_allclose(t, np.arange(0, 11, 2) * 1e-3)
     np.testing.assert_allclose(y[:, 0], [-1.0, 0.0, 2.0, 4.0, 6.0, 8.0])

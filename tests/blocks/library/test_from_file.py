@@ -67,7 +67,7 @@ blocks:
   src: {type: Sine, period: 1 ms, params: {amplitude: [1.0, 2.0], frequency: 5.0}}
 log: [src.y]
 """)
-    results = blocks.engine.simulate(diagram, t_end="0.2 s")
+    results = blocks.simulate(diagram, t_end="0.2 s")
     results.write_files(tmp_path, csv=True)
     t, expected = results["src.y"]
     for name in ("signals.npz", "signals.csv"):
@@ -107,7 +107,7 @@ def test_in_a_diagram_a_relative_path_is_the_diagrams_folders(tmp_path, monkeypa
     (tmp_path / "d.yaml").write_text("blocks: {ref: {type: FromFile, period: 1 ms, params: {path: ref.csv}}}\n"
                                      "log: [ref.y]\n")
     monkeypatch.chdir("/")
-    results = blocks.engine.simulate(blocks.load_diagram(tmp_path / "d.yaml"), t_end="10 ms")
+    results = blocks.simulate(blocks.load_diagram(tmp_path / "d.yaml"), t_end="10 ms")
     np.testing.assert_array_equal(results["ref.y"][1], held(np.arange(11) * 1e-3))
 
 

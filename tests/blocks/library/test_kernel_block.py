@@ -25,7 +25,7 @@ def test_without_the_extension_a_signal_block_loads_and_says_why_it_cannot_run(m
     monkeypatch.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
     diagram = blocks.loads_diagram(DIAGRAM)
     assert diagram.blocks["b"].block.kernel() is None
-    results = blocks.engine.simulate(diagram, t_end="2 ms")
+    results = blocks.simulate(diagram, t_end="2 ms")
     assert results.status.startswith("failed at t=0 s")
     assert "runs its compiled kernel, and the extension blocks._native is missing" in results.status
 

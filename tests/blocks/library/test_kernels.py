@@ -414,7 +414,7 @@ connections: [c.y -> g.u]
 log: [g.y]
 """
     d = blocks.loads_diagram(text, filename="k.yaml")
-    assert blocks.engine.simulate(d)["g.y"][1][-1, 0] == 6.0
+    assert blocks.simulate(d)["g.y"][1][-1, 0] == 6.0
     d.blocks["g"].block.k[...] = 5.0
     d.blocks["c"].block.value[...] = 1.5
-    assert blocks.engine.simulate(d)["g.y"][1][-1, 0] == 7.5
+    assert blocks.simulate(d)["g.y"][1][-1, 0] == 7.5

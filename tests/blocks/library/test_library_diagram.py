@@ -137,12 +137,12 @@ def test_the_diagram_holds_every_signal_block_of_the_library(tmp_path):
 
 def test_compiled_and_python_runs_agree_to_the_bit(tmp_path, monkeypatch):
     d = diagram(tmp_path)
-    compiled = blocks.engine.simulate(d)
+    compiled = blocks.simulate(d)
     assert compiled.complete, compiled.status
-    reference = blocks.engine.simulate(d, engine="reference")
+    reference = blocks.simulate(d, engine="reference")
     with monkeypatch.context() as m:
         m.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
-        python = blocks.engine.simulate(d)
+        python = blocks.simulate(d)
     for other in (reference, python):
         assert set(compiled) == set(other)
         for name in compiled:
@@ -154,7 +154,7 @@ def test_compiled_and_python_runs_agree_to_the_bit(tmp_path, monkeypatch):
 
 def test_every_block_runs_in_c_without_the_gil(tmp_path):
     d = diagram(tmp_path)
-    blocks.engine.simulate(d, t_end="1 ms")
+    blocks.simulate(d, t_end="1 ms")
     for name, spec in d.blocks.items():
         if isinstance(spec.block, KernelBlock):
             kernel = spec.block.kernel()

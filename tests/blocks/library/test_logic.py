@@ -85,7 +85,7 @@ blocks:
 connections: [k.y -> m.control, a.y -> m.u0, b.y -> m.u1]
 log: [m.y]
 """)
-    results = blocks.engine.simulate(diagram, t_end="5 ms")
+    results = blocks.simulate(diagram, t_end="5 ms")
     assert results.status.startswith("failed at t=0.002 s") and "control selects no data input" in results.status
     np.testing.assert_array_equal(results["m.y"][1][:, 0], [1.0, 2.0])
 

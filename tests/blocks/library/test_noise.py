@@ -125,15 +125,15 @@ def test_a_sweep_sets_each_points_seed_and_a_run_of_that_seed_agrees(tmp_path):
               serial=True, progress=False)
     rows = {int(r["noise.seed"]): float(r["end"]) for r in read_sweep(tmp_path / "sweep")[1]}
     assert len(set(rows.values())) == 3
-    alone = blocks.engine.simulate(blocks.load_diagram(diagram, overrides={"noise.seed": 2}))
+    alone = blocks.simulate(blocks.load_diagram(diagram, overrides={"noise.seed": 2}))
     assert alone["avg.y"][1][-1, 0] == rows[2]
 
 
 def test_compiled_and_python_runs_give_the_same_bits(monkeypatch):
     diagram = blocks.loads_diagram(NOISY)
-    compiled = blocks.engine.simulate(diagram)
+    compiled = blocks.simulate(diagram)
     monkeypatch.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
-    np.testing.assert_array_equal(blocks.engine.simulate(diagram)["avg.y"][1], compiled["avg.y"][1])
+    np.testing.assert_array_equal(blocks.simulate(diagram)["avg.y"][1], compiled["avg.y"][1])
 
 
 @pytest.mark.parametrize("cls, params, word", [

@@ -202,10 +202,10 @@ log: [plant.y, pid.y]
 
 def test_a_closed_loop_settles_and_runs_the_same_compiled_and_in_python(monkeypatch):
     diagram = blocks.loads_diagram(LOOP)
-    compiled = blocks.engine.simulate(diagram)
+    compiled = blocks.simulate(diagram)
     with monkeypatch.context() as m:
         m.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
-        python = blocks.engine.simulate(diagram)
+        python = blocks.simulate(diagram)
     for name in ("plant.y", "pid.y"):
         np.testing.assert_array_equal(compiled[name][1], python[name][1])
     y = compiled["plant.y"][1][:, 0]

@@ -72,7 +72,7 @@ blocks:
 connections: [c.y -> s.u]
 log: [s.y]
 """)
-    np.testing.assert_array_equal(blocks.engine.simulate(diagram, t_end=0.1)["s.y"][1][0], [3.0, 1.0])
+    np.testing.assert_array_equal(blocks.simulate(diagram, t_end=0.1)["s.y"][1][0], [3.0, 1.0])
 
 
 @pytest.mark.parametrize("cls, params, word", [

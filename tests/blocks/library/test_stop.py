@@ -26,7 +26,7 @@ log: [ramp.y]
 def test_stop_ends_the_run_at_its_next_hit(compiled, monkeypatch):
     if not compiled:
         monkeypatch.setattr(blocks.engine.compiled, "usable_kernel", lambda *args: None)
-    results = blocks.engine.simulate(blocks.loads_diagram(DIAGRAM))
+    results = blocks.simulate(blocks.loads_diagram(DIAGRAM))
     assert results.complete
     ended = results.ended_by
     # element 1 reaches 0.3 at t = 0.15 s; the run ends at the block's next hit

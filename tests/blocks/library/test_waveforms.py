@@ -47,7 +47,7 @@ blocks:
   p: {{type: Pulse, period: 0.1 ms, params: {{amplitude: 2.5, period: {period}, duty: {duty}, delay: {delay}}}}}
 log: [p.y]
 """)
-    results = blocks.engine.simulate(diagram, t_end="3 s")
+    results = blocks.simulate(diagram, t_end="3 s")
     y = results["p.y"][1][:, 0]
     np.testing.assert_array_equal(y, exact_pulse(len(y), 2.5, Fraction(period), Fraction(duty), Fraction(delay)))
 
