@@ -1,4 +1,4 @@
-/* lib_common.h: what the kernels of the library's signal blocks share (lib_*.c).
+/* lib_common.h: what the kernels of the library's blocks share (library.c, lib_*.c).
  *
  * Every one of these kernels reads a flat float64 context that its block's Python side
  * builds (blocks/library/kernel_block.py): the same two-number header first,

@@ -1,24 +1,21 @@
 /* Compiled kernels of the framework's library blocks (blocks/library).
  *
- * Every kernel reads a flat float64 context that the block's kernel() builds
- * (blocks/library/_kernels.py): sizes first, stored as doubles, then the parameters.
- * Each computes the quantity the block's Python method computes. Elementwise arithmetic
- * (sources, gains by a scalar or a vector, sums, saturation, delays, holds, and the LTI
- * blocks of one state, one input and one output) does the same operations in the same
- * order as the Python side, so it agrees to the last bit. Compiled with -ffp-contract=off:
- * no fused multiply-add anywhere, every product and sum is rounded on its own.
+ * These are the blocks' only definition: their Python methods call these same functions
+ * (blocks/library/kernel_block.py). Every kernel reads a flat float64 context as
+ * lib_common.h says: [W, T] then the block's numbers from LIB_H on, sizes stored as
+ * doubles. Compiled with -ffp-contract=off: no fused multiply-add anywhere, every product
+ * and sum is rounded on its own (the tests' numpy oracles, tests/blocks/library/oracles.py,
+ * agree to the last bit where they do the same operations in the same order).
  *
  * Matrix-vector products (matvec) have one definition of their own, independent of any
  * BLAS: each row is summed in column order starting from its first product,
  *     y_i = ((M_i0 v_0 + M_i1 v_1) + M_i2 v_2) + ... + M_i,L-1 v_L-1.
  * A row of a single term is that one product, as numpy's is; longer rows equal numpy's
- * ndarray.dot to round-off, not bit for bit (BLAS sums in its own order). That is enough:
- * within a run the executor uses a block's kernel for all of its hits or for none.
+ * ndarray.dot to round-off, not bit for bit (BLAS sums in its own order).
  *
  * The table of kernel types at the end (blocks_kernel.h) also lists the kernels of the
- * library's signal blocks (lib_math.c, lib_dynamic.c, lib_sources.c; their conventions in
- * lib_common.h). Every library context is a flat array of doubles, so a type's constructor
- * copies its record.
+ * library's other blocks (lib_math.c, lib_dynamic.c, lib_sources.c). Every library context
+ * is a flat array of doubles, so a type's constructor copies its record.
  */
 #include <math.h>
 #include <stddef.h>
@@ -44,37 +41,37 @@ static void matvec(const double *M, int r, int L, const double *v, double *y)
 
 /* -- sources ------------------------------------------------------------------------ */
 
-/* constant: [w, value...] */
+/* constant: [value(W)] */
 static int constant_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
                            int *which)
 {
     (void)t, (void)state, (void)inputs, (void)which;
     const double *c = ctx;
-    int w = (int)c[0];
-    memcpy(out, c + 1, (size_t)w * sizeof(double));
+    memcpy(out, c + LIB_H, (size_t)LIB_W(c) * sizeof(double));
     return 0;
 }
 
-/* step: [w, time, before..., after...] */
+/* step: [time, before(W), after(W)]: before while t < time, after from time on */
 static int step_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
                        int *which)
 {
     (void)state, (void)inputs, (void)which;
     const double *c = ctx;
-    int w = (int)c[0];
-    memcpy(out, t < c[1] ? c + 2 : c + 2 + w, (size_t)w * sizeof(double));
+    int w = LIB_W(c);
+    const double *before = c + LIB_H + 1, *after = before + w;
+    memcpy(out, t < c[LIB_H] ? before : after, (size_t)w * sizeof(double));
     return 0;
 }
 
-/* ramp: [w, start, slope..., initial...] */
+/* ramp: [start, slope(W), initial(W)]: initial + slope (t - start) once t > start */
 static int ramp_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
                        int *which)
 {
     (void)state, (void)inputs, (void)which;
     const double *c = ctx;
-    int w = (int)c[0];
-    const double *slope = c + 2, *initial = c + 2 + w;
-    double elapsed = t - c[1];
+    int w = LIB_W(c);
+    const double *slope = c + LIB_H + 1, *initial = slope + w;
+    double elapsed = t - c[LIB_H];
     if (elapsed <= 0.0) {
         memcpy(out, initial, (size_t)w * sizeof(double));
         return 0;
@@ -87,12 +84,12 @@ static int ramp_output(const void *ctx, double t, const double *state, const dou
 /* -- arithmetic --------------------------------------------------------------------- */
 
 /* gain: [mode, rows, cols, k...]: mode 0 elementwise (k has `rows` entries, or 1 for a
-   scalar applying to width cols), 1 matrix (rows x cols). */
+   scalar applying to width cols), 1 matrix (rows x cols): y = u k, or K u by matvec. */
 static int gain_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
                        int *which)
 {
     (void)t, (void)state, (void)which;
-    const double *c = ctx;
+    const double *c = (const double *)ctx + LIB_H;
     int mode = (int)c[0], rows = (int)c[1], cols = (int)c[2];
     const double *k = c + 3, *u = inputs[0];
     if (mode == 1) {
@@ -107,7 +104,7 @@ static int gain_output(const void *ctx, double t, const double *state, const dou
     return 0;
 }
 
-/* sum: [w, count, negate_sum, sign...] (sign +1 / -1 per input): the first '+' input,
+/* sum: [count, negate_sum, sign(count)] (sign +1 / -1 per input): the first '+' input,
    then the other '+' ones added in order, then the '-' ones subtracted (minus the first
    '-' to start when there is no '+'); negate_sum: "--", which is -(u0 + u1). */
 static int sum_output(const void *ctx, double t, const double *state, const double *const *inputs, double *out,
@@ -115,9 +112,9 @@ static int sum_output(const void *ctx, double t, const double *state, const doub
 {
     (void)t, (void)state, (void)which;
     const double *c = ctx;
-    int w = (int)c[0], count = (int)c[1];
-    const double *sign = c + 3;
-    if (c[2] != 0.0) {
+    int w = LIB_W(c), count = (int)c[LIB_H];
+    const double *sign = c + LIB_H + 2;
+    if (c[LIB_H + 1] != 0.0) {
         const double *a = inputs[0], *b = inputs[1];
         for (int i = 0; i < w; i++)
             out[i] = -(a[i] + b[i]);
@@ -148,42 +145,34 @@ static int sum_output(const void *ctx, double t, const double *state, const doub
     return 0;
 }
 
-/* saturation: [w, lower..., upper...]: np.minimum(np.maximum(u, lower), upper), NaN
-   passing through as in numpy. */
+/* saturation: [lower(W), upper(W)]: u clipped to [lower, upper], NaN passing through. */
 static int saturation_output(const void *ctx, double t, const double *state, const double *const *inputs,
                              double *out, int *which)
 {
     (void)t, (void)state, (void)which;
     const double *c = ctx;
-    int w = (int)c[0];
-    const double *lo = c + 1, *hi = c + 1 + w, *u = inputs[0];
-    for (int i = 0; i < w; i++) {
-        double v = u[i];
-        if (isnan(v)) {
-            out[i] = v;
-            continue;
-        }
-        v = v >= lo[i] ? v : lo[i];
-        out[i] = v <= hi[i] ? v : hi[i];
-    }
+    int w = LIB_W(c);
+    const double *lo = c + LIB_H, *hi = lo + w, *u = inputs[0];
+    for (int i = 0; i < w; i++)
+        out[i] = lib_clip(u[i], lo[i], hi[i]);
     return 0;
 }
 
 /* -- discrete ----------------------------------------------------------------------- */
 
-/* unit delay and zero-order hold: [w] */
+/* unit delay (state: the last input) and zero-order hold: the header alone */
 static int unit_delay_output(const void *ctx, double t, const double *state, const double *const *inputs,
                              double *out, int *which)
 {
     (void)t, (void)inputs, (void)which;
-    memcpy(out, state, (size_t)((const double *)ctx)[0] * sizeof(double));
+    memcpy(out, state, (size_t)LIB_W((const double *)ctx) * sizeof(double));
     return 0;
 }
 
 static int unit_delay_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
 {
     (void)t, (void)which;
-    memcpy(state, inputs[0], (size_t)((const double *)ctx)[0] * sizeof(double));
+    memcpy(state, inputs[0], (size_t)LIB_W((const double *)ctx) * sizeof(double));
     return 0;
 }
 
@@ -191,7 +180,7 @@ static int unit_delay_advance(const void *ctx, double t, double *state, const do
                               double *rows, int *done, int *which)
 {
     (void)t, (void)which;
-    size_t w = (size_t)((const double *)ctx)[0];
+    size_t w = (size_t)LIB_W((const double *)ctx);
     if (n > 0) {
         memcpy(state, inputs[0], w * sizeof(double));
         for (int i = 0; i < n; i++)
@@ -205,17 +194,18 @@ static int zero_order_hold_output(const void *ctx, double t, const double *state
                                   double *out, int *which)
 {
     (void)t, (void)state, (void)which;
-    memcpy(out, inputs[0], (size_t)((const double *)ctx)[0] * sizeof(double));
+    memcpy(out, inputs[0], (size_t)LIB_W((const double *)ctx) * sizeof(double));
     return 0;
 }
 
 /* -- linear time-invariant ---------------------------------------------------------- */
 
-/* lti context: header, then the matrices at the offsets the header gives.
+/* lti context, from LIB_H on: its own header, then the matrices at the offsets the header
+   gives (counted from LIB_H).
    [n, m, p, scalar, ft_path, a, b, c, d, off_CD, off_C, off_D, off_AB, chunk_max,
     off_Y[1..chunk_max], off_X[1..chunk_max]]
-   scalar (n = m = p = 1): output and update on the four numbers as Python floats do;
-   chunk c's maps, as _LinearBlock._chunk(c): Y (c p x (n + m)) at off_Y[c], X (n x (n + m))
+   scalar (n = m = p = 1): output and update on the four numbers, c x + d u and a x + b u;
+   chunk c's maps, as _LinearBlock._all_chunks builds them: Y (c p x (n + m)) at off_Y[c], X (n x (n + m))
    at off_X[c] (the Y's all start at one offset: each is the first c p rows of the last).
    Any sizes: the vectors z = [x; u] of the products live on the stack up to LTI_STACK
    doubles, in memory from malloc beyond (LTI_NOMEM when there is none). */
@@ -249,7 +239,7 @@ static int lti_output(const void *ctx, double t, const double *state, const doub
                       int *which)
 {
     (void)t, (void)which;
-    const double *c = ctx;
+    const double *c = (const double *)ctx + LIB_H;
     int n = (int)c[LTI_N], m = (int)c[LTI_M], p = (int)c[LTI_P];
     const double *u = inputs[0];
     if (c[LTI_SCALAR] != 0.0) {
@@ -276,7 +266,7 @@ static int lti_output(const void *ctx, double t, const double *state, const doub
 static int lti_update(const void *ctx, double t, double *state, const double *const *inputs, int *which)
 {
     (void)t, (void)which;
-    const double *c = ctx;
+    const double *c = (const double *)ctx + LIB_H;
     int n = (int)c[LTI_N], m = (int)c[LTI_M];
     const double *u = inputs[0];
     if (c[LTI_SCALAR] != 0.0) {
@@ -292,14 +282,13 @@ static int lti_update(const void *ctx, double t, double *state, const double *co
     return 0;
 }
 
-/* The closed form of _LinearBlock.advance: per chunk of at most chunk_max steps, the rows
-   Y z and the new state X z. For the scalar model these products are the two-term sums
-   its Python advance writes out, (first * x) + (second * u), so they match to the bit. */
+/* The closed form for a held input, x_{k+i} = A^i x + (sum_{j<i} A^j) B u: per chunk of at
+   most chunk_max steps, the rows Y z and the new state X z. */
 static int lti_advance(const void *ctx, double t, double *state, const double *const *inputs, int count,
                        double *rows, int *done, int *which)
 {
     (void)t, (void)which;
-    const double *c = ctx;
+    const double *c = (const double *)ctx + LIB_H;
     int n = (int)c[LTI_N], m = (int)c[LTI_M], p = (int)c[LTI_P], chunk = (int)c[LTI_CHUNK];
     const double *u = inputs[0];
     const double *off_y = c + LTI_HEADER - 1, *off_x = c + LTI_HEADER + chunk - 1; /* indexed by c = 1..chunk */
@@ -343,16 +332,6 @@ static long width_first(const double *c)
     return (long)c[0];
 }
 
-static long width_gain(const double *c)
-{
-    return (long)(c[0] == 1.0 || c[1] != 1.0 ? c[1] : c[2]);
-}
-
-static long width_lti(const double *c)
-{
-    return (long)c[LTI_P];
-}
-
 /* A library context is its record itself (the numbers blocks/library/_kernels.py packs):
    construct copies it, after checking that it holds the header its width is read from and
    that the width is one a kernel can write. */
@@ -388,8 +367,8 @@ static int flat_construct(const double *record, long n, long header, width_fn wi
     }
 
 CONSTRUCT(first, 1, width_first)
-CONSTRUCT(gain, 3, width_gain)
-CONSTRUCT(lti, LTI_HEADER, width_lti)
+CONSTRUCT(gain, LIB_H + 3, width_first)
+CONSTRUCT(lti, LIB_H + LTI_HEADER, width_first)
 
 #define TYPE(kind, construct, out, upd, adv) {#kind, construct##_construct, free, NULL, out, upd, adv, NULL}
 #define SIGNAL(kind) TYPE(kind, first, kind##_output, NULL, NULL)

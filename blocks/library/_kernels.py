@@ -1,14 +1,13 @@
-"""The library blocks' compiled kernels (blocks/csrc/library.c): addresses and contexts.
+"""The library blocks' compiled kernels (blocks/csrc/library.c, lib_*.c): addresses and contexts.
 
-Each library block's ``kernel()`` packs its parameters into one flat float64 array, the
-context its C functions read (sizes first, as doubles), and returns a ``Kernel`` with
-the addresses from ``blocks._native.library()``. A kernel computes the quantity its
-block's Python method computes: elementwise arithmetic, in the same order, to the last
-bit; matrix-vector products by library.c's own definition (each row summed in column
-order from its first product, no fused multiply-add), which equals numpy's
-``ndarray.dot`` for single-term rows and to round-off otherwise. Kernels exist for any
-size: the context holds the matrices. The kernels only read their context and keep
-their scratch on the stack (or in memory of their own call), so they say ``nogil``.
+Each library block (a ``KernelBlock``) packs its parameters into one flat float64 array,
+the context its C functions read (lib_common.h's header [W, T], then its numbers, sizes
+as doubles), and gets a ``Kernel`` with the addresses from ``blocks._native.library()``.
+Matrix-vector products are library.c's own (each row summed in column order from its
+first product, no fused multiply-add), so they equal numpy's ``ndarray.dot`` for
+single-term rows and to round-off otherwise. Kernels exist for any size: the context
+holds the matrices. The kernels only read their context and keep their scratch on the
+stack (or in memory of their own call), so they say ``nogil``.
 """
 
 from __future__ import annotations

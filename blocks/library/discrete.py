@@ -4,17 +4,17 @@ the discrete derivative and the moving average."""
 from __future__ import annotations
 
 import operator
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from blocks.arrays import float_array
-from blocks.block import Block, Signal
-from blocks.library import _kernels, _params
-from blocks.library.kernel_block import KernelBlock
+from blocks.block import Signal
+from blocks.library import _params
+from blocks.library.kernel_block import Advancing, KernelBlock
 
 
-class UnitDelay(Block):
+class UnitDelay(Advancing):
     """Delays its input by one sample: outputs the input of the previous hit (z^-1).
 
     Parameters
@@ -24,6 +24,8 @@ class UnitDelay(Block):
     width : int
         signal width; omit to take it from a vector 'initial' or from the connections
     """
+
+    kernel_name = "unit_delay"
 
     def __init__(self, initial: Any = 0.0, width: int | None = None):
         self.initial = float_array(initial, "initial", ndim=1, allow_empty=False)
@@ -50,44 +52,16 @@ class UnitDelay(Block):
         width = self.outputs["y"] or self.initial.size
         return np.resize(self.initial, width).astype(float)
 
-    def output(self, t: float, state: Signal, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        return {"y": state.copy()}
 
-    def update(self, t: float, state: Signal, inputs: Mapping[str, Signal]) -> Signal:
-        return inputs["u"].copy()
-
-    def advance(self, t: float, state: Signal, inputs: Mapping[str, Signal], n: int):
-        """Held input: every one of the ``n`` following outputs is that input."""
-        u = inputs["u"]
-        if n <= 0:
-            return state, {"y": np.empty((0, state.size))}
-        return u.copy(), {"y": np.tile(u, (n, 1))}
-
-    def kernel(self):
-        width = self.outputs["y"]
-        if width is None:
-            return None
-        return _kernels.cached(self, (width,), lambda: _kernels.make_kernel(
-            np.array([width], dtype=float), "unit_delay_output", "unit_delay_update", "unit_delay_advance"))
-
-
-class ZeroOrderHold(Block):
+class ZeroOrderHold(KernelBlock):
     """Samples its input at its own period and holds it in between (y = u at each hit)."""
+
+    kernel_name = "zero_order_hold"
 
     def __init__(self):
         self.inputs = {"u": None}
         self.outputs = {"y": None}
         self.feedthrough = True
-
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        return {"y": inputs["u"].copy()}
-
-    def kernel(self):
-        width = self.outputs["y"]
-        if width is None:
-            return None
-        return _kernels.cached(self, (width,), lambda: _kernels.make_kernel(
-            np.array([width], dtype=float), "zero_order_hold_output"))
 
 
 class Memory(UnitDelay):

@@ -1,14 +1,15 @@
 """KernelBlock: a library block whose step is defined once, by its C kernel.
 
-The signal blocks of the library (PID, integrators, switches, tables, sources, ...) have
-their equations in C (``blocks/csrc/lib_*.c``), and their Python methods call those same
-functions through ``blocks._native.call``: one definition of each block, the same bits
-whether the executor runs a hit in C or in Python. A block says which kernel it is
+Every block of the library has its equations in C (``blocks/csrc/library.c``,
+``lib_*.c``), and its Python methods call those same functions through
+``blocks._native.call``: one definition of each block, the same bits whether the executor
+runs a hit in C or in Python. A block says which kernel it is
 (``kernel_name``: ``pid`` names ``pid_output``, ``pid_update`` and, for ``Advancing``
 blocks, ``pid_advance``) and what its context holds after the common header
 [output width, period] (``context_numbers``); its ``initial_state`` is the flat array
-the kernel's state layout describes. Failure codes become messages in ``failure_text``.
-Without the compiled extension such a block loads and validates, but cannot run.
+the kernel's state layout describes; ``tunables`` names the context's slots an exported
+FMU's importer may set. Failure codes become messages in ``failure_text``. Without the
+compiled extension such a block loads and validates, but cannot run.
 """
 
 from __future__ import annotations
@@ -20,11 +21,14 @@ import numpy as np
 
 from blocks.engine import compiled
 from blocks.block import Block, BlockError, EndRun, Signal
-from blocks.engine.kernel import END_RUN, Kernel
+from blocks.engine.kernel import END_RUN, Kernel, Tunable
 from blocks.library import _kernels
 
 NOMEM, SINGULAR, OUT_OF_RANGE = 1, 2, 3
 """lib_common.h's failure codes."""
+
+HEADER = 2
+"""lib_common.h's LIB_H: the numbers of a context before the block's own [W, T]."""
 
 RESETS = ("none", "rising", "falling", "either", "level")
 """Reset kinds of an optional reset input (lib_common.h's lib_reset): a rising edge (from
@@ -47,6 +51,15 @@ class KernelBlock(Block):
     def context_numbers(self) -> Iterable[Any]:
         """The block's numbers after the header, in the kernel's order (scalars, arrays)."""
         return ()
+
+    def tunables(self) -> tuple[Tunable, ...]:
+        """The context's slots (counted from its start, header included) that an exported
+        FMU's importer may set; none by default."""
+        return ()
+
+    def not_ready(self) -> str:
+        """Why the block has no kernel yet, when it has the extension and its period."""
+        return "the port widths are not known yet"
 
     def failure_text(self, code: int, which: int) -> str:
         """What a failure code of the kernel means, in a few words."""
@@ -91,7 +104,7 @@ class KernelBlock(Block):
         stateful = self.initial_state() is not None
         advance = f"{name}_advance" if isinstance(self, Advancing) else None
         return _kernels.make_kernel(context, f"{name}_output", f"{name}_update" if stateful else None, advance,
-                                    failures=self.kernel_error)
+                                    failures=self.kernel_error, tunables=self.tunables())
 
     def kernel_error(self, code: int, which: int, t: float, phase: str) -> BaseException:
         """``Kernel.error``: the exception of a failure code (an ``EndRun`` for END_RUN)."""
@@ -123,14 +136,14 @@ class KernelBlock(Block):
         return state
 
     def _kernel_for_python(self) -> Kernel:
+        if not _kernels.functions() or _native() is None:
+            raise BlockError(f"{type(self).__name__} runs its compiled kernel, and the extension "
+                             "blocks._native is missing (pip install -e . builds it)")
         kernel = self.kernel()
         if kernel is None:
-            if not _kernels.functions() or _native() is None:
-                raise BlockError(f"{type(self).__name__} runs its compiled kernel, and the extension "
-                                 "blocks._native is missing (pip install -e . builds it)")
             if self.period is None and self.period_reason is not None:
                 raise BlockError(f"{type(self).__name__} needs a period: {self.period_reason}")
-            raise BlockError(f"{type(self).__name__}: the port widths are not known yet")
+            raise BlockError(f"{type(self).__name__}: {self.not_ready()}")
         return kernel
 
     def _input_list(self, inputs: Mapping[str, Signal]) -> list[np.ndarray]:
@@ -155,7 +168,7 @@ class KernelBlock(Block):
 
 
 class Advancing(KernelBlock):
-    """A KernelBlock with state and no feedthrough, whose kernel also advances n hits."""
+    """A KernelBlock whose kernel also advances n hits with its inputs held, in one call."""
 
     def advance(self, t: float, state: Any, inputs: Mapping[str, Signal], n: int):
         kernel = self._kernel_for_python()

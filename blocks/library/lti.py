@@ -2,42 +2,27 @@
 
 Both run the discrete model x[k+1] = A x + B u, y = C x + D u at the block period. With
 ``method`` set, the given matrices (or polynomials) are a continuous-time model that
-``bind(period)`` discretises with python-control. These blocks sit in the executor's
-hot loop, so everything is precomputed: the 1x1x1 case runs on Python floats (about 3x
-faster than a numpy matmul on a 1-vector), larger ones on one ``ndarray.dot`` of a
-stacked matrix (``.dot`` skips the ``@`` ufunc dispatch), and ``advance`` uses cached
-closed-form chunk matrices.
+``bind(period)`` discretises with python-control. Their steps are library.c's ``lti_*``
+kernels, which read the stacked matrices [A B] and [C D] and, for ``advance`` over a held
+input, closed-form chunk matrices, all computed here once per discretisation.
 """
 
 from __future__ import annotations
 
 from fractions import Fraction
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from blocks.arrays import float_array
-from blocks.block import Block, BlockError, Signal
-from blocks.library import _kernels
+from blocks.block import Signal
+from blocks.library.kernel_block import Advancing
 
 METHODS = ("zoh", "tustin")
 """Discretisation methods accepted by ``method`` (python-control names)."""
 
 CHUNK = 64
-"""Longest run of steps that one cached ``advance`` matrix covers."""
-
-
-class _Unbound:
-    """Stands in for the discrete matrices of a continuous model until ``bind``."""
-
-    def __init__(self, block_name: str, method: str):
-        self.message = (
-            f"{block_name} with method={method!r} is a continuous model: "
-            "bind(period) must discretise it before it runs"
-        )
-
-    def dot(self, *args: Any) -> np.ndarray:
-        raise BlockError(self.message)
+"""Longest run of steps that one ``advance`` matrix of the context covers."""
 
 
 def _check_method(method: str | None) -> str | None:
@@ -111,12 +96,14 @@ def transfer_function_realisation(num: Any, den: Any) -> tuple[np.ndarray, ...]:
     return A, B, C, D
 
 
-class _LinearBlock(Block):
-    """Shared machinery: discretisation, the run-time kernels and the advance cache.
+class _LinearBlock(Advancing):
+    """Shared machinery: discretisation and the kernel's context.
 
     ``A``, ``B``, ``C``, ``D`` are the discrete matrices in use (``None`` for a
     continuous model until ``bind``); the state is the 1-D array x of that realisation.
     """
+
+    kernel_name = "lti"
 
     def _configure(self, A: np.ndarray, B: np.ndarray, C: np.ndarray, D: np.ndarray,
                    x0: np.ndarray, method: str | None) -> None:
@@ -130,14 +117,8 @@ class _LinearBlock(Block):
         if self._continuous is None:
             self._set_discrete(A, B, C, D, x0)
             return
-        unbound = _Unbound(type(self).__name__, method)
         self.A = self.B = self.C = self.D = None
-        self._AB = self._CD = self._C = unbound
-        self._scalar = False
-        self._ft_path = True
         self._x0 = x0
-        self._chunks: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-        self._scalar_chunks: dict[int, tuple[np.ndarray, np.ndarray, float, float]] = {}
         # Until the period is known, assume the feedthrough a discretised model can have:
         # zoh keeps D; tustin adds a multiple of C (I - A T/2)^-1 B, which is zero for
         # every T only when all Markov parameters C A^k B are.
@@ -154,17 +135,12 @@ class _LinearBlock(Block):
         self.A, self.B, self.C, self.D = A, B, C, D
         self._AB = np.ascontiguousarray(np.hstack((A, B)))
         self._CD = np.ascontiguousarray(np.hstack((C, D)))
-        self._C = np.ascontiguousarray(C)
         self._x0 = x0
         self.feedthrough = bool(np.any(D != 0))
         # A stateless pure gain goes through the feedthrough branch even when D == 0.
         self._ft_path = self.feedthrough or self._n == 0
         self._scalar = (self._n, self._m, self._p) == (1, 1, 1)
-        if self._scalar:
-            self._a, self._b = float(A[0, 0]), float(B[0, 0])
-            self._c, self._d = float(C[0, 0]), float(D[0, 0])
-        self._chunks = {}
-        self._scalar_chunks = {}
+        self._matrices = object()  # these matrices in the kernel's cache key: new ones, a new context
 
     def bind(self, period: Fraction | None) -> None:
         """Discretise a continuous model (``method`` given) at ``period``."""
@@ -192,43 +168,11 @@ class _LinearBlock(Block):
     def initial_state(self) -> Signal | None:
         return None if self._n == 0 else self._x0.copy()
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        if self._scalar:
-            if self._ft_path:
-                return {"y": np.array((self._c * state.item() + self._d * inputs["u"].item(),))}
-            return {"y": np.array((self._c * state.item(),))}
-        if self._ft_path:
-            if state is None:
-                return {"y": self.D.dot(inputs["u"])}
-            return {"y": self._CD.dot(np.concatenate((state, inputs["u"])))}
-        return {"y": self._C.dot(state)}
-
-    def update(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> Any:
-        if self._scalar:
-            return np.array((self._a * state.item() + self._b * inputs["u"].item(),))
-        return self._AB.dot(np.concatenate((state, inputs["u"])))
-
-    def _chunk(self, c: int) -> tuple[np.ndarray, np.ndarray]:
-        """Matrices mapping z = [x; u] to the c outputs stacked, and to the state after c steps."""
-        maps = self._chunks.get(c)
-        if maps is None:
-            n, m = self._n, self._m
-            step = np.zeros((n + m, n + m))
-            step[:n] = self._AB
-            step[n:, n:] = np.eye(m)
-            power = np.eye(n + m)
-            rows = []
-            for _ in range(c):
-                power = step @ power
-                rows.append(self._CD @ power)
-            maps = (np.ascontiguousarray(np.vstack(rows)), np.ascontiguousarray(power[:n]))
-            self._chunks[c] = maps
-        return maps
-
     def _all_chunks(self) -> tuple[np.ndarray, list[np.ndarray]]:
-        """``_chunk(CHUNK)``'s output map and every ``_chunk(c)``'s state map, c = 1..CHUNK,
-        by the very operations ``_chunk`` does (its products for c are the first c of
-        those for CHUNK), in CHUNK steps instead of CHUNK (CHUNK + 1) / 2."""
+        """The maps of c steps with a held input u from z = [x; u], c = 1..CHUNK: the
+        outputs of CHUNK steps stacked (those of c steps are its first c p rows) and the
+        state after each c, from the powers S^c of the step matrix S = [[A, B], [0, I]]:
+        rows [C D] S^c, state S^c[:n]."""
         n, m = self._n, self._m
         step = np.zeros((n + m, n + m))
         step[:n] = self._AB
@@ -241,76 +185,29 @@ class _LinearBlock(Block):
             xmaps.append(np.ascontiguousarray(power[:n]))
         return np.ascontiguousarray(np.vstack(rows)), xmaps
 
-    def advance(self, t: float, state: Any, inputs: Mapping[str, Signal], n: int):
-        """Closed form for a held input: x_{k+i} = A^i x + (sum_{j<i} A^j) B u, in chunks."""
-        u = inputs["u"]
-        p = self._p
-        if state is None:
-            return None, {"y": np.tile(self.D.dot(u), (max(n, 0), 1))}
-        if n <= 0:
-            return state, {"y": np.empty((0, p))}
-        if self._scalar:
-            return self._advance_scalar(state.item(), u.item(), n)
-        nx = self._n
-        z = np.concatenate((state, u))
-        if n <= CHUNK:
-            ymap, xmap = self._chunk(n)
-            return xmap.dot(z), {"y": ymap.dot(z).reshape(n, p)}
-        out = np.empty((n, p))
-        done = 0
-        while done < n:
-            c = min(n - done, CHUNK)
-            ymap, xmap = self._chunk(c)
-            out[done:done + c] = ymap.dot(z).reshape(c, p)
-            x = xmap.dot(z)
-            z[:nx] = x
-            done += c
-        return x, {"y": out}
-
-    def _advance_scalar(self, x: float, u: float, n: int):
-        """``advance`` of the 1x1x1 model: each chunk's products written out as two-term
-        sums (first * x) + (second * u), elementwise, which the C kernel's products equal
-        to the bit (``ndarray.dot`` would leave the order and fusing to BLAS)."""
-        if n <= CHUNK:
-            yx, yu, xx, xu = self._scalar_chunk(n)
-            return np.array((xx * x + xu * u,)), {"y": yx * x + yu * u}
-        out = np.empty((n, 1))
-        done = 0
-        while done < n:
-            c = min(n - done, CHUNK)
-            yx, yu, xx, xu = self._scalar_chunk(c)
-            out[done:done + c] = yx * x + yu * u
-            x = xx * x + xu * u
-            done += c
-        return np.array((x,)), {"y": out}
-
-    def _scalar_chunk(self, c: int) -> tuple[np.ndarray, np.ndarray, float, float]:
-        """``_chunk(c)`` of the 1x1x1 model split by column: the output map's x and u
-        columns (contiguous, c x 1) and the state map's two numbers."""
-        parts = self._scalar_chunks.get(c)
-        if parts is None:
-            ymap, xmap = self._chunk(c)
-            parts = (ymap[:, :1].copy(), ymap[:, 1:].copy(), float(xmap[0, 0]), float(xmap[0, 1]))
-            self._scalar_chunks[c] = parts
-        return parts
+    def not_ready(self) -> str:
+        if self.A is None:
+            return (f"with method={self.method!r} it is a continuous model: "
+                    "bind(period) must discretise it before it runs")
+        return super().not_ready()
 
     def kernel(self):
-        """C output, update and advance (blocks/csrc/library.c, ``lti_*``), reading the
-        matrices in use and every ``_chunk`` map; None for a continuous model not yet
-        bound. The 1x1x1 model and a stateless 1x1 gain match the Python methods to the
-        bit (their products are the same float operations); larger ones compute the
-        same products to round-off (library.c's ``matvec``, see ``blocks.library._kernels``)."""
-        if self.A is None:
-            return None
-        return _kernels.cached(self, (id(self._AB), self.period), self._build_kernel)
+        """None for a continuous model not yet bound."""
+        return None if self.A is None else super().kernel()
 
-    def _build_kernel(self):
+    def cache_key(self):
+        return self._matrices
+
+    def context_numbers(self):
+        """library.c's lti context: a header of sizes, the 1x1x1 model's four numbers and
+        the offsets (from this header's start) of the matrices that follow: [A B], D,
+        [C D], C and every chunk's maps (``_all_chunks``)."""
         n, m, p = self._n, self._m, self._p
         header = np.zeros(14 + 2 * CHUNK)
         scalar = self._scalar
-        header[:9] = (n, m, p, scalar, self._ft_path,
-                      self._a if scalar else 0.0, self._b if scalar else 0.0,
-                      self._c if scalar else 0.0, self._d if scalar else 0.0)
+        header[:5] = (n, m, p, scalar, self._ft_path)
+        if scalar:
+            header[5:9] = (self.A[0, 0], self.B[0, 0], self.C[0, 0], self.D[0, 0])
         header[13] = CHUNK
         parts = [header]
         size = header.size
@@ -326,14 +223,13 @@ class _LinearBlock(Block):
         header[11] = place(self.D)
         if n:
             header[9] = place(self._CD)
-            header[10] = place(self._C)
+            header[10] = place(self.C)
             # chunk c's output map is the first c * p rows of chunk CHUNK's
             ymap, xmaps = self._all_chunks()
             header[14:14 + CHUNK] = place(ymap)
             for c in range(1, CHUNK + 1):
                 header[13 + CHUNK + c] = place(xmaps[c - 1])
-        return _kernels.make_kernel(np.concatenate(parts), "lti_output", "lti_update", "lti_advance",
-                                    self._AB)
+        return parts
 
 
 class DiscreteStateSpace(_LinearBlock):

@@ -2,21 +2,16 @@
 
 from __future__ import annotations
 
-from functools import partial
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from blocks.arrays import float_array
-from blocks.block import Block, Signal
 from blocks.library import _kernels
-
-# Python-float scalars cost an extra conversion inside every ufunc call; 0-d arrays
-# multiply and compare against a small vector about a third faster, so scalar
-# parameters are stored as 0-d float64 arrays.
+from blocks.library.kernel_block import HEADER, KernelBlock
 
 
-class Gain(Block):
+class Gain(KernelBlock):
     """Multiplies the input by ``k``: scalar, elementwise vector, or matrix (y = K @ u).
 
     Parameters
@@ -25,12 +20,13 @@ class Gain(Block):
         gain: a scalar (any width), a vector (elementwise) or a matrix (y = K @ u)
     """
 
+    kernel_name = "gain"
+
     def __init__(self, k: Any = 1.0):
         arr = float_array(k, "k", allow_empty=False)
         if arr.ndim > 2:
             raise ValueError(f"parameter 'k' must be a scalar, vector or matrix, got shape {arr.shape}")
         self.k = arr
-        self._matrix = arr.ndim == 2
         if arr.ndim == 0:
             self.inputs, self.outputs = {"u": None}, {"y": None}
         elif arr.ndim == 1:
@@ -39,102 +35,23 @@ class Gain(Block):
             self.inputs, self.outputs = {"u": arr.shape[1]}, {"y": arr.shape[0]}
         self.feedthrough = True
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        if self._matrix:
-            return {"y": self.k.dot(inputs["u"])}
-        return {"y": inputs["u"] * self.k}
+    def context_numbers(self):
+        """[mode, rows, cols, k]: mode 1 a matrix (rows x cols, library.c's ``matvec``, which
+        sums each row in column order), 0 elementwise (k's size, the input width)."""
+        if self.k.ndim == 2:
+            return ((1.0, *self.k.shape), self.k)
+        return ((0.0, self.k.size, self.inputs["u"]), self.k)
 
-    def kernel(self):
-        """C output: elementwise (the same bits), or the matrix product (library.c's
-        ``matvec``: ``ndarray.dot`` to round-off where a row has several terms)."""
-        width = self.inputs["u"]
-        return _kernels.cached(self, (width, self.k.shape, self.k.tobytes()), lambda: self._build_kernel(width))
-
-    def _build_kernel(self, width):
-        if width is None:
-            return None
-        if self._matrix:
-            rows, cols = self.k.shape
-            header = (1.0, rows, cols)
-        else:
-            header = (0.0, self.k.size, width)
-        return _kernels.make_kernel(np.concatenate((header, self.k.ravel())), "gain_output",
-                                    tunables=_kernels.tunables("k", 3, self.k.shape, "gain"))
+    def tunables(self):
+        return _kernels.tunables("k", HEADER + 3, self.k.shape, "gain")
 
 
-def _sum_p(i: Mapping[str, Signal]) -> Signal:
-    return i["u0"].copy()
-
-
-def _sum_m(i: Mapping[str, Signal]) -> Signal:
-    return -i["u0"]
-
-
-def _sum_pp(i: Mapping[str, Signal]) -> Signal:
-    return i["u0"] + i["u1"]
-
-
-def _sum_pm(i: Mapping[str, Signal]) -> Signal:
-    return i["u0"] - i["u1"]
-
-
-def _sum_mp(i: Mapping[str, Signal]) -> Signal:
-    return i["u1"] - i["u0"]
-
-
-def _sum_mm(i: Mapping[str, Signal]) -> Signal:
-    r = i["u0"] + i["u1"]
-    return np.negative(r, out=r)
-
-
-def _sum_ppp(i: Mapping[str, Signal]) -> Signal:
-    r = i["u0"] + i["u1"]
-    r += i["u2"]
-    return r
-
-
-def _sum_ppm(i: Mapping[str, Signal]) -> Signal:
-    r = i["u0"] + i["u1"]
-    r -= i["u2"]
-    return r
-
-
-def _sum_pmm(i: Mapping[str, Signal]) -> Signal:
-    r = i["u0"] - i["u1"]
-    r -= i["u2"]
-    return r
-
-
-def _sum_general(plus: tuple[str, ...], minus: tuple[str, ...], i: Mapping[str, Signal]) -> Signal:
-    """Any sign pattern: start from the first '+' input (or minus the first '-')."""
-    if plus:
-        r = i[plus[0]].copy()
-        rest = minus
-    else:
-        r = -i[minus[0]]
-        rest = minus[1:]
-    for p in plus[1:]:
-        r += i[p]
-    for p in rest:
-        r -= i[p]
-    return r
-
-
-_SUM_KERNELS: dict[str, Callable[[Mapping[str, Signal]], Signal]] = {
-    "+": _sum_p,
-    "-": _sum_m,
-    "++": _sum_pp,
-    "+-": _sum_pm,
-    "-+": _sum_mp,
-    "--": _sum_mm,
-    "+++": _sum_ppp,
-    "++-": _sum_ppm,
-    "+--": _sum_pmm,
-}
-
-
-class Sum(Block):
+class Sum(KernelBlock):
     """Signed sum of the inputs ``u0, u1, ...``, one sign character per input.
+
+    The first '+' input, the other '+' ones added in port order, then the '-' ones
+    subtracted (with no '+' input: minus the first, then the others subtracted); '--' is
+    -(u0 + u1).
 
     Parameters
     ----------
@@ -142,35 +59,23 @@ class Sum(Block):
         one '+' or '-' per input, in port order u0, u1, ... (e.g. '+-' gives u0 - u1)
     """
 
+    kernel_name = "sum"
+
     def __init__(self, signs: str = "++"):
         if not isinstance(signs, str) or not signs or set(signs) - {"+", "-"}:
             raise ValueError(f"parameter 'signs' must be a non-empty string of '+' and '-', got {signs!r}")
         self.signs = signs
-        ports = tuple(f"u{j}" for j in range(len(signs)))
-        self.inputs = {p: None for p in ports}
+        self.inputs = {f"u{j}": None for j in range(len(signs))}
         self.outputs = {"y": None}
         self.feedthrough = True
-        kernel = _SUM_KERNELS.get(signs)
-        if kernel is None:
-            plus = tuple(p for p, s in zip(ports, signs) if s == "+")
-            minus = tuple(p for p, s in zip(ports, signs) if s == "-")
-            kernel = partial(_sum_general, plus, minus)
-        self._kernel = kernel
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        return {"y": self._kernel(inputs)}
-
-    def kernel(self):
-        width = self.outputs["y"]
-        if width is None:
-            return None
+    def context_numbers(self):
         signs = [1.0 if s == "+" else -1.0 for s in self.signs]
-        return _kernels.cached(self, (width, self.signs), lambda: _kernels.make_kernel(
-            np.concatenate(((width, len(signs), float(self.signs == "--")), signs)), "sum_output"))
+        return ((len(signs), float(self.signs == "--")), signs)
 
 
-class Saturation(Block):
-    """Clips the input to ``[lower, upper]`` elementwise.
+class Saturation(KernelBlock):
+    """Clips the input to ``[lower, upper]`` elementwise (NaN passes through).
 
     Parameters
     ----------
@@ -179,6 +84,8 @@ class Saturation(Block):
     upper : scalar or vector
         upper limit, a scalar applying to any width; inf for no upper limit
     """
+
+    kernel_name = "saturation"
 
     def __init__(self, lower: Any = -1.0, upper: Any = 1.0):
         lo = float_array(lower, "lower", allow_inf=True, allow_empty=False)
@@ -201,17 +108,6 @@ class Saturation(Block):
         self.inputs, self.outputs = {"u": width}, {"y": width}
         self.feedthrough = True
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        return {"y": np.minimum(np.maximum(inputs["u"], self.lower), self.upper)}
-
-    def kernel(self):
+    def context_numbers(self):
         width = self.outputs["y"]
-        if width is None:
-            return None
-
-        def build():
-            lo = np.broadcast_to(self.lower, (width,))
-            hi = np.broadcast_to(self.upper, (width,))
-            return _kernels.make_kernel(np.concatenate(((width,), lo, hi)), "saturation_output")
-
-        return _kernels.cached(self, (width, np.asarray(self.lower).tobytes(), np.asarray(self.upper).tobytes()), build)
+        return (np.broadcast_to(self.lower, (width,)), np.broadcast_to(self.upper, (width,)))

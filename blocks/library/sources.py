@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
 from blocks.arrays import float_array
-from blocks.block import Block, Signal
+from blocks.block import Signal
 from blocks.library import _kernels
+from blocks.library.kernel_block import HEADER, KernelBlock
 
 
 def broadcast_vectors(**params: Any) -> dict[str, Signal]:
@@ -25,7 +26,12 @@ def broadcast_vectors(**params: Any) -> dict[str, Signal]:
     return {name: np.repeat(v, width) if v.size != width else v for name, v in vectors.items()}
 
 
-class Constant(Block):
+def _shape(vector: np.ndarray) -> tuple[int, ...]:
+    """A parameter's shape as its tunables name it: () for one number."""
+    return () if vector.size == 1 else vector.shape
+
+
+class Constant(KernelBlock):
     """Outputs a fixed value at every hit.
 
     Parameters
@@ -34,25 +40,22 @@ class Constant(Block):
         the output value
     """
 
+    kernel_name = "constant"
+
     def __init__(self, value: Any):
         self.value = float_array(value, "value", ndim=1, allow_empty=False)
         self.inputs = {}
         self.outputs = {"y": self.value.size}
         self.feedthrough = False
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        return {"y": self.value.copy()}
+    def context_numbers(self):
+        return (self.value,)
 
-    def kernel(self):
-        return _kernels.cached(self, (self.value.tobytes(),), lambda: _kernels.make_kernel(
-            np.concatenate(((self.value.size,), self.value)), "constant_output",
-            tunables=_kernels.tunables("value", 1, self._shape(), "the output value")))
-
-    def _shape(self) -> tuple[int, ...]:
-        return () if self.value.size == 1 else self.value.shape
+    def tunables(self):
+        return _kernels.tunables("value", HEADER, _shape(self.value), "the output value")
 
 
-class Step(Block):
+class Step(KernelBlock):
     """Outputs ``before`` until ``time``, then ``after`` from ``time`` on (t >= time).
 
     Parameters
@@ -65,6 +68,7 @@ class Step(Block):
         output from the switching time on
     """
     time_varying = True
+    kernel_name = "step"
 
     def __init__(self, time: float, before: Any = 0.0, after: Any = 1.0):
         self.time = float(float_array(time, "time", ndim=0))
@@ -74,21 +78,17 @@ class Step(Block):
         self.outputs = {"y": self.before.size}
         self.feedthrough = False
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        return {"y": (self.before if t < self.time else self.after).copy()}
+    def context_numbers(self):
+        return (self.time, self.before, self.after)
 
-    def kernel(self):
-        w = self.before.size
-        key = (self.time, self.before.tobytes(), self.after.tobytes())
-        shape = () if w == 1 else (w,)
-        return _kernels.cached(self, key, lambda: _kernels.make_kernel(
-            np.concatenate(((w, self.time), self.before, self.after)), "step_output",
-            tunables=(*_kernels.tunables("time", 1, (), "switching time, s"),
-                      *_kernels.tunables("before", 2, shape, "output before the switching time"),
-                      *_kernels.tunables("after", 2 + w, shape, "output from the switching time on"))))
+    def tunables(self):
+        shape, first = _shape(self.before), HEADER + 1
+        return (*_kernels.tunables("time", HEADER, (), "switching time, s"),
+                *_kernels.tunables("before", first, shape, "output before the switching time"),
+                *_kernels.tunables("after", first + self.before.size, shape, "output from the switching time on"))
 
 
-class Ramp(Block):
+class Ramp(KernelBlock):
     """Outputs ``initial + slope * max(0, t - start)``: flat until ``start``, then linear.
 
     Parameters
@@ -101,6 +101,7 @@ class Ramp(Block):
         output value up to the start time
     """
     time_varying = True
+    kernel_name = "ramp"
 
     def __init__(self, slope: Any = 1.0, start: float = 0.0, initial: Any = 0.0):
         self.start = float(float_array(start, "start", ndim=0))
@@ -110,14 +111,5 @@ class Ramp(Block):
         self.outputs = {"y": self.slope.size}
         self.feedthrough = False
 
-    def output(self, t: float, state: Any, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
-        elapsed = t - self.start
-        if elapsed <= 0.0:
-            return {"y": self.initial.copy()}
-        return {"y": self.initial + self.slope * elapsed}
-
-    def kernel(self):
-        w = self.slope.size
-        key = (self.start, self.slope.tobytes(), self.initial.tobytes())
-        return _kernels.cached(self, key, lambda: _kernels.make_kernel(
-            np.concatenate(((w, self.start), self.slope, self.initial)), "ramp_output"))
+    def context_numbers(self):
+        return (self.start, self.slope, self.initial)

@@ -2,11 +2,10 @@
 
 The diagrams of the loader's fuzz test (``wired_document``: random topology, rates,
 offsets, delays with initial values, decimated logs, loops) that load and plan are run
-three ways: with the library's kernels in the C core, the same in the reference loop
-(the same samples to the last bit: one table, the same kernels), and with every block
-through its Python methods. The last gives the same status, the same sample times and
-the same values to round-off (a matrix Gain or state-space block's products are summed
-in another order in C).
+three ways: with the library's kernels in the C core, the same in the reference loop,
+and with every block through its Python methods, as callback ops of the table (which
+call the same kernels). All three give the same status and the same samples to the last
+bit: one table, the same kernels, only the executors' own work differs.
 """
 
 from __future__ import annotations
@@ -45,10 +44,7 @@ def test_random_diagrams_give_the_same_results_compiled_and_in_python(doc, ticks
         assert np.array_equal(compiled[name][0], reference[name][0]), name
         assert np.array_equal(compiled[name][1], reference[name][1]), name
     python = run(diagram, t_end, False, monkeypatch)
-    assert compiled.status == python.status
-    assert set(compiled) == set(python)
+    assert compiled.status == python.status and list(compiled) == list(python)
     for name in compiled:
-        (tc, vc), (tp, vp) = compiled[name], python[name]
-        assert np.array_equal(tc, tp), name
-        scale = max(1.0, float(np.max(np.abs(vp), initial=0.0)))
-        np.testing.assert_allclose(vc, vp, rtol=1e-12, atol=1e-12 * scale, err_msg=name)
+        assert np.array_equal(compiled[name][0], python[name][0]), name
+        assert np.array_equal(compiled[name][1], python[name][1]), name

@@ -169,19 +169,34 @@ def test_the_shipped_diagrams_give_the_same_samples_both_ways(name):
     assert_same(simulate(diagram, engine="native"), simulate(diagram, engine="reference"))
 
 
-def test_without_the_compiled_extension_every_block_runs_in_python_in_the_reference_loop(monkeypatch):
+UNCOMPILED = """
+time: {t_end: 20 ms}
+blocks:
+  wave: {type: TestWave, period: 1 ms}
+  leak: {type: TestLeak, period: 2 ms, params: {a: 0.9, b: 0.5}}
+connections: [wave.y -> leak.u]
+log: [leak.y, leak.sum]
+"""
+
+
+def test_without_the_compiled_extension_python_blocks_run_in_the_reference_loop(monkeypatch):
     """An uncompiled checkout: no kernel can be called and the C core is not there, so the
-    reference loop runs the toy diagram with the library's Python methods (the same samples
-    to round-off); asking for the C core says what is missing."""
-    diagram = load_diagram(ROOT / "diagrams" / "toy.yaml")
+    reference loop runs every block through its Python methods (the test blocks' give their
+    kernels' samples); a library block, defined by its C kernel alone, says at its first hit
+    that it needs the extension; asking for the C core says what is missing."""
+    diagram = loads_diagram(UNCOMPILED, filename="uncompiled.yaml")
+    toy = load_diagram(ROOT / "diagrams" / "toy.yaml")
     compiled = simulate(diagram)
     with monkeypatch.context() as m:
         m.setattr(blocks.engine.compiled, "native", lambda: None)
         python = simulate(diagram)
+        library = simulate(toy)
         with pytest.raises(ValueError, match="engine 'native' needs the compiled extension blocks._native"):
             simulate(diagram, engine="native")
     assert python.complete and python.info["t_stop"] is None
-    np.testing.assert_allclose(python["plant.y"][1], compiled["plant.y"][1], rtol=1e-12, atol=1e-15)
+    assert_same(python, compiled)
+    assert library.status.startswith("failed at t=0 s")
+    assert "runs its compiled kernel, and the extension blocks._native is missing" in library.status
 
 
 def test_a_run_whose_tick_times_are_not_exact_in_double_runs_in_the_reference_loop():

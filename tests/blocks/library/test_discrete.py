@@ -43,14 +43,16 @@ class TestUnitDelay:
         np.testing.assert_array_equal(block.initial_state(), [0.5] * 4)
 
     def test_output_and_state_are_not_aliases(self):
+        """The output is a copy of the state, the state (updated in place, as every
+        library block's) a copy of the input."""
         block = UnitDelay(initial=[1.0, 2.0])
         state = block.initial_state()
         y = block.output(0.0, state, {"u": np.zeros(2)})["y"]
         assert not np.shares_memory(y, state)
         u = np.array([3.0, 4.0])
         new_state = block.update(0.0, state, {"u": u})
-        assert not np.shares_memory(new_state, u)
-        np.testing.assert_array_equal(state, [1.0, 2.0])
+        assert not np.shares_memory(new_state, u) and not np.shares_memory(new_state, y)
+        np.testing.assert_array_equal(new_state, [3.0, 4.0])
         np.testing.assert_array_equal(y, [1.0, 2.0])
 
     def test_advance_by_zero_keeps_state(self):
@@ -85,6 +87,7 @@ class TestZeroOrderHold:
         assert block.inputs == {"u": None} and block.outputs == {"y": None}
         assert block.has_feedthrough()
         assert block.initial_state() is None
+        block.set_width(2)
         u = np.array([1.5, -2.0])
         y = block.output(0.0, None, {"u": u})["y"]
         np.testing.assert_array_equal(y, u)

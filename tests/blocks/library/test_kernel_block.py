@@ -1,6 +1,7 @@
-"""KernelBlock: the signal blocks' Python methods are their C kernels, so without the
-compiled extension such a block loads and validates but says, at its first hit, why it
-cannot run; and its kernel follows a parameter changed between runs."""
+"""KernelBlock: every library block is defined once, by its C kernel, which its Python
+methods call; so without the compiled extension such a block loads and validates but says,
+at its first hit, why it cannot run; and its kernel follows a parameter changed between
+runs."""
 
 from __future__ import annotations
 
@@ -8,8 +9,12 @@ from fractions import Fraction
 
 import numpy as np
 
+import pytest
+
 import blocks
-from blocks.library import Bias, _kernels
+from blocks.block import Block
+from blocks.library import LIBRARY, Bias, _kernels
+from blocks.library.kernel_block import KernelBlock
 
 DIAGRAM = """
 blocks:
@@ -18,6 +23,17 @@ blocks:
 connections: [s.y -> b.u]
 log: [b.y]
 """
+
+
+@pytest.mark.parametrize("cls", LIBRARY, ids=lambda cls: cls.__name__)
+def test_every_library_block_is_defined_once_by_its_kernel(cls):
+    """No block of the library has a step of its own beside its kernel's: its output,
+    update and advance are KernelBlock's, which call the C functions (or Block's advance,
+    which steps them)."""
+    assert issubclass(cls, KernelBlock)
+    for method in ("output", "update", "advance"):
+        owner = next(c for c in cls.__mro__ if method in vars(c))
+        assert owner.__module__ in (KernelBlock.__module__, Block.__module__), (method, owner)
 
 
 def test_without_the_extension_a_signal_block_loads_and_says_why_it_cannot_run(monkeypatch):

@@ -1,12 +1,13 @@
-"""The library blocks' compiled kernels compute what their Python methods compute.
+"""The library's C kernels compute what independent numpy statements of their blocks do.
 
-Each kernel is called alone through ``blocks._native.call`` and compared with ``output`` /
-``update`` / ``advance`` of the same block, over several parameter sets (scalars, width-3
-vectors, random models up to 4 states and one of 130). Elementwise arithmetic and the
-single-term products of 1x1 models match bit for bit (``np.array_equal``, and the same bits
-for NaN and signed zeros); matrix products of several terms match numpy's to round-off
-(library.c sums each row in order, BLAS in its own): ``assert_allclose`` with rtol 1e-12
-and atol 1e-14 times the size of the terms.
+The blocks are defined once, by their kernels; ``oracles`` holds numpy code of the
+simplest of them (their former Python methods). Each block's methods (which call its
+kernel through ``blocks._native.call``) are compared with its oracle over several parameter
+sets (scalars, width-3 vectors, random models up to 6 states and one of 130). Elementwise
+arithmetic and the single-term products of 1x1 models match bit for bit
+(``np.array_equal``, and the same bits for NaN and signed zeros); matrix products of
+several terms match numpy's to round-off (library.c sums each row in order, BLAS in its
+own): ``assert_allclose`` with rtol 1e-12 and atol 1e-14 times the size of the terms.
 """
 
 import weakref
@@ -30,7 +31,9 @@ from blocks.library import (
 )
 from blocks.library.lti import CHUNK
 
-_native = pytest.importorskip("blocks._native")
+from . import oracles
+
+pytest.importorskip("blocks._native")
 
 TIMES = (-1.0, 0.0, 0.25, 0.5, 0.5000000000000001, 1.0, 3.7, 1e6)
 
@@ -56,44 +59,19 @@ def same(a, b) -> bool:
         np.ascontiguousarray(a).view(np.int64), np.ascontiguousarray(b).view(np.int64))
 
 
-def port_list(block, inputs):
-    return [np.ascontiguousarray(inputs[p], dtype=float) for p in block.inputs]
-
-
-def out_width(block):
-    return sum(block.outputs.values())
-
-
-def c_output(block, t, state, inputs):
-    kernel = kernel_of(block)
-    out = np.full(out_width(block), np.nan)
-    code, _ = _native.call("output", kernel.output, kernel.context, t, state, port_list(block, inputs),
-                           out)
-    assert code == 0
-    return out
-
-
-def c_update(block, t, state, inputs):
-    kernel = kernel_of(block)
-    state = state.copy()
-    code, _ = _native.call("update", kernel.update, kernel.context, t, state, port_list(block, inputs), None)
-    assert code == 0
-    return state
-
-
-def c_advance(block, t, state, inputs, n):
-    kernel = kernel_of(block)
-    state = None if state is None else state.copy()
-    rows = np.full((max(n, 0), out_width(block)), np.nan)
-    ports = port_list(block, inputs)
-    code, done, _ = _native.call("advance", kernel.advance, kernel.context, t, state, ports, rows, n)
-    assert code == 0 and done == max(n, 0)
-    return state, rows
-
-
-def py_output(block, t, state, inputs):
+def output(block, t, state, inputs):
+    """The block's output (its kernel's), all ports side by side."""
     out = block.output(t, None if state is None else state.copy(), inputs)
     return np.concatenate([np.atleast_1d(out[p]) for p in block.outputs])
+
+
+def update(block, t, state, inputs):
+    return block.update(t, state.copy(), inputs)
+
+
+def advance(block, t, state, inputs, n):
+    state, rows = block.advance(t, None if state is None else state.copy(), inputs, n)
+    return state, rows["y"]
 
 
 def magnitude(M, v):
@@ -106,10 +84,9 @@ def assert_close(got, expected, scale):
     np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-14 * scale)
 
 
-def assert_outputs_equal(block, state, inputs, times=(0.0,)):
+def assert_outputs_equal(block, oracle, inputs, times=(0.0,)):
     for t in times:
-        expected = py_output(block, t, state, inputs)
-        got = c_output(block, t, state, inputs)
+        got, expected = output(block, t, None, inputs), oracle(t)
         assert same(got, expected), (t, got, expected)
 
 
@@ -119,7 +96,7 @@ def assert_outputs_equal(block, state, inputs, times=(0.0,)):
 @pytest.mark.parametrize("value", [2.5, [1.0, -2.0, 3.5], [0.1]])
 def test_constant(value):
     block = prepared(Constant(value))
-    assert_outputs_equal(block, None, {}, TIMES)
+    assert_outputs_equal(block, lambda t: oracles.constant(block, t), {}, TIMES)
 
 
 @pytest.mark.parametrize("params", [
@@ -129,7 +106,7 @@ def test_constant(value):
 ])
 def test_step(params):
     block = prepared(Step(**params))
-    assert_outputs_equal(block, None, {}, TIMES)
+    assert_outputs_equal(block, lambda t: oracles.step(block, t), {}, TIMES)
 
 
 @pytest.mark.parametrize("params", [
@@ -140,7 +117,20 @@ def test_step(params):
 ])
 def test_ramp(params):
     block = prepared(Ramp(**params))
-    assert_outputs_equal(block, None, {}, TIMES)
+    assert_outputs_equal(block, lambda t: oracles.ramp(block, t), {}, TIMES)
+
+
+@pytest.mark.parametrize("block, parameters", [
+    (Constant([1.5, -2.0]), {"value[1]": 1.5, "value[2]": -2.0}),
+    (Step(0.25, before=[1.0, 2.0], after=[3.0, 4.0]),
+     {"time": 0.25, "before[1]": 1.0, "before[2]": 2.0, "after[1]": 3.0, "after[2]": 4.0}),
+    (Gain([[1.0, 2.0], [3.0, 4.0]]), {"k[1,1]": 1.0, "k[1,2]": 2.0, "k[2,1]": 3.0, "k[2,2]": 4.0}),
+])
+def test_tunables_name_the_slots_of_their_parameters(block, parameters):
+    """An exported FMU's parameters are slots of the kernels' records: each names the
+    number its parameter holds."""
+    record = kernel_of(prepared(block)).record
+    assert {tunable.name: record.values[tunable.slot] for tunable in record.tunables} == parameters
 
 
 # -- arithmetic ----------------------------------------------------------------------
@@ -155,7 +145,7 @@ def test_gain_elementwise(k, width, seed):
     block = prepared(Gain(k), width)
     for _ in range(20):
         u = rng.normal(size=block.inputs["u"]) * 10.0 ** rng.integers(-3, 4)
-        assert_outputs_equal(block, None, {"u": u})
+        assert_outputs_equal(block, lambda t: oracles.gain(block, u), {"u": u})
 
 
 @pytest.mark.parametrize("seed", RNG_SEEDS)
@@ -166,14 +156,14 @@ def test_gain_matrix(shape, seed):
     block = prepared(Gain(k))
     for _ in range(20):
         u = rng.normal(size=shape[1]) * 10.0 ** rng.integers(-3, 4)
-        assert_close(c_output(block, 0.0, None, {"u": u}), py_output(block, 0.0, None, {"u": u}),
-                     magnitude(k, u))
+        assert_close(output(block, 0.0, None, {"u": u}), oracles.gain(block, u), magnitude(k, u))
 
 
 def test_gain_matrix_of_one_column_is_exact():
     block = prepared(Gain([[2.0]]))
     for u in (1.0 / 3.0, -0.0, 7e-300):
-        assert_outputs_equal(block, None, {"u": np.array([u])})
+        u = np.array([u])
+        assert_outputs_equal(block, lambda t: oracles.gain(block, u), {"u": u})
 
 
 @pytest.mark.parametrize("signs", ["+", "-", "++", "+-", "-+", "--", "+++", "++-", "+--", "-+-", "---",
@@ -184,7 +174,9 @@ def test_sum(signs, width):
     block = prepared(Sum(signs), width)
     for _ in range(20):
         inputs = {f"u{j}": rng.normal(size=width) * 10.0 ** rng.integers(-8, 8) for j in range(len(signs))}
-        assert_outputs_equal(block, None, inputs)
+        assert_outputs_equal(block, lambda t: oracles.signed_sum(block, inputs), inputs)
+    zeros = {f"u{j}": np.array([0.0, -0.0, 0.0][:width]) * (-1) ** j for j in range(len(signs))}
+    assert_outputs_equal(block, lambda t: oracles.signed_sum(block, zeros), zeros)  # the signs of zero
 
 
 @pytest.mark.parametrize("lower, upper, width", [
@@ -196,10 +188,8 @@ def test_sum(signs, width):
 def test_saturation(lower, upper, width):
     rng = np.random.default_rng(width)
     block = prepared(Saturation(lower, upper), width)
-    for _ in range(20):
-        assert_outputs_equal(block, None, {"u": rng.normal(size=width) * 3.0})
-    assert_outputs_equal(block, None, {"u": np.full(width, np.nan)})
-    assert_outputs_equal(block, None, {"u": np.full(width, np.inf)})
+    for u in [rng.normal(size=width) * 3.0 for _ in range(20)] + [np.full(width, np.nan), np.full(width, np.inf)]:
+        assert_outputs_equal(block, lambda t: oracles.saturation(block, u), {"u": u})
 
 
 # -- discrete ------------------------------------------------------------------------
@@ -212,17 +202,15 @@ def test_unit_delay(initial, width):
     state = block.initial_state()
     for _ in range(5):
         u = rng.normal(size=width)
-        assert_outputs_equal(block, state, {"u": u})
-        expected = block.update(0.0, state.copy(), {"u": u})
-        assert same(c_update(block, 0.0, state, {"u": u}), expected)
+        assert same(output(block, 0.0, state, {"u": u}), state)
+        expected = oracles.unit_delay_update(block, state, u)
+        assert same(update(block, 0.0, state, {"u": u}), expected)
         state = expected
     for n in (0, 1, 7, 100):
         u = rng.normal(size=width)
-        x, rows = block.advance(0.0, state.copy(), {"u": u}, n)
-        cx, crows = c_advance(block, 0.0, state, {"u": u}, n)
-        if n:
-            assert same(cx, x)
-        assert same(crows, rows["y"])
+        x, rows = oracles.unit_delay_advance(block, state.copy(), u, n)
+        cx, crows = advance(block, 0.0, state, {"u": u}, n)
+        assert same(cx, x) and same(crows, rows)
 
 
 @pytest.mark.parametrize("width", [1, 3])
@@ -230,12 +218,11 @@ def test_zero_order_hold(width):
     rng = np.random.default_rng(width)
     block = prepared(ZeroOrderHold(), width)
     for _ in range(5):
-        assert_outputs_equal(block, None, {"u": rng.normal(size=width)})
+        u = rng.normal(size=width)
+        assert same(output(block, 0.0, None, {"u": u}), u)
 
 
 # -- linear time-invariant -----------------------------------------------------------
-
-
 def random_model(rng, n, m, p, with_d):
     A = rng.normal(size=(n, n))
     A *= 0.95 / max(abs(np.linalg.eigvals(A)))
@@ -273,12 +260,12 @@ LTI_BLOCKS = lti_blocks()
 
 def exact(block) -> bool:
     """Whether the block's products all have a single term: a 1x1x1 model (whose
-    two-term sums the Python side writes out as the kernel does) or a 1x1 pure gain."""
-    return block._scalar or (block._n, block._m, block._p) == (0, 1, 1)
+    two-term sums the oracle writes out as the kernel does) or a 1x1 pure gain."""
+    return (block.A.shape[0], block.B.shape[1], block.C.shape[0]) in ((1, 1, 1), (0, 1, 1))
 
 
 _CHUNK_MAPS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-"""Each block's ``_all_chunks()``, made once: a large model's take a fifth of a second."""
+"""Each block's maps of CHUNK hits, made once: a large model's take a fifth of a second."""
 
 
 def lti_scale(block, state, u):
@@ -287,9 +274,10 @@ def lti_scale(block, state, u):
         return magnitude(block.D, u)
     z = np.concatenate((state, u))
     if block not in _CHUNK_MAPS:
-        _CHUNK_MAPS[block] = block._all_chunks()
-    ymap, xmaps = _CHUNK_MAPS[block]
-    return max(magnitude(block._CD, z), magnitude(block._AB, z), magnitude(ymap, z), magnitude(xmaps[-1], z))
+        _CHUNK_MAPS[block] = oracles.lti_chunk(block, CHUNK)
+    ymap, xmap = _CHUNK_MAPS[block]
+    return max(magnitude(np.hstack((block.C, block.D)), z), magnitude(np.hstack((block.A, block.B)), z),
+               magnitude(ymap, z), magnitude(xmap, z))
 
 
 def assert_lti_equal(block, got, expected, state, u):
@@ -310,27 +298,27 @@ def test_lti_output_and_update(index):
     state = block.initial_state()
     for _ in range(30):
         u = rng.normal(size=block.inputs["u"])
-        s = None if state is None else state.copy()
-        assert_lti_equal(block, c_output(block, 0.0, state, {"u": u}), py_output(block, 0.0, state, {"u": u}),
-                         s, u)
+        assert_lti_equal(block, output(block, 0.0, state, {"u": u}), oracles.lti_output(block, state, u),
+                         state, u)
         if state is not None:
-            expected = block.update(0.0, state.copy(), {"u": u})
-            assert_lti_equal(block, c_update(block, 0.0, state, {"u": u}), expected, state, u)
+            expected = oracles.lti_update(block, state, u)
+            assert_lti_equal(block, update(block, 0.0, state, {"u": u}), expected, state, u)
             state = expected
 
 
 def check_advance(block, state, u, n):
-    """Python and C advance by n from state, then by 7 more from where each left off."""
-    x, rows = block.advance(0.0, None if state is None else state.copy(), {"u": u}, n)
-    cx, crows = c_advance(block, 0.0, state, {"u": u}, n)
-    assert_lti_equal(block, crows, rows["y"], state, u)
+    """The oracle and the kernel advance by n from state, then by 7 more from where each
+    left off."""
+    x, rows = oracles.lti_advance(block, None if state is None else state.copy(), u, n)
+    cx, crows = advance(block, 0.0, state, {"u": u}, n)
+    assert_lti_equal(block, crows, rows, state, u)
     if state is not None:
         assert_lti_equal(block, cx, x, state, u)
     # and again from where that left off: the kernel keeps no memory between calls
     if state is not None and n:
-        x2, rows2 = block.advance(0.0, x.copy(), {"u": u}, 7)
-        cx2, crows2 = c_advance(block, 0.0, cx, {"u": u}, 7)
-        assert_lti_equal(block, crows2, rows2["y"], x, u)
+        x2, rows2 = oracles.lti_advance(block, x.copy(), u, 7)
+        cx2, crows2 = advance(block, 0.0, cx, {"u": u}, 7)
+        assert_lti_equal(block, crows2, rows2, x, u)
         assert_lti_equal(block, cx2, x2, x, u)
 
 
@@ -356,12 +344,13 @@ def test_lti_advance_of_the_toy_plant_is_exact_from_many_states():
 
 @pytest.mark.parametrize("index", range(len(LTI_BLOCKS)))
 def test_lti_all_chunks_are_the_chunk_maps(index):
+    """The maps the kernel's context holds are the oracle's, to the bit."""
     block = prepared(LTI_BLOCKS[index])
     if block.initial_state() is None:
         return
     ymap, xmaps = block._all_chunks()
     for c in range(1, CHUNK + 1):
-        y, x = block._chunk(c)
+        y, x = oracles.lti_chunk(block, c)
         assert same(ymap[:c * block.outputs["y"]], y) and same(xmaps[c - 1], x)
 
 
@@ -371,10 +360,8 @@ def test_lti_kernel_for_a_large_model():
     A, B, C, D = random_model(rng, 130, 2, 3, True)
     block = prepared(DiscreteStateSpace(A, B, C, D, x0=rng.normal(size=130)))
     state, u = block.initial_state(), rng.normal(size=2)
-    assert_lti_equal(block, c_output(block, 0.0, state, {"u": u}), py_output(block, 0.0, state, {"u": u}),
-                     state, u)
-    assert_lti_equal(block, c_update(block, 0.0, state, {"u": u}), block.update(0.0, state.copy(), {"u": u}),
-                     state, u)
+    assert_lti_equal(block, output(block, 0.0, state, {"u": u}), oracles.lti_output(block, state, u), state, u)
+    assert_lti_equal(block, update(block, 0.0, state, {"u": u}), oracles.lti_update(block, state, u), state, u)
     check_advance(block, state, u, CHUNK + 3)
 
 
@@ -384,9 +371,9 @@ def test_lti_continuous_model_has_kernel_only_once_bound():
     prepared(block, period=Fraction(1, 100))
     state = block.initial_state()
     u = np.array([0.3])
-    x, rows = block.advance(0.0, state.copy(), {"u": u}, 9)
-    cx, crows = c_advance(block, 0.0, state, {"u": u}, 9)
-    assert same(crows, rows["y"]) and same(cx, x)
+    x, rows = oracles.lti_advance(block, state.copy(), u, 9)
+    cx, crows = advance(block, 0.0, state, {"u": u}, 9)
+    assert same(crows, rows) and same(cx, x)
 
 
 def test_polymorphic_blocks_need_a_width():
@@ -402,7 +389,7 @@ def test_kernel_is_built_once():
 
 def test_a_parameter_changed_between_runs_reaches_the_kernel():
     """Kernels are cached on their block by the values they copy: a gain changed on the
-    block between runs is used by the next run, as its Python output would use it."""
+    block between runs is used by the next run."""
     import blocks
 
     text = """

@@ -1,4 +1,7 @@
-"""Behaviour of Gain, Sum and Saturation: values, widths, signs, limits, parameter checks."""
+"""Behaviour of Gain, Sum and Saturation: values, widths, signs, limits, parameter checks.
+
+Their methods run their C kernels, which need the port widths: a block whose width is open
+gets it from its input first (``sized``), as a diagram's wiring gives it."""
 
 import numpy as np
 import pytest
@@ -6,6 +9,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from blocks.library import Gain, Saturation, Sum
+
+
+def sized(block, width):
+    """The block with its open width resolved."""
+    if None in block.outputs.values():
+        block.set_width(width)
+    return block
 
 
 class TestGain:
@@ -38,7 +48,7 @@ class TestGain:
 
     def test_output_does_not_alias_input(self):
         u = np.array([1.0, 2.0])
-        y = Gain(1.0).output(0.0, None, {"u": u})["y"]
+        y = sized(Gain(1.0), 2).output(0.0, None, {"u": u})["y"]
         assert not np.shares_memory(y, u)
 
     @pytest.mark.parametrize("bad", [np.nan, [1.0, np.inf], np.ones((2, 2, 2)), [], "x"])
@@ -63,12 +73,12 @@ class TestSum:
         assert block.inputs == {"u0": 2, "u1": 2, "u2": 2} and block.outputs == {"y": 2}
 
     def test_default_adds_two_inputs(self):
-        block = Sum()
+        block = sized(Sum(), 1)
         y = block.output(0.0, None, {"u0": np.array([1.0]), "u1": np.array([2.5])})["y"]
         np.testing.assert_array_equal(y, [3.5])
 
     def test_difference(self):
-        block = Sum("+-")
+        block = sized(Sum("+-"), 2)
         y = block.output(0.0, None, {"u0": np.array([5.0, 1.0]), "u1": np.array([2.0, 3.0])})["y"]
         np.testing.assert_array_equal(y, [3.0, -2.0])
 
@@ -79,7 +89,7 @@ class TestSum:
         rng = np.random.default_rng(len(signs))
         inputs = {f"u{j}": rng.normal(size=3) for j in range(len(signs))}
         kept = {p: v.copy() for p, v in inputs.items()}
-        y = Sum(signs).output(0.0, None, inputs)["y"]
+        y = sized(Sum(signs), 3).output(0.0, None, inputs)["y"]
         np.testing.assert_allclose(y, reference_sum(signs, inputs), rtol=1e-14, atol=1e-14)
         for p, v in inputs.items():
             np.testing.assert_array_equal(v, kept[p])
@@ -90,7 +100,7 @@ class TestSum:
     @settings(max_examples=60, deadline=None)
     def test_signed_sum_property(self, signs, values):
         inputs = {f"u{j}": np.array([values[j]]) for j in range(len(signs))}
-        y = Sum(signs).output(0.0, None, inputs)["y"]
+        y = sized(Sum(signs), 1).output(0.0, None, inputs)["y"]
         np.testing.assert_allclose(y, reference_sum(signs, inputs), rtol=1e-12, atol=1e-6)
 
     @pytest.mark.parametrize("bad", ["", "+*", "+ -", 2, None, ["+", "-"]])
@@ -103,11 +113,11 @@ class TestSaturation:
     def test_clips_to_default_unit_band(self):
         block = Saturation()
         assert block.inputs == {"u": None} and block.outputs == {"y": None}
-        y = block.output(0.0, None, {"u": np.array([-3.0, -0.5, 0.0, 0.99, 2.0])})["y"]
+        y = sized(block, 5).output(0.0, None, {"u": np.array([-3.0, -0.5, 0.0, 0.99, 2.0])})["y"]
         np.testing.assert_array_equal(y, [-1.0, -0.5, 0.0, 0.99, 1.0])
 
     def test_limits_are_reached_exactly(self):
-        block = Saturation(lower=-2.0, upper=0.5)
+        block = sized(Saturation(lower=-2.0, upper=0.5), 4)
         y = block.output(0.0, None, {"u": np.array([-2.0, 0.5, -2.0001, 0.5001])})["y"]
         np.testing.assert_array_equal(y, [-2.0, 0.5, -2.0, 0.5])
 
@@ -124,13 +134,13 @@ class TestSaturation:
         np.testing.assert_array_equal(y, [1.0, 0.0, 2.5])
 
     def test_one_sided_limit_with_infinity(self):
-        block = Saturation(lower=0.0, upper=np.inf)
+        block = sized(Saturation(lower=0.0, upper=np.inf), 2)
         y = block.output(0.0, None, {"u": np.array([-1.0, 1e300])})["y"]
         np.testing.assert_array_equal(y, [0.0, 1e300])
 
     def test_output_does_not_alias_input(self):
         u = np.array([0.1])
-        assert not np.shares_memory(Saturation().output(0.0, None, {"u": u})["y"], u)
+        assert not np.shares_memory(sized(Saturation(), 1).output(0.0, None, {"u": u})["y"], u)
 
     def test_lower_above_upper_raises(self):
         with pytest.raises(ValueError, match="lower"):
