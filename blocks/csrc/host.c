@@ -34,7 +34,9 @@
 #include "blocks_kernel.h"
 #include "core.h"
 #include "export_instance.h"
-#include "fmu.h"
+#include "fmu_block_step.h"
+#include "fmu_channel.h"
+#include "fmu_me_integration.h"
 #include "library.h"
 
 /* -- a Python block ------------------------------------------------------------------- */
@@ -900,12 +902,21 @@ static PyObject *library(PyObject *module, PyObject *unused)
     return found;
 }
 
-/* fmu_kernel(): the FMU block's kernel functions and its context's layout (fmu.h). */
+/* fmu_kernel(): the FMU block's step (its kernel functions and context layout), with
+   "model_exchange": the model-exchange loops', "host": the channel's to an isolated FMU. */
 static PyObject *fmu_kernel(PyObject *module, PyObject *unused)
 {
     (void)module;
     (void)unused;
-    return blk_fmu_kernel();
+    PyObject *found = blk_fmu_block_step();
+    PyObject *parts[] = {blk_fmu_me_functions(), blk_fmu_channel_functions()};
+    const char *names[] = {"model_exchange", "host"};
+    for (int i = 0; i < 2; i++) {
+        if (parts[i] == NULL || (found != NULL && PyDict_SetItemString(found, names[i], parts[i]) != 0))
+            Py_CLEAR(found);
+        Py_XDECREF(parts[i]);
+    }
+    return found;
 }
 
 static PyMethodDef module_methods[] = {

@@ -27,8 +27,9 @@ CORE = ["core.c"]
 CORE_HEADERS = ["core.h", "blocks_kernel.h"]
 LIBRARY = ["library.c", "lib_math.c", "lib_dynamic.c", "lib_sources.c"]
 LIBRARY_HEADERS = ["library.h", "lib_common.h"]
-HOST = ["host.c", "fmu.c", "fmu_me.c", "fmu_host.c"]
-HOST_HEADERS = ["fmu.h", "fmu_me.h", "fmu_calls.h", "fmu_host.h"]
+HOST = ["host.c", "layout_names.c", "fmu_block_step.c", "fmu_me_integration.c", "fmu_channel.c"]
+HOST_HEADERS = ["layout_names.h", "fmu_block_step.h", "fmu_me_integration.h", "fmu_channel.h", "fmu_step_table.h",
+                "fmi_step_calls.h"]
 EXPORT = ["export_instance.c"]
 EXPORT_HEADERS = ["export_instance.h"]
 FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
