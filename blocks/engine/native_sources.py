@@ -27,9 +27,12 @@ CORE = ["core.c"]
 CORE_HEADERS = ["core.h", "blocks_kernel.h"]
 LIBRARY = ["library.c", "lib_math.c", "lib_dynamic.c", "lib_sources.c"]
 LIBRARY_HEADERS = ["library.h", "lib_common.h"]
-HOST = ["host.c", "layout_names.c", "fmu_block_step.c", "fmu_me_integration.c", "fmu_channel.c"]
-HOST_HEADERS = ["layout_names.h", "fmu_block_step.h", "fmu_me_integration.h", "fmu_channel.h", "fmu_step_table.h",
-                "fmi_step_calls.h"]
+EXTENSION = ["native_module.c", "native_run.c", "native_run_bind.c", "native_run_hooks.c", "native_python_blocks.c",
+             "native_kernel_call.c", "layout_names.c", "fmu_block_step.c", "fmu_me_integration.c", "fmu_channel.c"]
+"""The extension's own files: the module, its Run type and single kernel calls, and the
+FMU block's compiled step, model-exchange loops and channel to an isolated FMU."""
+EXTENSION_HEADERS = ["native_run.h", "native_kernel_call.h", "layout_names.h", "fmu_block_step.h",
+                     "fmu_me_integration.h", "fmu_channel.h", "fmu_step_table.h", "fmi_step_calls.h"]
 EXPORT = ["export_instance.c"]
 EXPORT_HEADERS = ["export_instance.h"]
 FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
@@ -47,8 +50,8 @@ def paths(names: list[str], folder: str = CSRC) -> list[str]:
     return [f"{folder}/{name}" for name in names]
 
 
-EXTENSION_SOURCES = paths(HOST + CORE + LIBRARY)
-EXTENSION_DEPENDS = paths(CORE_HEADERS + LIBRARY_HEADERS + HOST_HEADERS)
+EXTENSION_SOURCES = paths(EXTENSION + CORE + LIBRARY)
+EXTENSION_DEPENDS = paths(CORE_HEADERS + LIBRARY_HEADERS + EXTENSION_HEADERS + EXPORT_HEADERS)
 
 
 def fmu_sources(fmi: int) -> list[str]:
