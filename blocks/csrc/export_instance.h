@@ -1,4 +1,5 @@
-/* One instance of an exported diagram FMU, independent of the FMI version.
+/* One instance of an exported diagram FMU, independent of the FMI version: the interface
+ * the FMI wrappers call (its files are listed in export_internal.h).
  *
  * An exported FMU runs a diagram's op table (core.h) over the kernels of its blocks,
  * which it rebuilds from their records (blocks_kernel.h, kernel types) when it is
