@@ -137,7 +137,7 @@ blk_status blk_snapshot_deserialize(blk_instance *inst, const unsigned char *byt
                                     blk_snapshot **snapshot);
 
 /* The kernel types this binary holds: tables of types (each ending with a NULL name), the
-   list ending with NULL. Each binary defines it (export_kernels.c: the library's; an
+   list ending with NULL. Each binary defines it (library_kernel_set.c: the library's; an
    application's own file adds its types). */
 extern const blk_kernel_type *const blk_export_kernel_sets[];
 

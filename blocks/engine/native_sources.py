@@ -11,7 +11,7 @@ while the interpreter starts waits for the command's handlers (``launcher.c`` sa
 
 An exported FMU's binary is the op-table core, the library's kernels, the FMU instance
 and one FMI wrapper, plus a kernel-set file that lists the kernel types the binary holds
-(``export_kernels.c`` for the library alone; an application lists its own beside it).
+(``library_kernel_set.c`` for the library alone; an application lists its own beside it).
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ EXPORT = ["export_log.c", "export_resources.c", "export_step.c", "export_build.c
 """An exported FMU's instance, one concern a file (export_internal.h lists them)."""
 EXPORT_HEADERS = ["export_instance.h", "export_internal.h"]
 FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
-KERNEL_SET = "export_kernels.c"
+KERNEL_SET = "library_kernel_set.c"
 """The kernel-set file of a binary holding the library's kernel types only."""
 
 LAUNCHER = "launcher.c"
