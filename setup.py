@@ -4,8 +4,8 @@ Metadata lives in pyproject.toml; this file only declares what is compiled, beca
 setuptools' extension support is the build path every pip and every Python install
 already has (no CMake, no code generator), and copies the shipped diagrams into the
 package (``hierhand/diagrams/``), which package data cannot reach from outside it. The framework's extension ``blocks._native``
-is the CPython host (``host.c``) of the op-table interpreter (``core.c``, plain C99 that
-needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``); the
+is the CPython module (``native_module.c``, ``native_run*.c``) of the op-table interpreter
+(``core.c``, plain C99 that needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``); the
 hand's, ``hierhand._native``, binds its C core. Besides the extensions the build links
 plain shared libraries that an FMU export copies into FMUs, so exporting needs no
 compiler: ``blocks/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the op-table core, the

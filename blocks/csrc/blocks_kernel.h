@@ -33,7 +33,7 @@
  *   and uses the Kernel it returns, whose context belongs to that run and may be written.
  *   That kernel gets the state as above: the flat array (the plant's), else NULL (an FMU's
  *   live instance, whose changes it keeps in its context).
- * - The GIL: the executor (blocks/csrc/host.c) holds it around a kernel's calls unless
+ * - The GIL: the executor (blocks/csrc/native_run_hooks.c) holds it around a kernel's calls unless
  *   the Kernel says nogil.
  *   A nogil kernel calls nothing of Python's C API (so never returns BLK_RAISED) and
  *   writes only its state, its outputs and a context no other run uses at the same time

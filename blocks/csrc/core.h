@@ -6,10 +6,11 @@
  * convention of blocks_kernel.h): the outputs, updates and advances of the blocks, the
  * logging of their outputs with decimation, the copies of delayed connections, the end
  * of a run asked by a block, and failures with their block, phase, tick and the rows an
- * advance completed. It knows nothing of Python: a host (blocks/csrc/host.c, the CPython
- * module; any C program) binds the kernels, provides the memory, and may hook in
- * callbacks for blocks without a kernel, for locks around kernels, for the checks for
- * an interrupt between events, and for requests to end the run.
+ * advance completed. It knows nothing of Python: a host (the Run of the CPython module,
+ * native_run.h; an exported FMU's instance, export_instance.h; any C program) binds the
+ * kernels, provides the memory, and may hook in callbacks for blocks without a kernel,
+ * for locks around kernels, for the checks for an interrupt between events, and for
+ * requests to end the run.
  *
  * Layouts. Every table is an int64 array of rows of the width named *_N; "offset" means
  * an index into the run's arena (float64 values), never a pointer.

@@ -1,4 +1,4 @@
-/* The FMI 2.0 co-simulation interface of an exported diagram FMU, over export_instance.c.
+/* The FMI 2.0 co-simulation interface of an exported diagram FMU, over export_instance.h.
  *
  * Only the common and co-simulation functions are exported (a co-simulation-only FMU
  * needs no model-exchange functions). Every failure is logged through the host's logger

@@ -1,4 +1,4 @@
-/* The FMI 3.0 co-simulation interface of an exported diagram FMU, over export_instance.c.
+/* The FMI 3.0 co-simulation interface of an exported diagram FMU, over export_instance.h.
  *
  * Every function of fmi3Functions.h is exported, as importers may look each one up; the
  * ones outside co-simulation without event mode (model exchange, scheduled execution,

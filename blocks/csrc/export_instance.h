@@ -1,4 +1,5 @@
-/* One instance of an exported diagram FMU, independent of the FMI version.
+/* One instance of an exported diagram FMU, independent of the FMI version: the interface
+ * the FMI wrappers call (its files are listed in export_internal.h).
  *
  * An exported FMU runs a diagram's op table (core.h) over the kernels of its blocks,
  * which it rebuilds from their records (blocks_kernel.h, kernel types) when it is
@@ -136,7 +137,7 @@ blk_status blk_snapshot_deserialize(blk_instance *inst, const unsigned char *byt
                                     blk_snapshot **snapshot);
 
 /* The kernel types this binary holds: tables of types (each ending with a NULL name), the
-   list ending with NULL. Each binary defines it (export_kernels.c: the library's; an
+   list ending with NULL. Each binary defines it (library_kernel_set.c: the library's; an
    application's own file adds its types). */
 extern const blk_kernel_type *const blk_export_kernel_sets[];
 

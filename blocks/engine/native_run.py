@@ -1,6 +1,6 @@
 """The C core's Python host: a bound table handed to ``blocks._native.Run``, its outcome read back.
 
-The whole run is one call into C (``blocks/csrc/host.c`` over ``core.c``): compiled
+The whole run is one call into C (``blocks/csrc/native_run*.c`` over ``core.c``): compiled
 blocks through their kernels, Python blocks as callback ops of the same table (their
 methods called by the host, with the rules of ``blocks.engine.python_blocks``), logging in C.
 What the core reports by numbers (an op, a code, a tick) becomes here the block, phase

@@ -15,7 +15,7 @@ keeps every value in the run's arena. Between the two, for every call:
 - **update**: the new state, or an ``EndRun`` (with its state, if it gives one).
 
 This module is the readable statement of those rules, which the reference loop runs as
-they stand; the C host (``blocks/csrc/host.c``) does outputs, updates and inputs itself,
+they stand; the C Run (``blocks/csrc/native_python_blocks.c``) does outputs, updates and inputs itself,
 for speed, and comes here for advances and for the messages of outputs that fail the
 check.
 """

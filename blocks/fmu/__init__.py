@@ -121,12 +121,12 @@ Modules, one concept each:
 - ``instance``: one FMU instance with its preallocated value transfers, FMI 2 and 3;
 - ``cosimulation``: a co-simulation instance's step (doStep and what its status says);
 - ``exchange``: a model-exchange instance's step (integration, events, event iteration);
-- ``solvers``: the integration settings, CVode and Euler over the C loops of blocks/csrc/fmu_me.c;
+- ``solvers``: the integration settings, CVode and Euler over the C loops of blocks/csrc/fmu_me_integration.c;
 - ``sundials``: the SUNDIALS (CVode) functions of fmpy's libraries, declared for ``solvers``;
-- ``kernel``: the compiled steady step (blocks/csrc/fmu.c) of a co-simulation FMU with Float64 ports only
-  (in this process, or through the channel of an isolated instance);
+- ``kernel``: the compiled steady step (blocks/csrc/fmu_block_step.c) of a co-simulation FMU with Float64 ports
+  only (in this process, or through the channel of an isolated instance);
 - ``hosted``: an instance in a process of its own, as the run sees it; ``host``: that process;
-  ``channel``: the shared memory and messages between them (blocks/csrc/fmu_host.c);
+  ``channel``: the shared memory and messages between them (blocks/csrc/fmu_channel.c);
   ``launcher``: the process that forks the hosts, as the run sees it; ``forkserver``: that process;
 - ``native``: the compiled functions of blocks._native the FMU modules use;
 - ``log_messages``: the FMUs' log messages and the FMI 2 logger proxy;

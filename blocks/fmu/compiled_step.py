@@ -1,9 +1,9 @@
-"""The FMU block's compiled kernel (``blocks/csrc/fmu.c``): the steady step in C, the rest in Python.
+"""The FMU block's compiled kernel (``blocks/csrc/fmu_block_step.c``): the steady step in C, the rest in Python.
 
 ``fmu_kernel(block)`` offers a kernel for a co-simulation FMU whose ports are all Float64
 (FMI 2 Real, FMI 3 Float64); ports of other types keep their range checks and conversions
 in Python, so such an FMU runs through the block's Python methods, as does a
-model-exchange FMU (whose integration between the hits runs in C of its own, fmu_me.c,
+model-exchange FMU (whose integration between the hits runs in C of its own, fmu_me_integration.c,
 see ``solvers``). The kernel's state is a live
 instance, so it has a ``bind``: each run gets a ``KernelRun``, whose int64 table is the C
 functions' context (its layout from ``blocks._native.fmu_kernel()``) and whose float64
@@ -57,7 +57,7 @@ def fmu_kernel(block: Any) -> Kernel | None:
 
 HANDLERS = {"output": "output", "update": "update", "arm": "arm", "set": "set_failed", "step": "stepped",
             "get": "get_failed", "hosted": "hosted"}
-"""The method of ``KernelRun`` for each kind of ``slow`` call of fmu.c."""
+"""The method of ``KernelRun`` for each kind of ``slow`` call of fmu_block_step.c."""
 
 
 def _raise(exc: BaseException) -> None:

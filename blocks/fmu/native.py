@@ -1,6 +1,6 @@
 """The FMU block's compiled functions, from ``blocks._native.fmu_kernel()``: the kernel's
-(blocks/csrc/fmu.c), the model-exchange loops' (fmu_me.c) and the channel's to an FMU in
-a process of its own (fmu_host.c), with the layouts of their tables. One place, imported
+(blocks/csrc/fmu_block_step.c), the model-exchange loops' (fmu_me_integration.c) and the
+channel's to an FMU in a process of its own (fmu_channel.c), with the layouts of their tables. One place, imported
 by the modules that use them (``kernel``, ``solvers``, ``channel``, ``host``)."""
 
 from __future__ import annotations

@@ -4,7 +4,7 @@
 against the block's period. ``ContinuousCalls`` is one instance's continuous-time
 functions (setTime, setContinuousStates, the derivatives, the event indicators,
 completedIntegratorStep) with their buffers, laid out in the int64 table that the C
-loops of ``blocks/csrc/fmu_me.c`` read. The solvers integrate from one time to another,
+loops of ``blocks/csrc/fmu_me_integration.c`` read. The solvers integrate from one time to another,
 stopping at the first state event, step event or request to terminate, and say which:
 
 - ``Euler``: forward Euler with a fixed sub-step on the grid of the hit interval (the
@@ -14,7 +14,7 @@ stopping at the first state event, step event or request to terminate, and say w
 - ``CVode``: SUNDIALS' CVode as fmpy ships it (``sundials``), BDF with a dense linear
   solver, relative tolerance ``tolerance`` and absolute tolerances ``tolerance`` times the
   states' nominal values, as fmpy's own ME simulation uses it (which also bounds its step
-  by a 50th of the simulated time, which a block does not know); its right-hand side and root function are the C functions of fmu_me.c, so no Python
+  by a 50th of the simulated time, which a block does not know); its right-hand side and root function are the C functions of fmu_me_integration.c, so no Python
   runs inside the integration, and its root finding locates state events.
 
 Both call completedIntegratorStep (when the FMU needs it) after each step they take,
@@ -114,7 +114,7 @@ def integration(solver: str, substep: Fraction | None, default_step: Fraction | 
 
 @functools.cache
 def layout() -> dict[str, Any]:
-    """The C functions and the table's layout (fmu_me.h), from blocks._native."""
+    """The C functions and the table's layout (fmu_me_integration.h), from blocks._native."""
     found = native()
     if found is None:
         raise SolverError("model exchange needs the compiled extension blocks._native, which is not built "
@@ -123,7 +123,7 @@ def layout() -> dict[str, Any]:
 
 
 class ContinuousCalls:
-    """An instance's continuous-time FMU functions and buffers, in the table fmu_me.c reads.
+    """An instance's continuous-time FMU functions and buffers, in the table fmu_me_integration.c reads.
 
     ``x`` holds the states, ``z`` the event indicators where the last step started; the
     FMU functions are the instance's own (``functions``: name -> ctypes function), called

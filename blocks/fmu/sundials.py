@@ -5,7 +5,7 @@ fmpy loads the SUNDIALS libraries of its platform and checks their major version
 (so that fmpy's declarations stay as they are), the calls ``solvers.CVode`` makes: a
 context, serial vectors over the solver's own numpy buffers, a BDF integrator with a dense
 linear solver and root finding, and their freeing. Pointers are plain ``c_void_p``; the
-right-hand side and the root function are C functions of ``blocks._native`` (fmu_me.c),
+right-hand side and the root function are C functions of ``blocks._native`` (fmu_me_integration.c),
 passed by address. Imported when a run first integrates with CVode, never at load time.
 """
 

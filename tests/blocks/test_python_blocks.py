@@ -1,5 +1,5 @@
 """Python blocks as ops of the table (blocks/engine/python_blocks.py, and its fast twin in
-blocks/csrc/host.c): what a block gets and what it may return, the same in both engines.
+blocks/csrc/native_python_blocks.c): what a block gets and what it may return, the same in both engines.
 
 - An input array a block keeps is never changed afterwards: a changed value comes in a
   new array (the C host overwrites one in place only when nobody else holds it).

@@ -1,4 +1,4 @@
-"""Diagrams run in several threads at once (blocks/csrc/host.c releasing the GIL).
+"""Diagrams run in several threads at once (blocks/csrc/native_run_hooks.c releasing the GIL).
 
 The executor runs kernels that say ``nogil`` with the GIL released, so threads that
 simulate diagrams run in parallel. What a thread gets must not depend on that: the toy

@@ -1,6 +1,6 @@
 """The channel between a run and an FMU instance hosted in a process of its own.
 
-Two pieces (the C side and the protocol: ``blocks/csrc/fmu_host.h``):
+Two pieces (the C side and the protocol: ``blocks/csrc/fmu_channel.h``):
 
 - ``Region``, the shared memory both processes map: the request and reply counters, the
   step asked for, the input and output values (float64, port after port in the block's
@@ -53,7 +53,7 @@ def native() -> dict[str, Any]:
 
 class Region:
     """The shared memory of one channel, mapped from the file descriptor ``fd``: the
-    header of fmu_host.h, then ``n_in`` input values and the output values."""
+    header of fmu_channel.h, then ``n_in`` input values and the output values."""
 
     def __init__(self, fd: int, n_in: int | None = None, n_out: int | None = None):
         layout = native()["layout"]

@@ -6,12 +6,12 @@ as the run's process would (``pool.new_instance``'s classes: the same fmpy calls
 checks and messages), so results are the same to the last bit; what it adds is:
 
 - tracing: before each call into the FMU it writes the FMU function's name into the
-  channel (``Region.mark``; the C loops do the same, ``fmu_calls.h`` and ``fmu_me.c``), so
+  channel (``Region.mark``; the C loops do the same, ``fmi_step_calls.h`` and ``fmu_me_integration.c``), so
   that when the FMU kills its process the run can say in which call;
 - the log: the FMU's messages also go into the channel, where the run reads them after
   a failure, even one the host did not survive;
 - the steady step in C: for a co-simulation FMU whose ports are all Float64 the channel's
-  C loop (``serve`` of fmu_host.c) sets the inputs, steps and gets the outputs itself, on
+  C loop (``serve`` of fmu_channel.c) sets the inputs, steps and gets the outputs itself, on
   the channel's values, and comes back here only for a step that was not a plain success.
 
 Requests are the messages of ``channel``: ``("instantiate", binary, inputs, outputs)``,
@@ -111,7 +111,7 @@ class Host:
         self.input_views: dict[str, Any] = {}
         """The input ports' values in the channel (views), as the instance reads them."""
         self.table: Any = None
-        """The FMU_* table of the steady step in C (fmu.h), for a co-simulation FMU with
+        """The FMU_* table of the steady step in C (fmu_step_table.h), for a co-simulation FMU with
         Float64 ports only; None for one that steps here."""
         self._me_names: Any = None
         self._step_names: dict[str, Any] = {}
@@ -242,7 +242,7 @@ class Host:
             self.table[compiled.native()["slots"]["ready"]] = int(ready)
 
     def _trace(self, inst: Instance) -> None:
-        """The C loops of a model-exchange instance name their calls too (fmu_me.c's ME_TRACE)."""
+        """The C loops of a model-exchange instance name their calls too (fmu_me_integration.c's ME_TRACE)."""
         if not isinstance(inst, ModelExchange):
             return
         calls = inst.calls
@@ -255,7 +255,7 @@ class Host:
         calls.table[slots["trace_names"]] = ctypes.addressof(self._me_names)
 
     def _fast_table(self, inst: CoSimulation) -> Any:
-        """The FMU_* table (fmu.h) of the C loop's steady step, on the channel's values."""
+        """The FMU_* table (fmu_step_table.h) of the C loop's steady step, on the channel's values."""
         import numpy as np
 
         slots = compiled.native()["slots"]

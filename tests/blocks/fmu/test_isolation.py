@@ -239,7 +239,7 @@ def test_an_fmu_that_kills_its_process_fails_the_run_naming_the_call(tmp_path, m
 
 
 def test_a_crash_inside_cvode_names_the_call_cvode_made(tmp_path, misbehaving):
-    """CVode calls the FMU from its right-hand side (fmu_me.c), which traces the call too."""
+    """CVode calls the FMU from its right-hand side (fmu_me_integration.c), which traces the call too."""
     path = misbehaving_fmu(tmp_path / "bad.fmu", "me2", misbehaving["me2"], "fmi2GetDerivatives abort 0.25")
     results = simulate(diagram(path, "me2", params="solver: cvode"))
     assert re.match(r"failed at t=0\.[12] s: block 'f' \(FMU\) update: FMU '.*' crashed in fmi2GetDerivatives \(the "

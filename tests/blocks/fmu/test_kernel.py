@@ -1,4 +1,4 @@
-"""The FMU block's compiled kernel (blocks/csrc/fmu.c, blocks/fmu/compiled_step.py).
+"""The FMU block's compiled kernel (blocks/csrc/fmu_block_step.c, blocks/fmu/compiled_step.py).
 
 A diagram runs the same whether the FMU steps through its kernel or its Python methods:
 the same samples to the last bit, the same status when the FMU fails (also inside a

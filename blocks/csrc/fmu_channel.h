@@ -1,5 +1,6 @@
-/* The channel between a run and an FMU instance hosted in a process of its own (fmu_host.c;
- * blocks/fmu/isolation/client.py and blocks/fmu/isolation/server.py are its two ends in Python).
+/* The channel between a run and an FMU instance isolated in a process of its own, which
+ * hosts the FMU (fmu_channel.c; blocks/fmu/isolation/client.py and
+ * blocks/fmu/isolation/server.py are its two ends in Python).
  *
  * The channel is one shared-memory region: this header, then the input values, then the
  * output values (float64, port after port in the block's order). A request is one bump of
@@ -13,8 +14,8 @@
  * pickles over the socket pair the two processes also share, whose end-of-file is how each
  * side learns that the other has died.
  */
-#ifndef BLOCKS_FMU_HOST_H
-#define BLOCKS_FMU_HOST_H
+#ifndef BLOCKS_FMU_CHANNEL_H
+#define BLOCKS_FMU_CHANNEL_H
 
 #include <Python.h>
 
@@ -30,7 +31,7 @@ typedef struct {
     int32_t command;         /* what is asked: HOST_STEP or HOST_MESSAGE */
     int32_t answer;          /* how it was answered: HOST_DONE or HOST_MESSAGE */
     int32_t parent_spins;    /* how much each side trusts spinning (each writes its own): */
-    int32_t host_spins;      /* spins that came to nothing lower it, see fmu_host.c */
+    int32_t host_spins;      /* spins that came to nothing lower it, see fmu_channel.c */
     int32_t parent_cpu;      /* the processor each side last ran on (each writes its own): */
     int32_t host_cpu;        /* spinning on the other side's processor cannot pay */
     double t, h;             /* HOST_STEP: from t over h */
@@ -65,6 +66,6 @@ int blk_host_wait(host_channel *ch, int fd, double timeout);
 
 /* {"layout": {...}, "post": ..., "wait": ..., "serve": ..., "answer": ...}: the channel's
    layout (offsets of host_channel) and the Python functions of both ends. */
-PyObject *blk_fmu_host_functions(void);
+PyObject *blk_fmu_channel_functions(void);
 
 #endif

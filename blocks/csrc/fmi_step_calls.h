@@ -1,18 +1,19 @@
 /* The FMI calls of a co-simulation step over Float64 values -- set the inputs, doStep, get
- * the outputs -- as the FMU block's kernel makes them in the run's process (fmu.c) and the
- * FMU host makes them in a process of its own (fmu_host.c). Their context is the FMU_*
- * table of fmu.h: the FMU's component and functions, the value references, the buffers.
- * Where the table has FMU_TRACE (the host), each call first writes the name of the FMU
- * function it calls there, so that a crash inside it can be named.
+ * the outputs -- as the FMU block's step makes them in the run's process
+ * (fmu_block_step.c) and the server loop of an isolated FMU makes them in a process of its
+ * own (fmu_channel.c): written once, as inline functions, for both. Their context is the
+ * FMU_* table of fmu_step_table.h: the FMU's component and functions, the value references,
+ * the buffers. Where the table has FMU_TRACE (the isolated FMU's process), each call first
+ * writes the name of the FMU function it calls there, so that a crash inside it can be named.
  */
-#ifndef BLOCKS_FMU_CALLS_H
-#define BLOCKS_FMU_CALLS_H
+#ifndef BLOCKS_FMI_STEP_CALLS_H
+#define BLOCKS_FMI_STEP_CALLS_H
 
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 
-#include "fmu.h"
+#include "fmu_step_table.h"
 
 /* The FMI functions the step calls (the FMI 2.0 and 3.0 signatures; statuses are ints,
    ok 0 and warning 1). */
@@ -33,7 +34,7 @@ static inline void fmu_trace(const int64_t *c, int name)
 }
 
 /* One set or get call of a group of Float64 values; first is FMU_SET or FMU_GET, whose
-   slots follow in the order of fmu.h: function, value references, their count, the buffer,
+   slots follow in the order of fmu_step_table.h: function, value references, their count, the buffer,
    the number of values. Returns the FMI status. */
 static inline int fmu_transfer(const int64_t *c, int first, bool set)
 {

@@ -1,7 +1,8 @@
-/* The inner loops of a model-exchange FMU's integration (fmu_me.c): the layout of their
- * context, for blocks._native, which hands it and the functions to blocks/fmu/solvers.py. */
-#ifndef BLOCKS_FMU_ME_H
-#define BLOCKS_FMU_ME_H
+/* The inner loops of a model-exchange FMU's integration (fmu_me_integration.c): the layout
+ * of their context, for blocks._native, which hands it and the functions to
+ * blocks/fmu/solvers.py. */
+#ifndef BLOCKS_FMU_ME_INTEGRATION_H
+#define BLOCKS_FMU_ME_INTEGRATION_H
 
 #include <Python.h>
 
@@ -25,7 +26,7 @@ enum {
     ME_Z_NEW,           /* double *: the event indicators at its end (nz) */
     ME_FAILED,          /* out: which call failed (ME_CALL_*), 0 for none */
     ME_FAILED_STATUS,   /* out: the status it returned */
-    ME_TRACE,           /* in the FMU host: char *, where each call first writes the FMU function it calls, */
+    ME_TRACE,           /* isolated FMU: char *, where each call first writes the FMU function it calls, */
     ME_TRACE_NAMES,     /* and const char **, their names by ME_CALL_* (0: no trace) */
     ME_TABLE_SIZE
 };

@@ -1,27 +1,27 @@
-/* The compiled kernel of the FMU block (blocks/fmu): the steady step of a co-simulation FMU
- * whose ports are all Float64 -- set the inputs, doStep, get the outputs -- through the
- * FMU's own C functions, with no Python in between.
+/* The FMU block's compiled step (blocks/fmu), a kernel of the op table: the steady step of
+ * a co-simulation FMU whose ports are all Float64 -- set the inputs, doStep, get the
+ * outputs -- through the FMU's own C functions, with no Python in between.
  *
- * Its context is one run's int64 table (FMU_* slots, then the ports), made and filled by
- * blocks/fmu/compiled_step.py, which binds it to the run's FMU instance. The kernel keeps the
- * FMU's time and outputs there (the values array), so it writes through its context.
- * Everything but the steady step goes to the Python side, slow(kind, t, status), which
- * does what the block's Python methods do from that point on, with the same messages: the
- * first call (taking an instance, initialising it), a step at the wrong time or of a broken
- * or ended instance, a call that returned worse than a warning, a doStep that asks to
- * terminate or returned early, and arming the interrupt hook when other code replaced it.
- * slow returns 0, or 1 when the update ended the run (BLK_END_RUN); a failure is a Python
- * exception (BLK_RAISED).
+ * Its context is one run's int64 table (FMU_* slots of fmu_step_table.h, then the ports),
+ * made and filled by blocks/fmu/compiled_step.py, which binds it to the run's FMU
+ * instance. The kernel keeps the FMU's time and outputs there (the values array), so it
+ * writes through its context. Everything but the steady step goes to the Python side,
+ * slow(kind, t, status), which does what the block's Python methods do from that point
+ * on, with the same messages: the first call (taking an instance, initialising it), a step
+ * at the wrong time or of a broken or ended instance, a call that returned worse than a
+ * warning, a doStep that asks to terminate or returned early, and arming the interrupt
+ * hook when other code replaced it. slow returns 0, or 1 when the update ended the run
+ * (BLK_END_RUN); a failure is a Python exception (BLK_RAISED).
  *
  * As the Python side does around each step: before it, the interrupt hook is looked at
  * and FMI 2's log proxy re-armed; after doStep, interrupt.check() raises a Ctrl-C that an
  * FMU callback noted (blocks/fmu/interrupt.py).
  *
- * An instance hosted in a process of its own (FMU_CHANNEL, blocks/fmu/isolation/client.py) steps
- * the same way through its channel instead (hosted_step): the inputs into the channel's
- * values, one round trip (fmu_host.c), the outputs out of them; the host makes the FMI
- * calls (fmu_calls.h, shared with this file). Anything but a plain success goes to slow
- * as FMU_SLOW_HOSTED, with how waiting ended.
+ * An instance hosted in a process of its own (FMU_CHANNEL, blocks/fmu/isolation/client.py)
+ * steps the same way through its channel instead (hosted_step): the inputs into the
+ * channel's values, one round trip (fmu_channel.c), the outputs out of them; the FMU's
+ * process makes the FMI calls (fmi_step_calls.h, shared with this file). Anything but a
+ * plain success goes to slow as FMU_SLOW_HOSTED, with how waiting ended.
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
@@ -31,10 +31,12 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "fmu.h"
-#include "fmu_calls.h"
-#include "fmu_host.h"
-#include "fmu_me.h"
+#include "blocks_kernel.h"
+#include "fmi_step_calls.h"
+#include "fmu_block_step.h"
+#include "fmu_channel.h"
+#include "fmu_step_table.h"
+#include "layout_names.h"
 
 typedef void (*log_arm_fn)(void *);
 
@@ -175,23 +177,9 @@ static const named kinds[] = {{"output", FMU_SLOW_OUTPUT}, {"update", FMU_SLOW_U
                               {"set", FMU_SLOW_SET}, {"step", FMU_SLOW_STEP}, {"get", FMU_SLOW_GET},
                               {"hosted", FMU_SLOW_HOSTED}, {NULL, 0}};
 
-/* {name: value} of a table of names, or NULL with an exception. */
-PyObject *blk_names(const named *table)
+PyObject *blk_fmu_block_step(void)
 {
-    PyObject *found = PyDict_New();
-    for (const named *e = table; found != NULL && e->name != NULL; e++) {
-        PyObject *value = PyLong_FromLong(e->value);
-        if (value == NULL || PyDict_SetItemString(found, e->name, value) != 0)
-            Py_CLEAR(found);
-        Py_XDECREF(value);
-    }
-    return found;
-}
-
-PyObject *blk_fmu_kernel(void)
-{
-    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
+    return Py_BuildValue("{s:N,s:N,s:N,s:N,s:N}", "output", PyLong_FromVoidPtr((void *)fmu_output), "update",
                          PyLong_FromVoidPtr((void *)fmu_update), "slots", blk_names(slots), "values", blk_names(values),
-                         "kinds", blk_names(kinds), "model_exchange", blk_fmu_me_functions(), "host",
-                         blk_fmu_host_functions());
+                         "kinds", blk_names(kinds));
 }

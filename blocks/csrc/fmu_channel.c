@@ -1,18 +1,20 @@
-/* Both ends of the channel to an FMU instance hosted in a process of its own (fmu_host.h).
+/* Both ends of the channel to an FMU instance isolated in a process of its own
+ * (fmu_channel.h), which hosts the FMU: "the host" below.
  *
- * The run's end: blk_host_post and blk_host_wait, which the FMU block's kernel (fmu.c)
- * calls for each steady step and blocks/fmu/isolation/client.py for everything else. The wait spins
- * for HOST_SPIN_NS, then sleeps on the reply counter in slices of HOST_SLICE_NS; between
- * slices it looks for the host's end of the socket pair closing (its process ended), for
- * the time the call may take, and, with the GIL taken back, runs the signal handlers, so
- * that Ctrl-C and SIGTERM stop a run whose FMU never returns.
+ * The run's end: blk_host_post and blk_host_wait, which the FMU block's step
+ * (fmu_block_step.c) calls for each steady step and blocks/fmu/isolation/client.py for
+ * everything else. The wait spins for HOST_SPIN_NS, then sleeps on the reply counter in
+ * slices of HOST_SLICE_NS; between slices it looks for the host's end of the socket pair
+ * closing (its process ended), for the time the call may take, and, with the GIL taken
+ * back, runs the signal handlers, so that Ctrl-C and SIGTERM stop a run whose FMU never
+ * returns.
  *
- * The host's end (blocks/fmu/isolation/server.py): serve waits for the next request the same way
- * (HOST_IDLE_SPIN_NS, then slices of HOST_IDLE_NS, ending when the run's process is gone;
- * the spins of both sides adapt, see spin) and answers a steady
- * step of a co-simulation FMU with Float64 ports by itself, through the FMU's functions
- * (fmu_calls.h) on the channel's values, tracing each call's name into the channel. Any
- * other request, and a step that was not a plain success, goes back to Python.
+ * The host's end (blocks/fmu/isolation/server.py): serve waits for the next request the
+ * same way (HOST_IDLE_SPIN_NS, then slices of HOST_IDLE_NS, ending when the run's process
+ * is gone; the spins of both sides adapt, see spin) and answers a steady step of a
+ * co-simulation FMU with Float64 ports by itself, through the FMU's functions
+ * (fmi_step_calls.h) on the channel's values, tracing each call's name into the channel.
+ * Any other request, and a step that was not a plain success, goes back to Python.
  *
  * Linux only (futexes); elsewhere isolation is refused in Python and these are not called.
  */
@@ -37,9 +39,10 @@
 #include <unistd.h>
 #endif
 
-#include "fmu.h"
-#include "fmu_calls.h"
-#include "fmu_host.h"
+#include "fmi_step_calls.h"
+#include "fmu_channel.h"
+#include "fmu_step_table.h"
+#include "layout_names.h"
 
 #define HOST_SPIN_NS 50000LL        /* how long the run's side spins for an answer before it sleeps */
 #define HOST_IDLE_SPIN_NS 50000LL   /* how long the host spins for the next request before it sleeps */
@@ -335,7 +338,7 @@ static const named codes[] = {
     {"step", HOST_STEP}, {"message", HOST_MESSAGE}, {"done", HOST_DONE}, {"answered", HOST_ANSWERED},
     {"gone", HOST_GONE}, {"late", HOST_LATE}, {"orphan", HOST_ORPHAN}, {NULL, 0}};
 
-PyObject *blk_fmu_host_functions(void)
+PyObject *blk_fmu_channel_functions(void)
 {
     PyObject *found = Py_BuildValue("{s:N,s:N}", "layout", blk_names(layout), "codes", blk_names(codes));
     for (PyMethodDef *f = functions; found != NULL && f->ml_name != NULL; f++) {

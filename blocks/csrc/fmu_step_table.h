@@ -1,16 +1,18 @@
-/* The FMU block's compiled kernel (fmu.c): the layout of its per-run context, for
- * blocks._native, which hands the layout and the functions to blocks/fmu/compiled_step.py. The
- * same table describes an FMU instance to the host that runs it in a process of its own
- * (fmu_host.c), which fills the FMU's slots and FMU_TRACE*; the run's kernel of such an
- * instance fills FMU_CHANNEL and FMU_SOCKET instead of the FMU's functions. */
-#ifndef BLOCKS_FMU_H
-#define BLOCKS_FMU_H
+/* The context of a co-simulation FMU's steady step: one int64 table (pointers stored as
+ * integers) of FMU_* slots, then the ports. The FMU block's step in the run's process
+ * (fmu_block_step.c) and the server loop of an FMU isolated in a process of its own
+ * (fmu_channel.c) both read it, and the FMI calls over it (fmi_step_calls.h) take it; so
+ * its layout is a header of its own, which all three include and which includes nothing.
+ * blocks/fmu/compiled_step.py and blocks/fmu/isolation/server.py fill it, by the names
+ * that fmu_block_step.c hands Python.
+ *
+ * In the run's process the table holds the FMU's component and functions; in the process
+ * that hosts an isolated FMU it holds them and FMU_TRACE*, and the run's table of such an
+ * instance holds FMU_CHANNEL and FMU_SOCKET instead of the FMU's functions. */
+#ifndef BLOCKS_FMU_STEP_TABLE_H
+#define BLOCKS_FMU_STEP_TABLE_H
 
-#include <Python.h>
-
-#include "blocks_kernel.h"
-
-/* The context: an int64 table, pointers stored as integers. */
+/* The slots. */
 enum {
     FMU_SLOW,      /* PyObject *: slow(kind, t, status) -> 0, or 1 when the update ended the run */
     FMU_CHECK,     /* PyObject *: interrupt.check, called after each doStep */
@@ -38,7 +40,7 @@ enum {
     FMU_FLAGS, /* FMI 3 doStep's output arguments: eventHandlingNeeded, terminateSimulation, earlyReturn, */
     FMU_N_IN = FMU_FLAGS + 4, /* lastSuccessfulTime (the instance's own) */
     FMU_N_OUT,
-    FMU_CHANNEL,    /* an instance hosted in a process of its own: its host_channel * (fmu_host.h), else 0; */
+    FMU_CHANNEL,    /* an instance hosted in a process of its own: its host_channel * (fmu_channel.h), else 0; */
     FMU_SOCKET,     /* the run's end of its socket pair; the set and get buffers are the channel's values */
     FMU_TRACE,      /* in the host: char *, where each call writes the FMU function it calls (0: no trace), */
     FMU_TRACE_SET,  /* and the names of the set, doStep and get functions (const char *) */
@@ -59,22 +61,8 @@ enum {
     FMU_SLOW_SET,    /* setting the inputs returned status */
     FMU_SLOW_STEP,   /* doStep returned status, or asked to terminate, or returned early */
     FMU_SLOW_GET,    /* getting the outputs returned status (the FMU's time is past the step) */
-    FMU_SLOW_HOSTED  /* a hosted step that was not a plain success: status is how waiting ended (HOST_*) */
+    FMU_SLOW_HOSTED  /* a hosted step that was not a plain success: status is how waiting ended (HOST_*,
+                        fmu_channel.h) */
 };
-
-/* {"output": address, "update": address, "slots": {name: index}, "values": {...},
-   "kinds": {...}, "model_exchange": {...} (fmu_me.h), "host": {...} (fmu_host.h)}: the
-   kernel's functions and its context's layout, the model-exchange integration's and the
-   FMU host's. */
-PyObject *blk_fmu_kernel(void);
-
-/* A name and its value, in the tables of names that describe a context's layout. */
-typedef struct {
-    const char *name;
-    int value;
-} named;
-
-/* {name: value} of a table of names ending with a NULL name, or NULL with an exception. */
-PyObject *blk_names(const named *table);
 
 #endif

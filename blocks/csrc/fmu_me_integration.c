@@ -9,20 +9,21 @@
  *   CVRhsFn and CVRootFn of SUNDIALS 7, the CVode that fmpy ships), which set the time and
  *   the states and get the derivatives or the event indicators.
  *
- * Their context is one FMU instance's int64 table (ME_* slots of fmu_me.h), made and
- * filled by blocks/fmu/solvers.py: the FMU's component and functions, the buffers. A call
- * that returns worse than a warning is recorded there (which call, its status, the time)
- * for the Python side's message; where the table has ME_TRACE (the FMU host, fmu_host.c),
- * each call first writes the name of the FMU function it calls there. Called through
- * ctypes, without the GIL; nothing here touches Python.
+ * Their context is one FMU instance's int64 table (ME_* slots of fmu_me_integration.h),
+ * made and filled by blocks/fmu/solvers.py: the FMU's component and functions, the
+ * buffers. A call that returns worse than a warning is recorded there (which call, its
+ * status, the time) for the Python side's message; where the table has ME_TRACE (an FMU
+ * isolated in a process of its own, fmu_channel.h), each call first writes the name of the
+ * FMU function it calls there. Called through ctypes, without the GIL; nothing here but
+ * blk_fmu_me_functions (the layout for Python) touches Python.
  */
 #include <math.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
 
-#include "fmu.h"
-#include "fmu_me.h"
+#include "fmu_me_integration.h"
+#include "layout_names.h"
 
 typedef int (*set_time_fn)(void *, double);
 typedef int (*states_fn)(void *, double *, size_t);
@@ -138,7 +139,7 @@ static int locate(int64_t *c, double t, double hs, const double *x0, const doubl
 /* Forward Euler from start to stop, each step ending at the next point of the grid
    base + (end - base) k / n (k = 1 .. n, the last one end itself) or at stop. The FMU is
    at start with the states ME_X (and the indicators ME_Z there); it is left at the time
-   reached (ME_V_REACHED) with the states there. Returns an ME_* outcome of fmu_me.h. */
+   reached (ME_V_REACHED) with the states there. Returns an ME_* outcome of fmu_me_integration.h. */
 static long euler(int64_t *c, double start, double stop, double base, double end, long n)
 {
     int64_t nx = c[ME_NX], nz = c[ME_NZ];
