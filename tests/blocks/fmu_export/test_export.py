@@ -60,7 +60,7 @@ def test_the_toy_leaves_as_a_valid_fmu_whose_samples_are_the_native_runs(toy_fmu
     assert float(md.defaultExperiment.stepSize) == 1e-4 and float(md.defaultExperiment.stopTime) == 1.0
     assert [v.name for v in md.modelVariables if v.causality == "output"] == ["plant.y"]  # the logged signal
     assert {"prop.k", "ref.value"} <= {v.name for v in md.modelVariables if v.causality == "parameter"}
-    native = blocks.engine.simulate(blocks.load_diagram(TOY))
+    native = blocks.simulate(blocks.load_diagram(TOY))
     on_events = run(path, tmp_path / "a", ["plant.y"], 1e-3, 1000)
     np.testing.assert_array_equal(on_events[:, 0], held(native, "plant.y", np.arange(1001) * 1e-3)[:, 0])
     every_tick = run(path, tmp_path / "b", ["plant.y"], 1e-4, 10000)
@@ -75,7 +75,7 @@ def test_every_signal_block_of_the_library_leaves_with_the_native_samples(tmp_pa
     names = slave.names("output")
     slave.close()
     rows = run(path, tmp_path / "run", names, 1e-3, 500)
-    native = blocks.engine.simulate(d)
+    native = blocks.simulate(d)
     times = np.arange(501) * 1e-3
     column = 0
     for e in d.log:
@@ -93,7 +93,7 @@ def test_every_signal_block_of_the_library_leaves_with_the_native_samples(tmp_pa
 def test_random_library_diagrams_leave_with_the_native_samples(doc, ticks, tmp_path):
     try:
         d = loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="random.yaml", base_dir=tmp_path)
-        native = blocks.engine.simulate(d, t_end=ticks * blocks.build_schedule(d, None).base_tick)
+        native = blocks.simulate(d, t_end=ticks * blocks.build_schedule(d, None).base_tick)
     except DiagramError:
         return
     if not d.log or not native.complete:
@@ -139,8 +139,8 @@ def test_a_subsystem_leaves_with_its_inputs_and_outputs_and_feeds_through_as_nat
     (tmp_path / "composed.yaml").write_text(toy_with("composed", "{diagram: pi.yaml}"))
     (tmp_path / "fmu.yaml").write_text(toy_with(
         "fmu", f'{{type: FMU, period: 1 ms, params: {{path: "{path}", feedthrough: true, isolation: {isolation}}}}}'))
-    composed = blocks.engine.simulate(blocks.load_diagram(tmp_path / "composed.yaml"))
-    via_fmu = blocks.engine.simulate(blocks.load_diagram(tmp_path / "fmu.yaml"))
+    composed = blocks.simulate(blocks.load_diagram(tmp_path / "composed.yaml"))
+    via_fmu = blocks.simulate(blocks.load_diagram(tmp_path / "fmu.yaml"))
     assert via_fmu.complete
     np.testing.assert_array_equal(via_fmu["plant.y"][0], composed["plant.y"][0])
     np.testing.assert_array_equal(via_fmu["plant.y"][1], composed["plant.y"][1])
@@ -184,7 +184,7 @@ def test_blocks_that_cannot_leave_python_are_refused_one_line_each(tmp_path, toy
 
 @pytest.mark.parametrize("fmi", [2, 3])
 def test_tunable_parameters_are_the_native_overrides_and_checked(toy_fmus, fmi, tmp_path):
-    native = blocks.engine.simulate(blocks.load_diagram(TOY, overrides={"prop.k": 2.5, "ref.value": 0.5}))
+    native = blocks.simulate(blocks.load_diagram(TOY, overrides={"prop.k": 2.5, "ref.value": 0.5}))
     rows = run(toy_fmus[fmi], tmp_path / "tuned", ["plant.y"], 1e-3, 200, start={"prop.k": 2.5, "ref.value": 0.5})
     np.testing.assert_array_equal(rows[:, 0], held(native, "plant.y", np.arange(201) * 1e-3)[:, 0])
     slave = Slave(toy_fmus[fmi], tmp_path / "bad")
