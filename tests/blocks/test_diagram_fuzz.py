@@ -68,7 +68,7 @@ def simulate_briefly(diagram: blocks.Diagram, text: str, ticks: int) -> None:
     if t_end is None:
         return
     try:
-        results = blocks.engine.simulate(diagram, t_end=t_end)
+        results = blocks.simulate(diagram, t_end=t_end)
     except blocks.DiagramError as err:
         check_issues(err, text)
         return
@@ -451,7 +451,7 @@ def test_valid_chain_with_random_gain_and_period(k, period, tmp_path):
     text = yaml.safe_dump(doc, sort_keys=False)
     diagram = load_or_error(text, tmp_path)
     assert diagram is not None, text
-    results = blocks.engine.simulate(diagram)
+    results = blocks.simulate(diagram)
     assert results.complete, results.status
     t, y = results["c.y"]
     hits = [Fraction(2, 1000) * j for j in range(6)]
@@ -466,7 +466,7 @@ def test_valid_chain_runs(tmp_path):
     text = yaml.safe_dump(VALID_CHAIN, sort_keys=False)
     diagram = load_or_error(text, tmp_path)
     assert diagram is not None
-    results = blocks.engine.simulate(diagram, t_end="10 ms")
+    results = blocks.simulate(diagram, t_end="10 ms")
     assert results.complete
     t, y = results["c.y"]
     np.testing.assert_allclose(t, [0.0, 0.002, 0.004, 0.006, 0.008, 0.010])

@@ -190,7 +190,7 @@ def check_composed(case, ticks, tmp_path) -> None:
     if t_end is None:
         return
     assert programs(diagram, t_end) == [rename(p) for p in programs(flat, t_end)]
-    a, b = blocks.engine.simulate(flat, t_end=t_end), blocks.engine.simulate(diagram, t_end=t_end)
+    a, b = blocks.simulate(flat, t_end=t_end), blocks.simulate(diagram, t_end=t_end)
     assert b.status == rename(a.status)
     assert set(b) == {rename(s) for s in a}
     for signal in a:
