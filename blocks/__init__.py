@@ -8,6 +8,8 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 
 import importlib
 
+from blocks.builder.records import use_params_reader as _use_params_reader
+
 _EXPORTS = {
     ".block": ("Block", "BlockError", "EndRun", "ParameterError"),
     ".builder.diagram_builder": ("DiagramBuilder",),
@@ -29,6 +31,18 @@ signal handlers from before anything else) does not import numpy and the rest.""
 _HOME = {name: module for module, names in _EXPORTS.items() for name in names}
 
 __all__ = sorted(_HOME)
+
+
+def _read_params_file(path):
+    """A params file read as the diagram file reads one (YAML): the reader of the builders
+    made in Python. It is given here, at the package's root, since the builder knows no
+    file format and its front ends are a layer above it."""
+    from blocks.diagram_file.params_file import read_params_file
+
+    return read_params_file(path)
+
+
+_use_params_reader(_read_params_file)
 
 
 def __getattr__(name: str) -> object:

@@ -62,6 +62,19 @@ def parse_duration(value: object) -> Fraction:
         "with a unit: s, ms, us, ns (e.g. '0.1 ms')")
 
 
+def positive_duration(value: object, what: str) -> Fraction:
+    """``value`` as a duration longer than zero: the rule of an end time, a period and a
+    step, checked here only. DurationError otherwise, its message starting with ``what``
+    (``"time.t_end"``, ``"--t-end"``, ``"block 'g': period"``)."""
+    try:
+        seconds = parse_duration(value)
+    except DurationError as exc:
+        raise DurationError(f"{what}: {exc}") from None
+    if seconds <= 0:
+        raise DurationError(f"{what} must be positive, got {value!r}")
+    return seconds
+
+
 def format_duration(seconds: Fraction) -> str:
     """Short human text for an exact duration, in the largest unit giving a clean number."""
     if seconds == 0:

@@ -19,7 +19,7 @@ from blocks.builder.construct import Constructor
 from blocks.builder.diagram import Diagram, jsonable
 from blocks.issues import DiagramError
 from blocks.builder.scopes import expand
-from blocks.timebase import DurationError, parse_duration
+from blocks.timebase import DurationError, positive_duration
 from blocks.builder.wiring import Wiring
 
 
@@ -75,11 +75,7 @@ def end_time(ctx: BuildContext, builder: DiagramRecord) -> tuple[Fraction | None
     site: Site = builder.t_end_site or builder.site
     line = site.key("t_end")
     try:
-        t_end = parse_duration(builder.t_end)
+        return positive_duration(builder.t_end, "time.t_end"), line
     except DurationError as exc:
-        ctx.error(site.file, line, f"time.t_end: {exc}")
+        ctx.error(site.file, line, str(exc))
         return None, line
-    if t_end <= 0:
-        ctx.error(site.file, line, f"time.t_end must be positive, got {builder.t_end!r}")
-        return None, line
-    return t_end, line

@@ -21,7 +21,7 @@ from typing import Any, Mapping, NamedTuple
 
 from blocks.block import Block, ParameterError
 from blocks.builder.context import BuildContext, known, suggest
-from blocks.builder.records import BlockEntry, Site
+from blocks.builder.records import BlockEntry, Site, SourceError, default_params_reader
 from blocks.builder.diagram import BlockSpec
 from blocks.limits import MAX_PORT_WIDTH
 from blocks.builder.param_paths import PathError, set_path
@@ -29,22 +29,15 @@ from blocks.builder.references import build_order, chain_text
 from blocks.registry import PYTHON_PREFIX, RegistryError, block_types, resolve_type
 from blocks.safepath import inside
 from blocks.builder.scopes import NOT_A_NAME, SUBSYSTEM, UNKNOWN, Bound, Level, Override, resolve_reference
-from blocks.timebase import DurationError, parse_duration
-from blocks.diagram_file.yaml_source import (
-    LineDict,
-    YamlSourceError,
-    line_at,
-    line_of,
-    load_yaml,
-    read_yaml_file,
-)
+from blocks.timebase import DurationError, parse_duration, positive_duration
 
 
 class ParamsFile(NamedTuple):
-    """A block's params file: its path and its content (a LineDict, or {} when empty)."""
+    """A block's params file: its content and where it is (its path, and the lines of its
+    parameters when its front end knows them)."""
 
-    path: str
     data: Mapping
+    site: Site
 
 
 @dataclass
@@ -213,16 +206,16 @@ class Constructor:
                 self.module_files(level, cls)
         period = offset = None
         if entry.period is not None:
-            period = self.duration(site, "period", entry.period, f"block '{name}' period")
-            if period is not None and period <= 0:
-                self.error(site, "period", f"block '{name}': period must be positive, got {entry.period!r}",
-                           "write e.g. period: 1 ms; leave it out to inherit")
-                period = None
-            elif period is None:
+            try:
+                period = positive_duration(entry.period, f"block '{name}': period")
+            except DurationError as exc:
+                self.error(site, "period", str(exc), "write e.g. period: 1 ms; leave it out to inherit")
                 return None
         if entry.offset is not None:
-            offset = self.duration(site, "offset", entry.offset, f"block '{name}' offset")
-            if offset is None:
+            try:
+                offset = parse_duration(entry.offset)
+            except DurationError as exc:
+                self.error(site, "offset", f"block '{name}': offset: {exc}")
                 return None
             if period is None:
                 self.error(site, "offset", f"block '{name}': an offset needs a period", "add period: ... to the block")
@@ -265,13 +258,6 @@ class Constructor:
         params = dict(entry.block.constructor_arguments())
         return Placed(name, level, entry, cls, period, offset, params, instance=entry.block) if ok else None
 
-    def duration(self, site: Site, key: str, value: Any, what: str) -> Fraction | None:
-        try:
-            return parse_duration(value)
-        except DurationError as exc:
-            self.error(site, key, f"{what}: {exc}")
-            return None
-
     def module_files(self, level: Level, cls: type) -> None:
         """Record the files of a ``python:`` type's module when it comes from the diagram's
         folder (a package: every .py file in it); installed modules are not the diagram's."""
@@ -303,15 +289,14 @@ class Constructor:
         declared = cls.parameters()
         accepts_any = cls.accepts_any_parameter()
         ok = True
-        given = [(inline, site.file, site.key("params"))]
+        given = [(inline, site.within("params"))]
         if source is not None:
-            given.insert(0, (source.data, source.path, 1))
-        for mapping, file, default_line in given:
+            given.insert(0, (source.data, source.site))
+        for mapping, where in given:
             for key in mapping:
                 if key not in declared and not accepts_any:
-                    self.ctx.error(file, line_of(mapping, key, default_line),
-                                   f"block '{name}' ({cls.registered_name()}) has no parameter {key!r}",
-                                   suggest(key, declared) or f"parameters: {known(declared)}")
+                    self.ctx.add(where.issue(f"block '{name}' ({cls.registered_name()}) has no parameter {key!r}",
+                                             suggest(key, declared) or f"parameters: {known(declared)}", key=key))
                     ok = False
         for ov in level.overrides.get(level.name_of(name), []):
             parts = list(ov.path)
@@ -361,27 +346,22 @@ class Constructor:
                        "(Python: trust=True) if you trust this diagram")
             return None
         ref = level.scope.ref(rel)
+        read = level.builder.read_params or default_params_reader()
         try:
-            text = read_yaml_file(self.ctx.files_map.get(ref, path))
-            self.ctx.found(ref, path)
-            self.ctx.hash.update(text.encode("utf-8"))
-            data = load_yaml(text)
+            found = read(self.ctx.files_map.get(ref, path))
         except FileNotFoundError:
             self.error(site, "params_file", f"block '{name}': params_file '{rel}' not found (looked at {path})",
                        "params_file is relative to the diagram's folder")
             return None
-        except YamlSourceError as exc:
+        except SourceError as exc:
             if exc.line is None:  # the file as a whole: reported where the diagram names it
                 self.error(site, "params_file", f"block '{name}': params_file '{rel}': {exc.message}", exc.hint)
             else:
                 self.ctx.error(str(path), exc.line, exc.message, exc.hint)
             return None
-        if data is None:
-            return ParamsFile(str(path), {})
-        if not isinstance(data, Mapping):
-            self.ctx.error(str(path), 1, "a params file must be a YAML mapping of parameter names to values")
-            return None
-        return ParamsFile(str(path), data)
+        self.ctx.found(ref, path)
+        self.ctx.hash.update(found.text.encode("utf-8"))
+        return ParamsFile(found.params, Site(str(path), 1, found.positions))
 
     # -- references -------------------------------------------------------------------
 
@@ -451,13 +431,12 @@ class Constructor:
                 ov.report(self.ctx, message, hint)
                 return
         site = p.site
-        inline = p.entry.params
-        line, found = line_at(inline, path) if isinstance(inline, LineDict) else (None, 0)
+        line, found = site.within("params").line_at(path) if p.entry.params is not None else (None, 0)
         file = site.file
         if p.source is not None:
-            file_line, file_found = line_at(p.source.data, path)
+            file_line, file_found = p.source.site.line_at(path)
             if file_found > found:
-                file, line, found = p.source.path, file_line, file_found
+                file, line, found = p.source.site.file, file_line, file_found
         if not found:
             line = site.key("params") if p.entry.params is not None else site.key("params_file")
         self.ctx.error(file, line, message, hint)

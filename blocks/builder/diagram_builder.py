@@ -4,11 +4,11 @@ Its calls record what a diagram says: blocks (by registered type, class or ``Blo
 instance), subsystems (another builder used as one block), connections, the diagram's
 own inputs and outputs, the block references it leaves to an including diagram, and
 the signals to log; each with where it was said (``Site``): the file and line of the
-Python call, or the YAML file's line that the loader (``blocks.diagram_file.reader``, a front end of
-this class) passes. Nothing is checked while recording; ``build()`` checks everything
-at once (``blocks.builder.assemble``) and plans the result, so every problem is one
-``file:line: message (hint: ...)`` of one ``DiagramError`` and a diagram that builds
-can run.
+Python call, or the line (and the ``Positions`` of its parts) that a front end of this
+class, such as the diagram file's loader, passes. Nothing is checked while recording;
+``build()`` checks everything at once (``blocks.builder.assemble``) and plans the
+result, so every problem is one ``file:line: message (hint: ...)`` of one
+``DiagramError`` and a diagram that builds can run.
 """
 
 from __future__ import annotations
@@ -25,6 +25,7 @@ from blocks.builder.records import (
     DiagramSource,
     LogRequest,
     PortEntry,
+    ParamsReader,
     Problem,
     ReferenceEntry,
     Site,
@@ -60,12 +61,15 @@ class DiagramBuilder(DiagramRecord):
     lead (default: the current folder). ``trust`` lets it name ``python:`` types and
     params files outside ``base_dir``; a builder made in code is trusted, one the YAML
     loader makes only with ``--trust``. ``where`` (every method) says where a problem with
-    the entry is reported; by default it is the line of the call.
+    the entry is reported; by default it is the line of the call. ``read_params`` reads its
+    params files (default: as a diagram file's, YAML; a front end gives its own).
     """
 
     def __init__(self, name: str = "diagram", description: str = "", t_end: Any = None, *,
-                 base_dir: str | Path | None = None, trust: bool = True, where: Site | None = None):
-        super().__init__(name, description, t_end, base_dir=base_dir, trust=trust, where=where or call_site())
+                 base_dir: str | Path | None = None, trust: bool = True, where: Site | None = None,
+                 read_params: ParamsReader | None = None):
+        super().__init__(name, description, t_end, base_dir=base_dir, trust=trust, where=where or call_site(),
+                         read_params=read_params)
 
     # -- what a diagram says ----------------------------------------------------------
 

@@ -1,9 +1,11 @@
 """What a diagram records before it is built: its entries, each with where it was said.
 
-A ``DiagramBuilder`` (``blocks.builder.diagram_builder``) fills a ``DiagramRecord`` from Python calls, the
-YAML loader from a file; the build (``blocks.builder.assemble``) reads it. Each entry keeps its
-``Site``: the file and line of the Python call, or of the YAML text, with the mapping it
-was written as, so that a problem with any part of it is reported where that part is.
+A ``DiagramBuilder`` (``blocks.builder.diagram_builder``) fills a ``DiagramRecord`` from Python calls, a
+front end (the YAML file's, an SSP's) from a file; the build (``blocks.builder.assemble``) reads
+it. Each entry keeps its ``Site``: the file and line of the Python call, or of the text,
+with the ``Positions`` of its parts, so that a problem with any part of it is reported
+where that part is. The builder knows no file format: a front end answers ``Positions``
+for its text, and reads the params files its diagrams name (``ParamsReader``).
 """
 
 from __future__ import annotations
@@ -12,32 +14,109 @@ import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, Callable, Mapping, Protocol, Sequence
 
 from blocks.issues import Issue
-from blocks.diagram_file.yaml_source import LineDict
 
 if TYPE_CHECKING:
     from blocks.builder.diagram import FileScope
 
 
+class Positions(Protocol):
+    """Where the parts of a value a front end read are written (the YAML front end's
+    mappings and lists answer this for their text)."""
+
+    def line_at(self, path: Sequence[Any]) -> tuple[int | None, int]:
+        """The line of the deepest part of ``path`` (mapping keys and list indices,
+        ``("params", "fingers", 1)``) that is written, and how many of its parts are (0:
+        none; the line is then the value's own, if known)."""
+
+
+@dataclass(frozen=True, slots=True)
+class _Part:
+    """The positions of the part under ``key`` of a value whose positions are ``whole``."""
+
+    whole: Positions
+    key: Any
+
+    def line_at(self, path: Sequence[Any]) -> tuple[int | None, int]:
+        line, found = self.whole.line_at((self.key, *path))
+        return line, max(found - 1, 0)
+
+
 @dataclass(frozen=True, slots=True)
 class Site:
-    """Where part of a diagram was said: a file and line, and for YAML the mapping it was
-    written as (a ``LineDict``), whose keys know their own lines."""
+    """Where part of a diagram was said: a file and line, and for a front end's text the
+    ``Positions`` of the entry's parts (None: a Python call, whose parts are all at its
+    line)."""
 
     file: str
     line: int | None = None
-    mapping: Any = None
+    positions: Positions | None = None
+
+    def line_at(self, path: Sequence[Any]) -> tuple[int | None, int]:
+        """The line of the deepest part of ``path`` written in the entry and how many of
+        its parts are; (the site's line, 0) when none is."""
+        if self.positions is not None:
+            line, found = self.positions.line_at(tuple(path))
+            if found:
+                return line, found
+        return self.line, 0
 
     def key(self, key: Any) -> int | None:
-        """The line of ``key`` in the mapping, or the site's line (a Python call's line)."""
-        if isinstance(self.mapping, LineDict) and key in self.mapping:
-            return self.mapping.line_of(key)
-        return self.line
+        """The line of ``key`` in the entry, or the site's line (a Python call's line)."""
+        return self.line_at((key,))[0]
+
+    def within(self, key: Any) -> "Site":
+        """The site of the value written under ``key`` (a Python call's: this one)."""
+        line, found = self.line_at((key,))
+        if not found:
+            return self if self.positions is None else Site(self.file, self.line)
+        return Site(self.file, line, _Part(self.positions, key))
 
     def issue(self, message: str, hint: str = "", key: Any = None) -> Issue:
         return Issue(self.file, self.line if key is None else self.key(key), message, hint)
+
+
+class SourceError(Exception):
+    """A file a front end cannot read for the builder (a params file): ``message`` at
+    ``line`` (1-based; None: the file as a whole), with a hint."""
+
+    def __init__(self, message: str, line: int | None, hint: str = ""):
+        super().__init__(message)
+        self.message = message
+        self.line = line
+        self.hint = hint
+
+
+@dataclass(frozen=True, slots=True)
+class ParamsText:
+    """A params file as a front end read it: its text (the diagram's hash covers it), its
+    parameters (a mapping, empty for an empty file) and where they are written."""
+
+    text: str
+    params: Mapping
+    positions: Positions | None = None
+
+
+ParamsReader = Callable[[Path], ParamsText]
+"""Reads the params file at a path: FileNotFoundError when there is none, SourceError when
+it cannot be read as one."""
+
+_default_reader: ParamsReader | None = None
+
+
+def use_params_reader(reader: ParamsReader) -> None:
+    """Read the params files of builders made without a reader (``DiagramBuilder`` in
+    Python) with ``reader``: the package's root gives the diagram file's, since the
+    builder knows no file format."""
+    global _default_reader
+    _default_reader = reader
+
+
+def default_params_reader() -> ParamsReader | None:
+    """The reader ``use_params_reader`` gave, if any."""
+    return _default_reader
 
 
 def call_site(depth: int = 2) -> Site:
@@ -148,13 +227,16 @@ class DiagramRecord:
     """A diagram as recorded: its fields and entries, in the order given."""
 
     def __init__(self, name: Any = "diagram", description: Any = "", t_end: Any = None, *,
-                 base_dir: str | Path | None = None, trust: bool = True, where: Site):
+                 base_dir: str | Path | None = None, trust: bool = True, where: Site,
+                 read_params: ParamsReader | None = None):
         self.site = where
+        self.read_params = read_params
+        """How its params files are read (None: ``default_params_reader``)."""
         self.name = name
         self.description = description
         self.t_end = t_end
         self.t_end_site: Site | None = None
-        """Where the end time is written (a YAML ``time`` mapping); None: ``site``."""
+        """Where the end time is written (a YAML ``time`` mapping, with a ``t_end`` key); None: ``site``."""
         self.base_dir = Path(base_dir) if base_dir is not None else Path.cwd()
         self.trust = trust
         self.file = self.site.file

@@ -27,7 +27,6 @@ from blocks.builder.diagram import FileScope
 from blocks.issues import DiagramError
 from blocks.limits import MAX_SUBSYSTEM_BLOCKS, MAX_SUBSYSTEM_DEPTH
 from blocks.builder.records import BlockEntry, DiagramRecord, ReferenceEntry, Site, SubsystemEntry
-from blocks.diagram_file.yaml_source import LineDict
 
 NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 """A block's (or subsystem's, port's, reference's) name as a diagram writes it."""
@@ -269,7 +268,7 @@ def route_overrides(ctx: BuildContext, top: Level) -> None:
             ctx.add(site.issue(f"{level.describe()}: 'params' must be a mapping of block.param paths to values",
                                "params: {prop.k: 2.0}", key="params"))
             continue
-        inner_site = _nested(site, "params")
+        inner_site = site.within("params")
         for key, value in params.items():
             if not isinstance(key, str):
                 ctx.add(inner_site.issue(f"{level.describe()}: params key {key!r} is not a block.param path",
@@ -281,14 +280,6 @@ def route_overrides(ctx: BuildContext, top: Level) -> None:
         if level.entry is not None:
             level.params[ov.key] = ov.value
         route(ctx, level, str(ov.key).split("."), ov)
-
-
-def _nested(site: Site, key: str) -> Site:
-    """The site of the mapping under ``key`` of ``site``'s mapping (a Python call: itself)."""
-    inner = site.mapping.get(key) if isinstance(site.mapping, LineDict) else None
-    if isinstance(inner, LineDict):
-        return Site(site.file, site.key(key), inner)
-    return site
 
 
 def route(ctx: BuildContext, level: Level, parts: list[str], ov: Override) -> None:
@@ -335,7 +326,7 @@ def _bind(ctx: BuildContext, level: Level) -> None:
                            "bind: {plant: hand}", key="bind"))
         level.bindings = dict.fromkeys(level.references)
         return
-    inner_site = _nested(site, "bind")
+    inner_site = site.within("bind")
     for key in bind:
         if key not in level.references:
             ctx.add(inner_site.issue(f"{level.describe()} declares no reference {key!r}",

@@ -60,22 +60,15 @@ def load(args: argparse.Namespace):
 
 
 def end_time(args: argparse.Namespace, diagram):
-    """The end time: --t-end if given (checked), else the diagram's; DiagramError if neither."""
-    from blocks import DiagramError
-    from blocks.timebase import DurationError, parse_duration
+    """The end time: --t-end if given (checked), else the diagram's; DiagramError if neither
+    (``blocks.engine.simulate.run_end_time``), UsageError for a bad --t-end."""
+    from blocks.engine.simulate import run_end_time
+    from blocks.timebase import DurationError
 
-    if args.t_end is None:
-        if diagram.t_end is None:
-            raise DiagramError([diagram.issue(None, "no end time", "add time: {t_end: 1 s} to the "
-                                              "diagram or pass --t-end")])
-        return diagram.t_end
     try:
-        t_end = parse_duration(args.t_end)
+        return run_end_time(diagram, args.t_end, "--t-end")
     except DurationError as exc:
-        raise UsageError(f"--t-end: {exc}") from None
-    if t_end <= 0:
-        raise UsageError(f"--t-end must be positive, got {args.t_end!r}")
-    return t_end
+        raise UsageError(str(exc)) from None
 
 
 def png_output(path: Path) -> Path:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Mapping
 
 from blocks.builder.api_args import boolean
 
@@ -27,6 +27,7 @@ from blocks.builder.context import known, suggest
 from blocks.issues import DiagramError, Issue
 from blocks.safepath import inside
 from blocks.builder.scopes import NAME
+from blocks.diagram_file.params_file import read_params_file
 from blocks.diagram_file.yaml_source import (
     LineDict,
     LineList,
@@ -156,7 +157,9 @@ class _FrontEnd:
         self.trust = trust
         self.b: DiagramBuilder | None = None
 
-    def site(self, line: int | None, mapping: Any = None) -> Site:
+    def site(self, line: int | None, mapping: LineDict | None = None) -> Site:
+        """The builder's site of an entry at ``line``, written as ``mapping`` (whose keys
+        know their lines: the builder's ``Positions``)."""
         return Site(self.file, line, mapping)
 
     def fail(self, line: int | None, message: str, hint: str = "", name: str | None = None) -> None:
@@ -177,7 +180,8 @@ class _FrontEnd:
             raise DiagramError([Issue(self.file, getattr(data, "line", 1) or 1, "a diagram must be a YAML mapping",
                                       f"top-level keys are: {known(TOP_KEYS)}")])
         b = self.b = DiagramBuilder(data.get("name", Path(self.file).stem), data.get("description", ""),
-                                    base_dir=self.base_dir, trust=self.trust, where=self.site(1, data))
+                                    base_dir=self.base_dir, trust=self.trust, where=self.site(1, data),
+                                    read_params=read_params_file)
         b.label = self.file
         b.texts.append(text)
         b.files_map = self.reading.files_map

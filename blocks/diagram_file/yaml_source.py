@@ -58,6 +58,11 @@ class LineDict(dict):
     def line_of(self, key: Any) -> int:
         return self.key_lines.get(key, self.line)
 
+    def line_at(self, path: Sequence[Any]) -> tuple[int | None, int]:
+        """Where the value at ``path`` inside this mapping is written (``line_at``): the
+        builder's ``Positions`` of a mapping read from YAML."""
+        return line_at(self, path)
+
     def __deepcopy__(self, memo: dict) -> "LineDict":
         """A copy with its lines, made directly (copy's generic way is slow, and every
         block's parameters are copied once per load)."""
@@ -75,6 +80,10 @@ class LineList(list):
 
     def line_of(self, index: int) -> int:
         return self.item_lines[index] if 0 <= index < len(self.item_lines) else self.line
+
+    def line_at(self, path: Sequence[Any]) -> tuple[int | None, int]:
+        """Where the value at ``path`` inside this sequence is written (``line_at``)."""
+        return line_at(self, path)
 
     def __deepcopy__(self, memo: dict) -> "LineList":
         """A copy with its lines, made directly (as LineDict's)."""

@@ -18,6 +18,7 @@ complete; ``info["ended_by"]`` says which block asked, when, why, and where it e
 from __future__ import annotations
 
 import time
+from fractions import Fraction
 from typing import Any, Callable
 
 from blocks.engine.binding import Binding
@@ -33,7 +34,7 @@ from blocks.engine.reference_loop import ReferenceLoop
 from blocks.results.signals import Results
 from blocks.results.record import PortInfoFailure, StopRequest, port_info, results_of
 from blocks.engine.schedule import build_schedule
-from blocks.timebase import DurationError, format_duration, parse_duration
+from blocks.timebase import DurationError, format_duration, positive_duration
 
 __all__ = ["ENGINES", "MAX_LOG_BYTES", "ProgressCallback", "SimulationError", "StopRequest", "simulate"]
 
@@ -73,7 +74,10 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     unless ``check_finite`` is False.
     """
     boolean("raise_on_failure", raise_on_failure)
-    t_end = _end_time(diagram, t_end)
+    try:
+        t_end = run_end_time(diagram, t_end)
+    except DurationError as exc:
+        raise DiagramError([diagram.issue(None, str(exc))]) from None
     refused = diagram.open_issue()
     if refused is not None:
         raise DiagramError([refused])
@@ -138,19 +142,16 @@ def _finish(binding: Binding, outcome: Outcome) -> Outcome:
     return outcome
 
 
-def _end_time(diagram: Diagram, t_end: Any):
+def run_end_time(diagram: Diagram, t_end: Any = None, what: str = "t_end") -> Fraction:
+    """The end time of a run of ``diagram``: ``t_end`` (given as ``what``: ``t_end`` to
+    ``simulate``, ``--t-end``), else the diagram's own ``time.t_end``. DiagramError when
+    there is neither; DurationError when ``t_end`` is not a positive duration."""
     if t_end is None:
         if diagram.t_end is None:
-            raise DiagramError([diagram.issue(None, "no end time given",
-                                              "set time: {t_end: 1 s} in the diagram or pass t_end")])
+            raise DiagramError([diagram.issue(None, "no end time",
+                                              f"add time: {{t_end: 1 s}} to the diagram or pass {what}")])
         return diagram.t_end
-    try:
-        t_end = parse_duration(t_end)
-    except DurationError as exc:
-        raise DiagramError([diagram.issue(None, f"t_end: {exc}")]) from None
-    if t_end <= 0:
-        raise DiagramError([diagram.issue(None, f"t_end must be positive, got {t_end}")])
-    return t_end
+    return positive_duration(t_end, what)
 
 
 def _engine(engine: str | None, table: OpTable) -> Callable[[Binding, Callable[[int], None] | None], Outcome]:

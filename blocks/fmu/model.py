@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ..limits import MAX_PORT_WIDTH
-from ..timebase import parse_duration
+from ..timebase import positive_duration
 from .description import read_description, shown_text, step_of
 from .port_types import KINDS, NOT_PORTS
 from .ports import direct_reads, group_variables, groups, initial_reads, port_name, variable_width, vectors
@@ -217,18 +217,12 @@ def isolation_choice(model: Model, isolation: Any, call_timeout: Any) -> tuple[s
         raise ValueError("parameter 'call_timeout' is for FMUs that run in a process of their own "
                          f"('isolation: process'); {model.shown} runs in the run's process, where a call "
                          "cannot be timed out")
-    return isolation, float(duration_parameter("call_timeout", call_timeout, "30 s"))
+    return isolation, float(duration_parameter("call_timeout", call_timeout))
 
 
-def duration_parameter(name: str, value: Any, example: str) -> Fraction:
-    """A block parameter that is a positive duration (ValueError naming it, with an example)."""
-    try:
-        duration = parse_duration(value)
-    except ValueError as exc:
-        raise ValueError(f"parameter '{name}' must be a duration such as '{example}': {exc}") from None
-    if duration <= 0:
-        raise ValueError(f"parameter '{name}' must be positive, got {value!r}")
-    return duration
+def duration_parameter(name: str, value: Any) -> Fraction:
+    """A block parameter that is a positive duration (ValueError naming it)."""
+    return positive_duration(value, f"parameter '{name}'")
 
 
 def float_or_none(text: Any) -> float | None:

@@ -89,7 +89,7 @@ def solver_choice(solver: Any, substep: Any) -> tuple[str, Fraction | None]:
     if solver != "euler":
         raise ValueError("parameter 'substep' is the fixed step of 'solver: euler'; CVode chooses its own "
                          "steps (drop 'substep', or add 'solver: euler')")
-    return solver, duration_parameter("substep", substep, "1 ms")
+    return solver, duration_parameter("substep", substep)
 
 
 def integration(solver: str, substep: Fraction | None, default_step: Fraction | None, tolerance: float,

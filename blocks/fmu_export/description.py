@@ -3,7 +3,7 @@
 Co-simulation only, FMI 2.0 or 3.0, every variable a Float64 (FMI 2 Real) scalar:
 inputs (continuous, a start value), outputs (``initial="calculated"``), parameters
 (``variability="fixed"``, settable until initialization ends). Units are declared once in
-``UnitDefinitions`` (with their SI base units where the unit is made of known symbols)
+``UnitDefinitions`` (with their SI base units where pint reads the unit: ``blocks.units``)
 and named by every variable that has one. The step rules say what the binary does: the
 internal step is the communication grid (``fixedInternalStepSize``, FMI 2: in a vendor
 annotation), any whole multiple of it is taken (``canHandleVariableCommunicationStepSize``),
@@ -12,59 +12,11 @@ FMU states can be got, set and serialized.
 
 from __future__ import annotations
 
-import re
 from fractions import Fraction
 from xml.etree import ElementTree as ET
 
+from ..units import base_unit
 from .variables import VR_TIME, Variable, Variables
-
-BASE_UNITS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
-_SYMBOLS: dict[str, dict[str, int]] = {
-    "kg": {"kg": 1}, "g": {"kg": 1}, "m": {"m": 1}, "s": {"s": 1}, "A": {"A": 1}, "K": {"K": 1},
-    "mol": {"mol": 1}, "cd": {"cd": 1}, "rad": {"rad": 1}, "N": {"kg": 1, "m": 1, "s": -2},
-    "J": {"kg": 1, "m": 2, "s": -2}, "W": {"kg": 1, "m": 2, "s": -3}, "Pa": {"kg": 1, "m": -1, "s": -2},
-    "Hz": {"s": -1}, "V": {"kg": 1, "m": 2, "s": -3, "A": -1},
-}
-_FACTORS = {"g": 1e-3}
-_SCALED = {"deg": ("rad", 3.141592653589793 / 180.0), "min": ("s", 60.0), "h": ("s", 3600.0)}
-"""Units that are a known symbol times a factor."""
-_PREFIXES = {"n": 1e-9, "u": 1e-6, "µ": 1e-6, "m": 1e-3, "c": 1e-2, "k": 1e3, "M": 1e6, "G": 1e9}
-_TOKEN = re.compile(r"^([A-Za-zµ]+)(?:\^?(-?\d+))?$")
-
-
-def _symbol(token: str) -> tuple[dict[str, int], float] | None:
-    """A unit symbol's base-unit exponents and factor: a known symbol, a scaled one
-    (``deg``), or an SI prefix before a known symbol (``mm``, ``kN``, ``ms``)."""
-    if token in _SYMBOLS:
-        return _SYMBOLS[token], _FACTORS.get(token, 1.0)
-    if token in _SCALED:
-        symbol, factor = _SCALED[token]
-        return _SYMBOLS[symbol], factor
-    if len(token) > 1 and token[0] in _PREFIXES and token[1:] in _SYMBOLS:
-        return _SYMBOLS[token[1:]], _PREFIXES[token[0]] * _FACTORS.get(token[1:], 1.0)
-    return None
-
-
-def base_units(unit: str) -> tuple[dict[str, int], float] | None:
-    """The SI base-unit exponents and factor of ``unit`` ("N m", "m/s^2", "1/(N m)", "mm",
-    "deg/s"), or None when it holds a symbol not known here ("1" is dimensionless: no
-    exponents); such a unit is declared without a BaseUnit."""
-    numerator, _, denominator = unit.partition("/")
-    exponents: dict[str, int] = {}
-    factor = 1.0
-    for text, sign in ((numerator, 1), (denominator, -1)):
-        for token in text.replace("(", " ").replace(")", " ").replace("*", " ").split():
-            if token == "1":
-                continue
-            m = _TOKEN.match(token)
-            known = None if m is None else _symbol(m.group(1))
-            if known is None:
-                return None
-            power = sign * int(m.group(2) or 1)
-            for base, e in known[0].items():
-                exponents[base] = exponents.get(base, 0) + e * power
-            factor *= known[1] ** power
-    return {k: e for k, e in exponents.items() if e}, factor
 
 
 def _units(root: ET.Element, variables: list[Variable], extra: tuple[str, ...] = ()) -> None:
@@ -74,13 +26,9 @@ def _units(root: ET.Element, variables: list[Variable], extra: tuple[str, ...] =
     block = ET.SubElement(root, "UnitDefinitions")
     for name in names:
         unit = ET.SubElement(block, "Unit", name=name)
-        found = base_units(name)
+        found = base_unit(name)
         if found is not None:
-            exponents, factor = found
-            attrs = {k: str(e) for k, e in exponents.items()}
-            if factor != 1.0:
-                attrs["factor"] = repr(factor)
-            ET.SubElement(unit, "BaseUnit", **attrs)
+            ET.SubElement(unit, "BaseUnit", **found.attributes())
 
 
 def model_description(fmi: int, identifier: str, token: str, model: str, description: str, variables: Variables,

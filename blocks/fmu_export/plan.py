@@ -38,7 +38,7 @@ from blocks.engine.schedule import (
     initial_outputs_program,
     lazy_outputs_program,
 )
-from ..timebase import DurationError, parse_duration
+from ..timebase import DurationError, positive_duration
 
 OPEN_END = MAX_TICKS // 2
 """The table's length in base ticks: no end but the importer's stop time."""
@@ -98,11 +98,11 @@ def plan_export(diagram: Diagram, output_blocks: set[str], step=None) -> Plan:
 def _step(diagram: Diagram, step, grid: Fraction) -> Fraction:
     """``step`` (a duration) as seconds; DiagramError unless a positive multiple of ``grid``."""
     try:
-        value = parse_duration(step)
+        value = positive_duration(step, "step")
     except DurationError as exc:
-        raise DiagramError([diagram.issue(None, f"step: {exc}")]) from None
-    if value <= 0 or (value / grid).denominator != 1:
-        raise DiagramError([diagram.issue(None, f"the step {step} is not a positive multiple of the FMU's "
+        raise DiagramError([diagram.issue(None, str(exc))]) from None
+    if (value / grid).denominator != 1:
+        raise DiagramError([diagram.issue(None, f"the step {step} is not a multiple of the FMU's "
                                           f"internal step {float(grid):g} s", f"use a multiple of {float(grid):g} s")])
     return value
 

@@ -12,9 +12,11 @@ import zipfile
 from pathlib import Path
 from typing import Any
 
+from .. import units
 from .xml import MAX_XML_BYTES, local, q
 
-BASE_ATTRIBUTES = ("kg", "m", "s", "A", "K", "mol", "cd", "rad", "factor", "offset")
+BASE_ATTRIBUTES = (*units.BASE_ATTRIBUTES.values(), "factor", "offset")
+"""The attributes of an ``ssc:BaseUnit``, as of an FMU's ``BaseUnit``."""
 
 
 def unit_definitions(fmu: str | Path) -> dict[str, dict[str, str]]:

@@ -259,3 +259,59 @@ def test_a_diagram_file_read_into_a_builder_is_a_subsystem_from_python(tmp_path)
     assert list(d.files.values()) == [tmp_path / "double.yaml"]
     assert simulate(d)["d.g.y"][1][-1, 0] == 5.0
     assert d.subsystems["d"].file == str(tmp_path / "double.yaml")
+
+
+def gain_from_file(folder: Path, params_file: str, **options) -> tuple[DiagramBuilder, list[blocks.Issue]]:
+    """A builder of a Gain whose parameters are in ``params_file``, and the issues of its build."""
+    b = DiagramBuilder("p", base_dir=folder, **options)
+    b.add("c", "Constant", params={"value": 1.0})
+    b.add("g", "Gain", period="1 ms", params_file=params_file)
+    b.connect("c.y", "g.u")
+    with pytest.raises(DiagramError) as info:
+        b.build()
+    return b, info.value.issues
+
+
+def test_a_params_file_named_in_python_is_read_as_a_diagram_files_and_its_problems_are_at_its_lines(tmp_path):
+    (tmp_path / "gains.yaml").write_text("k: 3.0\n\nkk: 1.0\n")
+    b, [issue] = gain_from_file(tmp_path, "gains.yaml")
+    assert (issue.file, issue.line) == (str(tmp_path / "gains.yaml"), 3)
+    (tmp_path / "gains.yaml").write_text("k: 3.0\n")
+    assert b.build().blocks["g"].params == {"k": 3.0}
+
+
+class JsonParams:
+    """A front end's reader of params files in another format (JSON, one parameter a line):
+    the builder reports a problem at the line this reader says its parameter is on."""
+
+    def __init__(self, lines: dict[str, int]):
+        self.lines = lines
+
+    def line_at(self, path):
+        return (self.lines[path[0]], 1) if path and path[0] in self.lines else (None, 0)
+
+    def __call__(self, path: Path):
+        import json
+
+        from blocks.builder.records import ParamsText, SourceError
+
+        text = path.read_text()
+        try:
+            params = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise SourceError(f"not JSON: {exc.msg}", exc.lineno) from None
+        return ParamsText(text, params, JsonParams({k: i for i, line in enumerate(text.splitlines(), 1)
+                                                    for k in params if f'"{k}"' in line}))
+
+
+def test_the_builder_reads_params_files_with_the_reader_its_front_end_gives_it(tmp_path):
+    """It knows no file format: a reader of JSON gives it the parameters and their lines."""
+    (tmp_path / "gains.json").write_text('{\n "k": 4.0,\n "kk": 1.0\n}\n')
+    b, [issue] = gain_from_file(tmp_path, "gains.json", read_params=JsonParams({}))
+    assert (issue.file, issue.line, issue.hint) == (str(tmp_path / "gains.json"), 3, "did you mean 'k'?")
+    (tmp_path / "gains.json").write_text('{\n "k": 4.0,\n')
+    with pytest.raises(DiagramError) as info:
+        b.build()
+    assert [(i.file, i.line) for i in info.value.issues] == [(str(tmp_path / "gains.json"), 3)]
+    (tmp_path / "gains.json").write_text('{"k": 4.0}')
+    assert b.build().blocks["g"].params == {"k": 4.0}

@@ -93,17 +93,32 @@ def test_the_blocks_modules_import_each_other_without_a_cycle():
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c + [c[0]]) for c in cycles)
 
 
-LAYERS = ["blocks.issues", "blocks.builder.diagram", "blocks.builder.records", "blocks.engine.schedule", "blocks.builder.assemble", "blocks.builder.diagram_builder",
+LAYERS = ["blocks.issues", "blocks.builder.diagram", "blocks.builder.records", "blocks.engine.schedule",
+          "blocks.builder.assemble", "blocks.builder.diagram_builder", "blocks.diagram_file.params_file",
           "blocks.diagram_file.reader", "blocks.diagram_file.load", "blocks.engine.simulate"]
 """The core modules from the lowest layer up: data, what a diagram records, planner, the
-checks that make a Diagram, the builder (checks + planner), its YAML front end, load
-(front end + builder), executor."""
+checks that make a Diagram, the builder (checks + planner), its YAML front end (the params
+files it reads for the builder, the diagram file), load (front end + builder), executor."""
 
 
 @pytest.mark.parametrize("lower, higher", [(a, b) for i, a in enumerate(LAYERS) for b in LAYERS[i + 1:]])
 def test_a_lower_layer_never_reaches_a_higher_one(lower, higher):
     graph = import_graph()
     assert not nx.has_path(graph, lower, higher), " -> ".join(nx.shortest_path(graph, lower, higher))
+
+
+def in_package(package: str) -> list[str]:
+    """The modules of ``package`` (``blocks.builder``), the package itself included."""
+    return sorted(m for m in MODULES if m == package or m.startswith(package + "."))
+
+
+@pytest.mark.parametrize("module", in_package("blocks.builder"))
+def test_the_builder_imports_no_front_end(module):
+    """The builder knows no file format: its front ends (``blocks.diagram_file``, YAML) are
+    a layer above it, which hands it source positions in its own form (``Site``,
+    ``Positions``) and reads the params files its diagrams name (``ParamsReader``)."""
+    bad = sorted(m for m in imported(module) if m in in_package("blocks.diagram_file") or m.split(".")[0] == "yaml")
+    assert not bad, f"{MODULES[module].relative_to(ROOT)} imports {', '.join(bad)}"
 
 
 def test_importing_the_command_line_and_sweeps_loads_no_application_code():

@@ -381,3 +381,41 @@ def test_an_interrupt_inside_one_long_advance_span_records_the_time_reached():
     t, y = r["acc.y"]
     assert t[-1] == pytest.approx(reached) and y[-1, 0] == 2 * ADVANCE_CHUNK
     assert r.info["t_stop"] == pytest.approx(reached)
+
+
+@pytest.mark.parametrize("t_end", ["0", "-1 ms", "soon", "1e20 s"])
+def test_an_end_time_is_checked_by_one_rule_wherever_it_is_given(t_end):
+    """In the diagram file, to ``simulate`` and as ``--t-end``, a bad end time is refused
+    with one message, after the name it was given by."""
+    import argparse
+
+    from blocks.cli.options import end_time
+    from blocks.cli.program import UsageError
+    from blocks.issues import DiagramError
+
+    text = "blocks:\n  c: {type: Constant, period: 1 ms, params: {value: 1.0}}\n"
+    with pytest.raises(DiagramError) as in_file:
+        loads_diagram(f"time: {{t_end: '{t_end}'}}\n" + text)
+    diagram = loads_diagram(text)
+    with pytest.raises(DiagramError) as in_python:
+        simulate(diagram, t_end=t_end)
+    with pytest.raises(UsageError) as in_cli:
+        end_time(argparse.Namespace(t_end=t_end), diagram)
+    said = [in_file.value.issues[0].message, in_python.value.issues[0].message, str(in_cli.value)]
+    names = ["time.t_end", "t_end", "--t-end"]
+    assert all(message.startswith(name) for message, name in zip(said, names))
+    assert len({message.removeprefix(name) for message, name in zip(said, names)}) == 1
+
+
+def test_without_an_end_time_a_run_is_refused_the_same_way_from_python_and_the_command_line():
+    import argparse
+
+    from blocks.cli.options import end_time
+    from blocks.issues import DiagramError
+
+    diagram = loads_diagram("blocks:\n  c: {type: Constant, period: 1 ms, params: {value: 1.0}}\n")
+    with pytest.raises(DiagramError) as in_python:
+        simulate(diagram)
+    with pytest.raises(DiagramError) as in_cli:
+        end_time(argparse.Namespace(t_end=None), diagram)
+    assert in_python.value.issues[0].message == in_cli.value.issues[0].message == "no end time"

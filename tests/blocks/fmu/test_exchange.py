@@ -320,7 +320,7 @@ def test_the_defaults_come_from_the_default_experiment(me):
     ("solver: rk4", "parameter 'solver' must be one of cvode, euler, got 'rk4'"),
     ("substep: 1 ms", "parameter 'substep' is the fixed step of 'solver: euler'; CVode chooses its own steps"),
     ("solver: euler, substep: -1 ms", "parameter 'substep' must be positive"),
-    ("solver: euler, substep: fast", "parameter 'substep' must be a duration such as '1 ms'"),
+    ("solver: euler, substep: fast", "parameter 'substep': cannot read 'fast' as a duration"),
     ("interface: exchange", "parameter 'interface' must be one of co_simulation, model_exchange, got 'exchange'"),
     ("interface: co_simulation", "has no co-simulation interface (it provides only model exchange); drop "
                                  "'interface: co_simulation' to run it as model exchange"),
