@@ -8,7 +8,7 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 
 import importlib
 
-from blocks.builder.records import use_params_reader as _use_params_reader
+from blocks.builder.params_reader import use_params_reader as _use_params_reader
 
 _EXPORTS = {
     ".block": ("Block", "BlockError", "EndRun", "ParameterError"),

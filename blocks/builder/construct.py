@@ -21,7 +21,8 @@ from typing import Any, Mapping, NamedTuple
 
 from blocks.block import Block, ParameterError
 from blocks.builder.context import BuildContext, known, suggest
-from blocks.builder.records import BlockEntry, Site, SourceError, default_params_reader
+from blocks.builder.params_reader import default_params_reader
+from blocks.builder.records import BlockEntry, Site, SourceError
 from blocks.builder.diagram import BlockSpec
 from blocks.limits import MAX_PORT_WIDTH
 from blocks.builder.param_paths import PathError, set_path

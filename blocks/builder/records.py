@@ -103,22 +103,6 @@ ParamsReader = Callable[[Path], ParamsText]
 """Reads the params file at a path: FileNotFoundError when there is none, SourceError when
 it cannot be read as one."""
 
-_default_reader: ParamsReader | None = None
-
-
-def use_params_reader(reader: ParamsReader) -> None:
-    """Read the params files of builders made without a reader (``DiagramBuilder`` in
-    Python) with ``reader``: the package's root gives the diagram file's, since the
-    builder knows no file format."""
-    global _default_reader
-    _default_reader = reader
-
-
-def default_params_reader() -> ParamsReader | None:
-    """The reader ``use_params_reader`` gave, if any."""
-    return _default_reader
-
-
 def call_site(depth: int = 2) -> Site:
     """The file and line of the caller's caller (a builder method's caller)."""
     frame = sys._getframe(depth)
@@ -231,7 +215,7 @@ class DiagramRecord:
                  read_params: ParamsReader | None = None):
         self.site = where
         self.read_params = read_params
-        """How its params files are read (None: ``default_params_reader``)."""
+        """How its params files are read (None: ``blocks.builder.params_reader``)."""
         self.name = name
         self.description = description
         self.t_end = t_end

@@ -31,7 +31,6 @@ import sys
 import threading
 from pathlib import Path
 
-import blocks
 from blocks.block import BlockError
 
 STARTUP_SECONDS = 120.0
@@ -73,7 +72,7 @@ class Launcher:
 
     def __init__(self):
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
-        root = str(Path(blocks.__file__).resolve().parent.parent)  # where the blocks package is found
+        root = str(Path(__file__).resolve().parents[3])  # the folder the blocks package is in
         env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
                    PYTHONPATH=os.pathsep.join([root, *filter(None, [os.environ.get("PYTHONPATH")])]))
         command = [sys.executable, "-P", "-c", f"from blocks.fmu.isolation.forkserver import main; main({theirs.fileno()})"]
