@@ -1,6 +1,6 @@
-"""The framework's import structure: ``blocks`` never imports ``hierhand``, and the
-modules of ``blocks`` import each other without a cycle, so its layers (data -> loader ->
-planner -> executor -> results) stay layers.
+"""The project's import structure: ``blocks`` never imports ``hierhand``, the modules of
+both import each other without a cycle, and the framework's layers (data -> builder ->
+planner -> front end -> executor) stay layers.
 
 Imports are read from the source with ``ast``, wherever they stand: at module level,
 under ``if TYPE_CHECKING``, or inside a function (a deferred import is still a
@@ -28,13 +28,19 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+PROJECT = {module_name(p): p for package in ("blocks", "hierhand") for p in sorted((ROOT / package).rglob("*.py"))}
+"""Every module of the project, the framework's and the application's."""
+MODULES = {name: path for name, path in PROJECT.items() if name.split(".")[0] == "blocks"}
+"""The framework's modules."""
+TOP_LEVEL_LIMIT = 12
+"""The most modules at the top of ``blocks/``: the rest lives in subpackages, one stage or
+concern each, so that the tree shows where a change belongs."""
 
 
 def imported(module: str) -> set[str]:
     """Every module ``module`` imports: ``from pkg import sub`` counts as ``pkg.sub`` when
     that is a module, relative imports resolved."""
-    path = MODULES[module]
+    path = PROJECT[module]
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     found: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
@@ -48,18 +54,19 @@ def imported(module: str) -> set[str]:
                 source = node.module
             for alias in node.names:
                 sub = f"{source}.{alias.name}"
-                found.add(sub if sub in MODULES else source)
+                found.add(sub if sub in PROJECT else source)
+    found.discard(module)  # a package importing its compiled extension (``from . import _native``)
     return found
 
 
 @functools.lru_cache(maxsize=1)
 def import_graph() -> nx.DiGraph:
-    """The graph of who imports whom among the blocks modules, read once: the 36 layer
+    """The graph of who imports whom among the project's modules, read once: the layer
     checks each walk it, and the sources do not change while the tests run."""
     graph = nx.DiGraph()
-    graph.add_nodes_from(MODULES)
-    for module in MODULES:
-        graph.add_edges_from((module, target) for target in imported(module) if target in MODULES)
+    graph.add_nodes_from(PROJECT)
+    for module in PROJECT:
+        graph.add_edges_from((module, target) for target in imported(module) if target in PROJECT)
     return graph
 
 
@@ -87,7 +94,7 @@ def test_importing_every_blocks_module_loads_nothing_of_hierhand():
     assert proc.returncode == 0, proc.stderr
 
 
-def test_the_blocks_modules_import_each_other_without_a_cycle():
+def test_the_project_modules_import_each_other_without_a_cycle():
     graph = import_graph()
     cycles = list(nx.simple_cycles(graph))
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c + [c[0]]) for c in cycles)
@@ -105,6 +112,11 @@ files it reads for the builder, the diagram file), load (front end + builder), e
 def test_a_lower_layer_never_reaches_a_higher_one(lower, higher):
     graph = import_graph()
     assert not nx.has_path(graph, lower, higher), " -> ".join(nx.shortest_path(graph, lower, higher))
+
+
+def test_the_top_of_blocks_holds_few_modules():
+    top = sorted(p.name for p in PACKAGE.glob("*.py"))
+    assert len(top) <= TOP_LEVEL_LIMIT, f"{len(top)} modules at the top of blocks/: {', '.join(top)}"
 
 
 def in_package(package: str) -> list[str]:
