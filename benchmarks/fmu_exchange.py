@@ -72,8 +72,8 @@ log: [f.x]
 """)
             inside, isolated = diagram("none"), diagram("process")
             options = {"output_interval": 1e-3, **theirs}
-            ours = median_time(lambda: blocks.engine.simulate(inside), args.repeat)
-            apart = median_time(lambda: blocks.engine.simulate(isolated), args.repeat)
+            ours = median_time(lambda: blocks.simulate(inside), args.repeat)
+            apart = median_time(lambda: blocks.simulate(isolated), args.repeat)
             reference = median_time(lambda: fmpy.simulate_fmu(str(path), fmi_type="ModelExchange", stop_time=T_END,
                                                              record_events=False, **options), args.repeat)
             ratio = ours / reference

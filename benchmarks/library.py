@@ -129,10 +129,10 @@ def main() -> None:
     n_ticks = round(args.t_end / TICK)
 
     def framework():
-        return blocks.engine.simulate(blocks.loads_diagram(SERVO, filename="servo"), t_end=args.t_end)
+        return blocks.simulate(blocks.loads_diagram(SERVO, filename="servo"), t_end=args.t_end)
 
     def executor_only(diagram=blocks.loads_diagram(SERVO, filename="servo")):
-        return blocks.engine.simulate(diagram, t_end=args.t_end)
+        return blocks.simulate(diagram, t_end=args.t_end)
 
     t_hand, reference = timed(lambda: hand_loop(n_ticks), args.repeat)
     t_full, results = timed(framework, args.repeat)

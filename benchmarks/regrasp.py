@@ -118,7 +118,7 @@ def profile_simulate(diagram, t_end, top: int = 10) -> None:
 
     prof = cProfile.Profile()
     prof.enable()
-    blocks.engine.simulate(diagram, t_end=t_end)
+    blocks.simulate(diagram, t_end=t_end)
     prof.disable()
     print(f"cProfile of one simulate (top {top} by tottime; profiling inflates Python-side costs):")
     pstats.Stats(prof).sort_stats("tottime").print_stats(top)
@@ -138,10 +138,10 @@ def main() -> None:
 
     def full():
         d = blocks.load_diagram(REGRASP)
-        return blocks.engine.simulate(d)
+        return blocks.simulate(d)
 
     def simulate_only():
-        return blocks.engine.simulate(diagram)
+        return blocks.simulate(diagram)
 
     t_full, res = timed(full, args.repeat)
     t_sim, _ = timed(simulate_only, args.repeat)

@@ -118,7 +118,7 @@ def chain_times(n: int, repeat: int) -> tuple[float, float]:
         t0 = time.perf_counter()
         diagram = blocks.loads_diagram(text, filename=f"chain{n}")
         t1 = time.perf_counter()
-        results = blocks.engine.simulate(diagram)
+        results = blocks.simulate(diagram)
         t2 = time.perf_counter()
         if results.status != "complete" or results[f"g{n - 1}.y"][1][-1, 0] != 1.0:
             raise SystemExit(f"chain of {n} blocks: wrong run ({results.status})")
@@ -160,22 +160,22 @@ def main() -> None:
 
     def framework():
         diagram = blocks.load_diagram(TOY)
-        return blocks.engine.simulate(diagram, t_end=args.t_end)
+        return blocks.simulate(diagram, t_end=args.t_end)
 
     def executor_only(diagram=blocks.load_diagram(TOY)):
-        return blocks.engine.simulate(diagram, t_end=args.t_end)
+        return blocks.simulate(diagram, t_end=args.t_end)
 
     def executor_unchecked(diagram=blocks.load_diagram(TOY)):
-        return blocks.engine.simulate(diagram, t_end=args.t_end, check_finite=False)
+        return blocks.simulate(diagram, t_end=args.t_end, check_finite=False)
 
     block_types()[PythonSum.type_name] = PythonSum
     python_text = toy_with_python_block()
 
     def with_python_block():
-        return blocks.engine.simulate(blocks.loads_diagram(python_text, filename="toy-python.yaml"), t_end=args.t_end)
+        return blocks.simulate(blocks.loads_diagram(python_text, filename="toy-python.yaml"), t_end=args.t_end)
 
     def python_block_executor_only(diagram=blocks.loads_diagram(python_text, filename="toy-python.yaml")):
-        return blocks.engine.simulate(diagram, t_end=args.t_end)
+        return blocks.simulate(diagram, t_end=args.t_end)
 
     t_hand, ref = timed(lambda: hand_loop(n_ticks), args.repeat)
     t_full, res = timed(framework, args.repeat)

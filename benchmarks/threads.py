@@ -31,7 +31,7 @@ REGRASP = Path(__file__).resolve().parent.parent / "diagrams" / "regrasp.yaml"
 
 
 def regrasp(_: int = 0) -> blocks.Results:
-    return blocks.engine.simulate(blocks.load_diagram(REGRASP))
+    return blocks.simulate(blocks.load_diagram(REGRASP))
 
 
 def same(a: blocks.Results, b: blocks.Results) -> bool:

@@ -65,7 +65,7 @@ def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda 
     for task in TASKS:
         path = diagrams / f"{task}.yaml"
         diagram = blocks.load_diagram(path)
-        results = blocks.engine.simulate(diagram)
+        results = blocks.simulate(diagram)
         results.save(out / "runs" / task)
         if not results.complete:
             raise ReproduceError(f"{path}: {results.status} (partial results in {out / 'runs' / task})")

@@ -35,7 +35,7 @@ def separation_relation(diagram: Path) -> list[dict]:
             moved = copy.deepcopy(fore)
             moved["waypoints"] = [[w[0] + shift, *w[1:]] for w in fore["waypoints"]]
             overrides = {b.resolve("manip.trajectories.fore"): moved, b.resolve("suppress.S_b"): s_b * scale}
-            results = blocks.engine.simulate(blocks.load_diagram(diagram, overrides=overrides))
+            results = blocks.simulate(blocks.load_diagram(diagram, overrides=overrides))
             rows.append({"withdrawal_start_s": moved["waypoints"][0][0], "S_b": s_b * scale,
                          "fore_separation_time_s": regrasp_events(results, b)["fore_separation_time_s"]})
     return rows

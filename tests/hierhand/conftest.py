@@ -18,7 +18,7 @@ def native_regrasp():
     """diagrams/regrasp.yaml run natively."""
     import blocks
 
-    return blocks.engine.simulate(blocks.load_diagram(REPO / "diagrams" / "regrasp.yaml"))
+    return blocks.simulate(blocks.load_diagram(REPO / "diagrams" / "regrasp.yaml"))
 
 
 @pytest.fixture(scope="session")

@@ -39,7 +39,7 @@ log:
 def run_dir(tmp_path_factory):
     root = tmp_path_factory.mktemp("animate")
     (root / "d.yaml").write_text(DIAGRAM, encoding="utf-8")
-    results = blocks.engine.simulate(blocks.load_diagram(root / "d.yaml"))
+    results = blocks.simulate(blocks.load_diagram(root / "d.yaml"))
     assert results.complete
     return results.save(root / "run")
 
@@ -130,7 +130,7 @@ def test_default_speed_makes_about_ten_seconds_and_is_printed(run_dir, tmp_path)
 @pytest.fixture(scope="module")
 def regrasp():
     """The first 50 ms of the shipped re-grasp task: thumb and forefinger on the object."""
-    results = blocks.engine.simulate(blocks.load_diagram(ROOT / "diagrams" / "regrasp.yaml"), t_end=0.05)
+    results = blocks.simulate(blocks.load_diagram(ROOT / "diagrams" / "regrasp.yaml"), t_end=0.05)
     assert results.complete
     return results
 

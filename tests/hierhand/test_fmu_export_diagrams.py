@@ -101,7 +101,7 @@ def test_the_controller_and_the_loop_leave_as_valid_fmus_with_units(fmus, fmi):
 
 @pytest.mark.parametrize("fmi", [2, 3])
 def test_the_controller_fmu_with_the_plant_fmu_is_the_native_regrasp(fmus, fmi, native_regrasp, tmp_path):
-    via = blocks.engine.simulate(two_fmus(tmp_path, fmus["plant", fmi], fmus["ctrl", fmi], feedthrough=True))
+    via = blocks.simulate(two_fmus(tmp_path, fmus["plant", fmi], fmus["ctrl", fmi], feedthrough=True))
     assert via.complete
     for signal in COMPARED:
         np.testing.assert_array_equal(via[signal][0], native_regrasp[signal][0])
@@ -139,7 +139,7 @@ def test_a_c_host_without_python_runs_the_closed_loop_as_natively(fmus, c_host, 
 def test_a_parameter_and_what_derives_from_it_follow_as_in_a_native_run(fmus, tmp_path):
     """plant.object.mass alone: the plant's inertia follows, and so do the controller's and
     the support's models of the hand, as when a diagram sets it."""
-    native = blocks.engine.simulate(blocks.load_diagram(REGRASP, overrides={"plant.object.mass": 0.4}), t_end=0.3)
+    native = blocks.simulate(blocks.load_diagram(REGRASP, overrides={"plant.object.mass": 0.4}), t_end=0.3)
     obj = names("plant.obj", 3)
     result = simulate_fmu(extract(str(fmus["loop", 3]), tmp_path / "loop"), stop_time=0.3, output_interval=STEP,
                           output=obj, start_values={"plant.object.mass": 0.4})
@@ -202,7 +202,7 @@ def test_libcosim_runs_the_controller_fmu_with_the_plant_fmu_as_blocks_does(fmus
     in the native diagram, where the controller reads the plant's outputs of the same tick.
     Its run is the blocks run of the same two FMUs exchanged the same way (no feedthrough)."""
     rows = libcosim_run(fmus["plant", 2], fmus["ctrl", 2], 1000)
-    jacobi = blocks.engine.simulate(two_fmus(tmp_path, fmus["plant", 2], fmus["ctrl", 2], feedthrough=False))
+    jacobi = blocks.simulate(two_fmus(tmp_path, fmus["plant", 2], fmus["ctrl", 2], feedthrough=False))
     t, q = jacobi["plant.q"]
     np.testing.assert_allclose(rows, q[1:], rtol=1e-9, atol=1e-12)
 

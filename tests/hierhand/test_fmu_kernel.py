@@ -37,7 +37,7 @@ def test_regrasp_with_the_fmu_plant_is_bit_identical_through_the_kernel(plants, 
     d = blocks.load_diagram(ROOT / "diagrams" / "regrasp_fmu.yaml", overrides={"plant.path": str(plants[fmi])})
     with monkeypatch.context() as m:
         m.setattr(FMU, "kernel", lambda self: None)
-        python = blocks.engine.simulate(d)
+        python = blocks.simulate(d)
     slow: collections.Counter = collections.Counter()
     call = fmu_kernel.KernelRun.__call__
 
@@ -46,7 +46,7 @@ def test_regrasp_with_the_fmu_plant_is_bit_identical_through_the_kernel(plants, 
         return call(self, kind, t, status)
 
     monkeypatch.setattr(fmu_kernel.KernelRun, "__call__", counted)
-    compiled = blocks.engine.simulate(d)
+    compiled = blocks.simulate(d)
     assert compiled.complete and python.complete
     assert slow == {fmu_kernel.native()["kinds"]["output"]: 1}
     assert list(compiled) == list(python) and len(list(compiled)) == len(d.log)

@@ -66,7 +66,7 @@ def test_the_regrasp_leaves_as_three_components_with_units_and_a_valid_ssd(regra
 
 
 def test_the_regrasp_ssp_run_back_is_the_native_regrasp(regrasp_ssp, native_regrasp):
-    via = blocks.engine.simulate(blocks.load_diagram(regrasp_ssp[0]))
+    via = blocks.simulate(blocks.load_diagram(regrasp_ssp[0]))
     assert via.complete
     for signal in COMPARED:
         np.testing.assert_array_equal(via[signal][0], native_regrasp[signal][0])
@@ -75,10 +75,10 @@ def test_the_regrasp_ssp_run_back_is_the_native_regrasp(regrasp_ssp, native_regr
 
 def test_a_component_parameter_set_on_the_ssp_is_the_native_override(regrasp_ssp):
     key = {"ctrl.reflex.ki": 40.0, "ctrl.suppress.time_constant": 0.03}
-    native = blocks.engine.simulate(blocks.load_diagram(REGRASP, overrides=key), t_end=0.3)
-    via = blocks.engine.simulate(blocks.load_diagram(regrasp_ssp[0], overrides=key), t_end=0.3)
+    native = blocks.simulate(blocks.load_diagram(REGRASP, overrides=key), t_end=0.3)
+    via = blocks.simulate(blocks.load_diagram(regrasp_ssp[0], overrides=key), t_end=0.3)
     np.testing.assert_array_equal(via["plant.q"][1], native["plant.q"][1])
-    assert not np.array_equal(via["plant.q"][1], blocks.engine.simulate(blocks.load_diagram(regrasp_ssp[0]),
+    assert not np.array_equal(via["plant.q"][1], blocks.simulate(blocks.load_diagram(regrasp_ssp[0]),
                                                                  t_end=0.3)["plant.q"][1])
 
 
@@ -108,6 +108,6 @@ def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regras
         rows.append(observer.last_real_values(plant, q))
     without = blocks.load_diagram(jacobi_copy(unpacked, tmp_path))
     assert not any(s.params.get("feedthrough") for s in without.blocks.values())
-    jacobi = blocks.engine.simulate(without)
+    jacobi = blocks.simulate(without)
     np.testing.assert_allclose(np.array(rows), jacobi["plant.q"][1][1:], rtol=1e-9, atol=1e-12)
     assert np.abs(np.array(rows) - native_regrasp["plant.q"][1][1:]).max() > 1e-4  # the lag shows

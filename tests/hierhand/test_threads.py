@@ -35,7 +35,7 @@ def assert_same(a, b) -> None:
 
 
 def run(path: Path, overrides=None) -> blocks.Results:
-    return blocks.engine.simulate(blocks.load_diagram(path, overrides=overrides))
+    return blocks.simulate(blocks.load_diagram(path, overrides=overrides))
 
 
 def in_threads_as_serial(jobs, serial) -> None:
@@ -56,8 +56,8 @@ def test_two_equal_hands_at_once_give_the_serial_samples():
 def test_one_diagram_simulated_in_two_threads_at_once_gives_the_serial_samples():
     """Both runs step the one plant block's model, each with its own scratch."""
     d = blocks.load_diagram(REGRASP)
-    serial = blocks.engine.simulate(d)
-    in_threads_as_serial([lambda: blocks.engine.simulate(d)] * 2, [serial] * 2)
+    serial = blocks.simulate(d)
+    in_threads_as_serial([lambda: blocks.simulate(d)] * 2, [serial] * 2)
 
 
 def test_two_different_hands_at_once_give_their_serial_samples():

@@ -94,9 +94,9 @@ def test_every_task_with_the_controller_subsystem_runs_as_its_flat_diagram(task,
     a, b = blocks.build_schedule(flat, flat.t_end), blocks.build_schedule(composed, composed.t_end)
     assert [p.describe() for p in [a.initial, *a.programs]] == \
         [_flat(p.describe()) for p in [b.initial, *b.programs]]
-    results = blocks.engine.simulate(composed)
+    results = blocks.simulate(composed)
     assert results.complete
-    assert_same(blocks.engine.simulate(flat), results)
+    assert_same(blocks.simulate(flat), results)
 
 
 def test_the_tasks_differ_in_what_they_give_the_controller():
@@ -117,8 +117,8 @@ def test_the_plant_given_once_reaches_the_controllers_inside(tmp_path):
     flat_path = tmp_path / "regrasp_flat.yaml"
     flat_path.write_text(yaml.safe_dump(inlined(DIAGRAMS / "regrasp.yaml"), sort_keys=False), encoding="utf-8")
     short = "50 ms"
-    assert_same(blocks.engine.simulate(blocks.load_diagram(flat_path, overrides=heavy), t_end=short),
-                blocks.engine.simulate(composed, t_end=short))
+    assert_same(blocks.simulate(blocks.load_diagram(flat_path, overrides=heavy), t_end=short),
+                blocks.simulate(composed, t_end=short))
 
 
 def test_the_controller_validates_on_its_own_with_a_stand_in_plant():
@@ -154,7 +154,7 @@ log: [hand.contact, hand.obj]
 """, encoding="utf-8")
     d = blocks.load_diagram(path)
     assert d.blocks["brain.manip"].block.hand is d.blocks["hand"].block.hand
-    run = blocks.engine.simulate(d)
+    run = blocks.simulate(d)
     assert run.complete
     t, contact = run["hand.contact"]
     _, obj = run["hand.obj"]

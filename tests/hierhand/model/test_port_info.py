@@ -47,7 +47,7 @@ def test_finger_names_follow_the_hand():
 
 def test_a_run_records_the_units_of_its_signals(tmp_path):
     d = blocks.load_diagram(REPO / "diagrams" / "regrasp.yaml")
-    r = blocks.engine.simulate(d, t_end="20 ms")
+    r = blocks.simulate(d, t_end="20 ms")
     r.save(tmp_path)
     again = blocks.Results.load(tmp_path)
     assert again.unit("plant.q") == "rad" and again.element_labels("plant.q") == JOINTS

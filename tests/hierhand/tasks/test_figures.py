@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[3]
 
 @pytest.fixture(scope="module")
 def runs():
-    return {task: blocks.engine.simulate(blocks.load_diagram(ROOT / "diagrams" / f"{task}.yaml"))
+    return {task: blocks.simulate(blocks.load_diagram(ROOT / "diagrams" / f"{task}.yaml"))
             for task in ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed")}
 
 

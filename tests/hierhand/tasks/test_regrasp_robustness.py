@@ -33,14 +33,14 @@ def carried():
 
 @pytest.mark.parametrize("point", range(len(POINTS)))
 def test_with_the_suppresser_the_forefinger_lets_go_and_the_others_keep_the_object(carried, point):
-    run = blocks.engine.simulate(blocks.load_diagram(REGRASP, overrides=carried[point]))
+    run = blocks.simulate(blocks.load_diagram(REGRASP, overrides=carried[point]))
     assert regrasp_outcome(run) == "", POINTS[point]
 
 
 @pytest.mark.parametrize("off", SIGMOID_OFF)
 @pytest.mark.parametrize("point", range(len(POINTS)))
 def test_with_only_the_sigmoid_switched_off_the_forefinger_never_lets_go(carried, point, off):
-    run = blocks.engine.simulate(blocks.load_diagram(REGRASP, overrides={**carried[point], **by_name(ROLES, SIGMOID_OFF[off])}))
+    run = blocks.simulate(blocks.load_diagram(REGRASP, overrides={**carried[point], **by_name(ROLES, SIGMOID_OFF[off])}))
     assert unsuppressed_outcome(run) == "", POINTS[point]
 
 

@@ -141,7 +141,7 @@ def test_fig14_legend_names_the_unsuppressed_run_as_such():
 
     labels = {}
     for task in ("regrasp", "regrasp_unsuppressed"):
-        results = blocks.engine.simulate(blocks.load_diagram(ROOT / "diagrams" / f"{task}.yaml"))  # 1 s: it suppresses
+        results = blocks.simulate(blocks.load_diagram(ROOT / "diagrams" / f"{task}.yaml"))  # 1 s: it suppresses
         ax = Figure().add_subplot()
         _torque_axes(ax, results, 3, "Fig. 14")
         labels[task] = [t.get_text() for t in ax.get_legend().get_texts()]
