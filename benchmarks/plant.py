@@ -27,7 +27,7 @@ import numpy as np
 
 from hierhand import _native
 from hierhand.model import HandPlant
-from hierhand.model.layout import N_OUTPUTS
+from hierhand.layouts import OUTPUT
 
 ROOT = Path(__file__).resolve().parents[1]
 DT = 1e-4
@@ -65,7 +65,7 @@ def median_us_per_step(run_once) -> float:
 
 
 def bench_core(plant, inputs, start) -> float:
-    rows = np.empty((STEPS_PER_RUN, N_OUTPUTS))
+    rows = np.empty((STEPS_PER_RUN, OUTPUT.size))
     state = start.copy()
     model = plant._model  # the bound model: the bare core steps exactly what advance does
 

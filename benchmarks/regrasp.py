@@ -37,7 +37,7 @@ import numpy as np
 
 import blocks
 from hierhand import _native
-from hierhand.model.layout import N_OUTPUTS, OUTPUT_PORTS
+from hierhand.layouts import OUTPUT
 
 ROOT = Path(__file__).resolve().parent.parent
 REGRASP = ROOT / "diagrams" / "regrasp.yaml"
@@ -48,8 +48,7 @@ TARGET_ABOVE_CORE_MS = 4.0
 MUJOCO_MS = 71.0
 HOLD_STEPS = 2500  # the open-loop pinch holds about 0.4 s; restart every 0.25 s for the held variant
 
-_PORT_NAMES = [name for name, _ in OUTPUT_PORTS]
-_CONTACT_COL = sum(w for _, w in OUTPUT_PORTS[: _PORT_NAMES.index("contact")])  # first column of plant.contact
+_CONTACT_COL = OUTPUT.CONTACT  # first column of plant.contact
 
 
 def timed(fn, repeat: int) -> tuple[float, object]:
@@ -88,7 +87,7 @@ def core_runner(plant, n_steps: int, chunk: int, segment: int | None = None):
     for s0 in range(0, n_steps, segment):
         seg = min(segment, n_steps - s0)
         plan.append([chunk] * (seg // chunk) + ([seg % chunk] if seg % chunk else []))
-    rows = {n: np.empty((n, N_OUTPUTS)) for seg in plan for n in seg}
+    rows = {n: np.empty((n, OUTPUT.size)) for seg in plan for n in seg}
     state = start.copy()
 
     def once(record=None):

@@ -41,7 +41,7 @@ __all__ = ["FmuExportError", "default_output_path", "export_diagram_fmu", "expor
 
 
 def kernel_set() -> KernelSet:
-    """hierhand's FMU binary: the library's kernel types and the hand's (kernels.h)."""
+    """hierhand's FMU binary: the library's kernel types and the hand's (kernel_types.h)."""
     from blocks.fmu_export.kernel_sets import library_set
 
     hand = frozenset(name.split(".", 1)[0] for name in _native.kernels())

@@ -1,15 +1,19 @@
 """The C sources of the hand core and what is built from them (read by setup.py too).
 
-One list, so that the extension, the FMU binaries built at install and the ``sources/``
-folder of an exported FMU always hold the same files. Paths are relative to the
-repository root (``CSRC``); an export copies its files flat into ``sources/``. Like
-``blocks.engine.native_sources`` this module imports nothing of the packages, so that setup.py
-can read it before anything is built.
+One rule, so that the extension, the FMU binaries built at install and the ``sources/``
+folder of an exported FMU always hold the same files: every C file directly in
+``hierhand/csrc`` is the hand's C code (the plant core, the controllers' laws and every
+kernel type, ``layouts.h`` listing the types), which the extension and the FMU binaries
+both compile; ``python/`` holds the extension's binding, and the kernel-set file
+``fmu_kernel_set.c`` only the FMU binaries'. A new block type's C file is therefore
+built without being listed. Paths are relative to the repository root (``CSRC``); an
+export copies its files flat into ``sources/``. Like ``blocks.engine.native_sources``
+this module imports nothing of the packages, so that setup.py can read it before anything
+is built.
 
-hierhand's FMU binary is the framework's (``blocks.engine.native_sources.fmu_sources``) with the
-hand's kernel types: the plant core and the controllers' laws, their kernels
-(``kernels.c``) and the kernel-set file ``fmu_kernels.c`` that lists them beside the
-library's, so any diagram of library and hand blocks leaves as an FMU.
+hierhand's FMU binary is the framework's (``blocks.engine.native_sources.fmu_sources``)
+with the hand's kernel types beside the library's, so any diagram of library and hand
+blocks leaves as an FMU.
 """
 
 from __future__ import annotations
@@ -18,23 +22,29 @@ import os
 import zlib
 
 CSRC = "hierhand/csrc"
+KERNEL_SET = "fmu_kernel_set.c"
 
-CORE = ["hand_params.c", "contact.c", "plant.c"]
-CORE_HEADERS = ["hand.h", "kinematics.h", "dynamics.h", "contact.h"]
-CONTROL = ["reflex.c", "manipulation.c", "suppresser.c", "control_params.c", "kernels.c"]
-CONTROL_HEADERS = ["control.h", "float_ops.h", "kernels.h"]
-BINDING = ["python/module.c", "python/py_common.c", "python/py_model.c", "python/py_plant.c", "python/py_control.c",
-           "python/py_kernels.c"]
-KERNEL_SET = "fmu_kernels.c"
+_FOLDER = Path(__file__).resolve().parent / "csrc"
+
+
+def _names(pattern: str) -> list[str]:
+    """The files of ``hierhand/csrc`` matching ``pattern``, sorted (relative to it)."""
+    return sorted(p.relative_to(_FOLDER).as_posix() for p in _FOLDER.glob(pattern))
+
+
+HAND_SOURCES = [name for name in _names("*.c") if name != KERNEL_SET]
+"""The hand's C code, which the extension and the FMU binaries compile alike."""
+HAND_HEADERS = _names("*.h")
+BINDING = _names("python/*.c")
 
 
 def _paths(names: list[str]) -> list[str]:
     return [f"{CSRC}/{name}" for name in names]
 
 
-EXTENSION_SOURCES = _paths(CORE + CONTROL + BINDING)
-EXTENSION_DEPENDS = _paths(CORE_HEADERS + CONTROL_HEADERS + ["python/py_common.h"]) + [
-    "blocks/csrc/blocks_kernel.h"  # the calling convention of kernels.c
+EXTENSION_SOURCES = _paths(HAND_SOURCES + BINDING)
+EXTENSION_DEPENDS = _paths(HAND_HEADERS + _names("python/*.h")) + [
+    "blocks/csrc/blocks_kernel.h"  # the calling convention of the kernel types
 ]
 """Headers whose change must rebuild the extension."""
 
@@ -43,8 +53,8 @@ def fmu_sources(framework: list[str]) -> list[str]:
     """Every file (repository paths) of hierhand's FMU binary of one FMI version: the
     framework's (``framework``, from ``blocks.engine.native_sources.fmu_sources``), the hand's
     kernels and its kernel-set file; C files first, then headers."""
-    c_files = [p for p in framework if p.endswith(".c")] + _paths(CORE + CONTROL + [KERNEL_SET])
-    return c_files + [p for p in framework if not p.endswith(".c")] + _paths(CORE_HEADERS + CONTROL_HEADERS)
+    c_files = [p for p in framework if p.endswith(".c")] + _paths(HAND_SOURCES + [KERNEL_SET])
+    return c_files + [p for p in framework if not p.endswith(".c")] + _paths(HAND_HEADERS)
 
 
 def sources_digest(root: str | os.PathLike) -> str:

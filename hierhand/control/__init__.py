@@ -9,10 +9,11 @@ against).
   onto internal forces, and the friction-cone scaling used by the grasping reflex.
 - ``inverse_kinematics``: exact three-joint finger IK/FK and whole-hand IK.
 - ``trajectory``: timed fingertip waypoints with linear or minimum-jerk segments.
-- ``suppresser_kernel``: the suppresser's sigmoid gain on the grasping torque.
+- ``suppresser_law``: the suppresser's sigmoid gain on the grasping torque.
 
-The blocks that use them (reflex, manipulation, suppresser) live beside these modules,
-with the kernels that pack their parameters (``reflex_kernel``, ``manipulation_kernel``).
+The blocks that use them (reflex, manipulation, suppresser, and the small ``JointLowPass``
+filter) live beside these modules, with the laws' bindings that pack their parameters
+(``reflex_law``, ``manipulation_law``).
 """
 
 from .internal_forces import (
@@ -23,7 +24,7 @@ from .internal_forces import (
     required_scale_from_sensors,
 )
 from .inverse_kinematics import UnreachableError, finger_fk, finger_ik, finger_ik_near, hand_ik, wrap_angle
-from .suppresser_kernel import finger_shares, sigmoid, suppress
+from .suppresser_law import finger_shares, sigmoid, suppress
 from .trajectory import Trajectory
 
 __all__ = [

@@ -46,7 +46,7 @@ Why a margin: an integral loop approaches its target exponentially, so aiming ex
 the safety ratio would leave ``|f_t| / f_n`` just above it for ever; aiming at
 ``safety_ratio / (1 + margin)`` brings it below the safety ratio in finite time.
 
-How: ``output`` and ``update`` each make one native call through ``reflex_kernel`` (the
+How: ``output`` and ``update`` each make one native call through ``reflex_law`` (the
 law in C, ``hierhand/csrc/reflex.c``: the grasp matrix solve written out by hand, the tip
 Jacobians from the plant's own kinematics); ``internal_forces.project_internal`` and
 ``internal_directions`` call the same C. The parameters are packed for the native calls
@@ -62,31 +62,14 @@ import numpy as np
 from blocks import Block
 from blocks.engine.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
-from ..model.hand_source import ModelsTheHand, hand_of
+from ..layouts import REFLEX_GIVEN as GIVEN, REFLEX_INPUTS, REFLEX_OUT, REFLEX_PARAMS, REFLEX_RECORD
+from ..layouts import port_columns, ports
+from ..model.hand_source import ModelsTheHand, hand_link, hand_of
 from ..model.port_info import DescribesHandPorts
+from ..records import KERNELS, context_of, hand_segment, record
 from .internal_forces import _COINCIDENT_RTOL
-from .reflex_kernel import (
-    G_APPROACH,
-    G_COINCIDENT_RTOL,
-    G_FOLLOW,
-    G_GRASP,
-    G_HOLD_SHARE,
-    G_KI,
-    G_MARGIN,
-    G_MAX_FORCE,
-    G_MIN_FORCE,
-    G_RELEASE_SHARE,
-    G_SAFETY_RATIO,
-    G_THRESHOLD,
-    N_GIVEN,
-    N_OUT,
+from .reflex_law import (
     WHOLE_SHARE,
-    O_ACTIVE,
-    O_FORCE,
-    O_TAU,
-    P_DT,
-    P_RATIO,
     pack_params,
     reflex_directions,
     reflex_failure,
@@ -94,6 +77,9 @@ from .reflex_kernel import (
     reflex_output,
     reflex_update,
 )
+
+_PORTS = port_columns(REFLEX_OUT)
+"""The output ports (tau_g, force, active) and their columns of the law's output."""
 
 
 def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray:
@@ -151,7 +137,7 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                  approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.5,
                  hold_share: float = 0.9, follow_suppression: bool = True):
         self.hand = hand_of(hand)
-        self._links = hand_link(hand)
+        self._links = hand_link(hand, REFLEX_RECORD.SEGMENT)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
                             ("max_force", max_force), ("contact_threshold", contact_threshold),
@@ -159,26 +145,27 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                             ("release_share", release_share), ("hold_share", hold_share)):
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ValueError(f"parameter '{name}' must be a number, got {value!r}")
-        given = np.empty(N_GIVEN)
-        given[G_KI], given[G_SAFETY_RATIO], given[G_MARGIN] = ki, safety_ratio, margin
-        given[G_MIN_FORCE], given[G_MAX_FORCE], given[G_APPROACH] = min_force, max_force, approach_force
-        given[G_THRESHOLD], given[G_RELEASE_SHARE], given[G_HOLD_SHARE] = contact_threshold, release_share, hold_share
-        given[G_FOLLOW] = 1.0 if follow_suppression else 0.0
-        given[G_GRASP:G_GRASP + 3] = self.initial
-        given[G_COINCIDENT_RTOL] = _COINCIDENT_RTOL
+        given = np.empty(GIVEN.size)
+        given[GIVEN.KI], given[GIVEN.SAFETY_RATIO], given[GIVEN.MARGIN] = ki, safety_ratio, margin
+        given[GIVEN.MIN_FORCE], given[GIVEN.MAX_FORCE], given[GIVEN.APPROACH] = min_force, max_force, approach_force
+        given[GIVEN.THRESHOLD], given[GIVEN.RELEASE_SHARE] = contact_threshold, release_share
+        given[GIVEN.HOLD_SHARE] = hold_share
+        given[GIVEN.FOLLOW] = 1.0 if follow_suppression else 0.0
+        given[GIVEN.slice("GRASP")] = self.initial
+        given[GIVEN.COINCIDENT_RTOL] = _COINCIDENT_RTOL
         self._given = given
         # the native calls' flat parameter array, its checks and derived values in C; the
-        # period (P_DT) is set by bind
+        # period (REFLEX_PARAMS.DT) is set by bind
         self._params = pack_params(given, self.hand.vector, np.nan)
         self.ki, self.min_force, self.max_force = float(ki), float(min_force), float(max_force)
-        self.ratio_target = float(self._params[P_RATIO])
+        self.ratio_target = float(self._params[REFLEX_PARAMS.RATIO])
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
         self.release_share = float(release_share)
         self.hold_share = float(hold_share)
         self.follow_suppression = bool(follow_suppression)
-        self.inputs = {"q": 9, "tip": 9, "fn": 3, "ft": 3, "normal": 6, "share": 3}
+        self.inputs = dict(REFLEX_INPUTS)
         self.input_defaults = {"share": WHOLE_SHARE}
-        self.outputs = {"tau_g": 9, "force": 3, "active": 3}
+        self.outputs = dict(ports(REFLEX_OUT))
         self.feedthrough = {"tau_g": {"q", "tip", "fn", "normal"}, "force": {"tip", "fn", "normal"},
                             "active": {"fn"}}
 
@@ -187,7 +174,7 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
             raise ValueError("GraspReflex needs an explicit period (the paper's is 1 ms)")
         super().bind(period)
         self.dt = float(period)
-        self._params[P_DT] = self.dt
+        self._params[REFLEX_PARAMS.DT] = self.dt
         self._kernel = None
 
     def kernel(self) -> Kernel | None:
@@ -195,7 +182,7 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         law, hierhand/csrc/reflex.c), in a context its constructor builds from the record
         ``[hand segment, dt, given]``; None before ``bind``. In an exported FMU the
         gains, forces and shares are tunable, and the hand follows the plant's."""
-        if not self._params[P_DT] > 0:
+        if not self._params[REFLEX_PARAMS.DT] > 0:
             return None
         held = getattr(self, "_kernel", None)
         if held is None:
@@ -223,7 +210,7 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         squeeze can point a contact's force along the face instead). A finger still
         approaching pushes towards the others' centroid. Should the projection leave a
         finger not pushing (``g_i . push_i <= 0``), the grasp falls back to the centroid
-        squeeze ``internal_directions``. Computed by ``reflex_kernel.reflex_directions``
+        squeeze ``internal_directions``. Computed by ``reflex_law.reflex_directions``
         (``G^+ = G^T (G G^T)^-1`` solved by hand, as ``project_internal`` does).
         """
         return reflex_directions(self._params, state, tip, normal, fn)
@@ -238,7 +225,7 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         flags; one native call, the ports are views of one fresh array."""
         out = reflex_output(self.hand.native, self._params, state, inputs["q"], inputs["tip"], inputs["normal"],
                             inputs["fn"])
-        return {"tau_g": out[O_TAU:O_FORCE], "force": out[O_FORCE:O_ACTIVE], "active": out[O_ACTIVE:N_OUT]}
+        return {port: out[columns] for port, columns in _PORTS}
 
     def update(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> np.ndarray:
         """The integral step of the grasp force scale and the hand-over scales (a fresh array)."""
@@ -246,18 +233,16 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                              inputs.get("share", WHOLE_SHARE))
 
 
-_GIVEN_AT = SEGMENT + 1
-"""Where the kernel record's given parameters start (after the hand segment and dt)."""
-_TUNABLES = tuple(Tunable(name, _GIVEN_AT + slot, text, unit) for name, slot, text, unit in (
-    ("ki", G_KI, "integral gain of the fingertip force loop", "1/s"),
-    ("safety_ratio", G_SAFETY_RATIO, "largest |f_t|/f_n the reflex allows", "1"),
-    ("margin", G_MARGIN, "the loop aims at safety_ratio / (1 + margin)", "1"),
-    ("min_force", G_MIN_FORCE, "smallest normal force per contact", "N"),
-    ("max_force", G_MAX_FORCE, "largest commanded force per fingertip", "N"),
-    ("approach_force", G_APPROACH, "force pushing a 'grasp' finger towards the others", "N"),
-    ("contact_threshold", G_THRESHOLD, "normal force above which a finger counts as in contact", "N"),
-    ("release_share", G_RELEASE_SHARE, "share at which a third touching finger is wholly handed over", "1"),
-    ("hold_share", G_HOLD_SHARE, "share down to which a third touching finger is held whole", "1")))
+_TUNABLES = tuple(Tunable(name, REFLEX_RECORD.GIVEN + slot, text, unit) for name, slot, text, unit in (
+    ("ki", GIVEN.KI, "integral gain of the fingertip force loop", "1/s"),
+    ("safety_ratio", GIVEN.SAFETY_RATIO, "largest |f_t|/f_n the reflex allows", "1"),
+    ("margin", GIVEN.MARGIN, "the loop aims at safety_ratio / (1 + margin)", "1"),
+    ("min_force", GIVEN.MIN_FORCE, "smallest normal force per contact", "N"),
+    ("max_force", GIVEN.MAX_FORCE, "largest commanded force per fingertip", "N"),
+    ("approach_force", GIVEN.APPROACH, "force pushing a 'grasp' finger towards the others", "N"),
+    ("contact_threshold", GIVEN.THRESHOLD, "normal force above which a finger counts as in contact", "N"),
+    ("release_share", GIVEN.RELEASE_SHARE, "share at which a third touching finger is wholly handed over", "1"),
+    ("hold_share", GIVEN.HOLD_SHARE, "share down to which a third touching finger is held whole", "1")))
 """GraspReflex's parameters an exported FMU lets an importer set."""
 
 

@@ -5,7 +5,7 @@ Every hit (10 ms in the paper) samples them, turns the samples into joint target
 exact three-joint inverse kinematics and tracks them with a joint PD. Fingers without a
 trajectory hold their initial joint angles.
 
-All of that runs in one native call per hit (``manipulation_kernel.manipulation_output``,
+All of that runs in one native call per hit (``manipulation_law.manipulation_output``,
 the law in C over flat arrays packed once at load time). When a target turns out
 unreachable during the run, the Python API on the same C (``finger_ik_near``) names the
 finger and the distance.
@@ -45,38 +45,22 @@ from blocks import Block
 from blocks.arrays import flat_float64, float_array
 from blocks.engine.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
-from ..model.hand_source import ModelsTheHand, hand_of
+from ..layouts import MANIP_GIVEN as GIVEN, MANIP_INPUTS, MANIP_OUT, MANIP_PARAMS, MANIP_RECORD, MANIP_STATUS
+from ..layouts import port_columns, ports
+from ..model.hand_source import ModelsTheHand, hand_link, hand_of
 from ..model.port_info import DescribesHandPorts
+from ..records import KERNELS, context_of, hand_segment, record
 from .inverse_kinematics import UnreachableError, finger_ik_near
 from .inverse_kinematics import _REACH_RTOL
-from .manipulation_kernel import (
-    G_CONTACT_COMP,
-    G_GRAVITY_COMP,
-    G_KD,
-    G_KP,
-    G_LOAD_COMP,
-    G_MATCHED,
-    G_REACH_RTOL,
-    G_STEP,
-    G_THRESHOLD,
-    N_GIVEN,
-    NO_PERIOD,
-    OK,
-    P_DT,
-    P_WX,
-    P_WY,
-    UNREACHABLE,
-    manipulation_output,
-    pack_params,
-    pack_trajectories,
-)
+from .manipulation_law import manipulation_output, pack_params, pack_trajectories
 from .trajectory import Trajectory
 
 DERIVATIVE_STEP = 1e-3
 """Seconds either side of t for the joint-velocity target (central difference of the IK)."""
 DISCRETIZATIONS = ("matched", "held")
 """How kp and kd become the torque of a sampled PD (see the class docstring)."""
+_PORTS = port_columns(MANIP_OUT)
+"""The output ports (tau_m, tau_ff, q_ref) and their columns of the law's output."""
 
 
 class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
@@ -132,24 +116,24 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
                              f"got {discretization!r}")
         self.discretization = discretization
         self.contact_compensation = bool(contact_compensation)
-        self._links = hand_link(hand)
+        self._links = hand_link(hand, MANIP_RECORD.SEGMENT)
         self.trajectories = self.parse_trajectories(trajectories or {})
-        self.inputs = {"q": 9, "qd": 9, "fn": 3, "support": 3, "normal": 6, "obj": 3}
+        self.inputs = dict(MANIP_INPUTS)
         self.input_defaults = {"support": np.zeros(3)}
-        self.outputs = {"tau_m": 9, "tau_ff": 9, "q_ref": 9}
+        self.outputs = dict(ports(MANIP_OUT))
         self.feedthrough = True
         # the native output's flat arrays (built from the attributes above, once; the
         # checks and the values taken from the hand in C)
         self._model = self.hand.native
-        given = np.empty(N_GIVEN)
-        given[G_KP:G_KP + 9], given[G_KD:G_KD + 9] = self.kp, self.kd
-        given[G_THRESHOLD] = self.threshold
-        given[G_GRAVITY_COMP], given[G_LOAD_COMP] = self.gravity_compensation, self.load_compensation
-        given[G_MATCHED], given[G_CONTACT_COMP] = discretization == "matched", self.contact_compensation
-        given[G_STEP], given[G_REACH_RTOL] = DERIVATIVE_STEP, _REACH_RTOL
+        given = np.empty(GIVEN.size)
+        given[GIVEN.slice("KP")], given[GIVEN.slice("KD")] = self.kp, self.kd
+        given[GIVEN.THRESHOLD] = self.threshold
+        given[GIVEN.GRAVITY_COMP], given[GIVEN.LOAD_COMP] = self.gravity_compensation, self.load_compensation
+        given[GIVEN.MATCHED], given[GIVEN.CONTACT_COMP] = discretization == "matched", self.contact_compensation
+        given[GIVEN.STEP], given[GIVEN.REACH_RTOL] = DERIVATIVE_STEP, _REACH_RTOL
         self._given = given
         self._params = pack_params(given, self.hand.vector, np.nan)
-        self.weight = self._params[P_WX:P_WY + 1].copy()
+        self.weight = self._params[[MANIP_PARAMS.WX, MANIP_PARAMS.WY]]
         self._waypoints, self._meta = pack_trajectories(self.trajectories)
 
     def parse_trajectories(self, config: Mapping[str, Any]) -> list[Trajectory | None]:
@@ -184,7 +168,7 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
             raise ValueError("ManipulationPD needs an explicit period (the paper's is 10 ms) to realise its gains "
                              "for it; or give discretization: held")
         super().bind(period)
-        self._params[P_DT] = float(period) if period is not None else np.nan
+        self._params[MANIP_PARAMS.DT] = float(period) if period is not None else np.nan
         self._kernel = None
 
     def joint_targets_for(self, finger: int, point: np.ndarray) -> np.ndarray:
@@ -197,7 +181,7 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         (lists, other dtypes, strided views) are converted to float64 first; inputs of the
         wrong width raise ``ValueError`` naming the port, a target out of reach
         ``UnreachableError`` naming the finger; matched gains need ``bind``'s period first."""
-        out = np.empty((3, 9))
+        out = np.empty(MANIP_OUT.size)
         values = (inputs["q"], inputs["qd"], inputs["fn"], inputs.get("support", self.input_defaults["support"]),
                   inputs["normal"], inputs["obj"])
         try:
@@ -205,9 +189,9 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         except TypeError:
             status = manipulation_output(self._model, self._params, self._waypoints, self._meta, t,
                                          *(flat_float64(v) for v in values), out)
-        if status != OK:
+        if status != MANIP_STATUS.OK:
             raise self._kernel_error(status, 0, t, "output")
-        return {"tau_m": out[0], "tau_ff": out[1], "q_ref": out[2]}
+        return {port: out[columns] for port, columns in _PORTS}
 
     def kernel(self) -> Kernel | None:
         """``output`` in C (kernel type ``ManipulationPD``: the same native call), in a
@@ -217,7 +201,7 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         held = getattr(self, "_kernel", None)
         if held is None:
             waypoints, meta = self._waypoints, self._meta
-            rec = record("ManipulationPD", hand_segment(self.hand, False), [self._params[P_DT]], self._given,
+            rec = record("ManipulationPD", hand_segment(self.hand, False), [self._params[MANIP_PARAMS.DT]], self._given,
                          [waypoints.shape[1]], waypoints, meta, tunables=_TUNABLES, links=self._links)
             ctx = context_of(rec)
             held = self._kernel = Kernel(context=ctx.address, output=KERNELS["ManipulationPD.output"], owners=(ctx,),
@@ -227,10 +211,10 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
     def _kernel_error(self, code: int, which: int, t: float, phase: str) -> BaseException:
         """A failure of the native output (a target out of reach, no period to match the gains
         to) as ``output`` raises it."""
-        if code == NO_PERIOD:
+        if code == MANIP_STATUS.NO_PERIOD:
             return ValueError("ManipulationPD: its gains are matched to its period, and it has none yet "
                               "(hint: give the block a period, or discretization: held)")
-        return self.unreachable(code - UNREACHABLE, t)
+        return self.unreachable(code - MANIP_STATUS.UNREACHABLE, t)
 
     def unreachable(self, finger: int, t: float) -> UnreachableError:
         """The error of the first target of ``finger`` out of reach at time t: its pose at
@@ -245,12 +229,11 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
                            f"t = {t:g} s, but none of its targets is")
 
 
-_GIVEN_AT = SEGMENT + 1
-"""Where the kernel record's given parameters start (after the hand segment and dt)."""
+_GIVEN_AT = MANIP_RECORD.GIVEN
 _TUNABLES = (
-    *(Tunable(f"kp[{j + 1}]", _GIVEN_AT + G_KP + j, f"joint {j + 1} stiffness", "N m/rad") for j in range(9)),
-    *(Tunable(f"kd[{j + 1}]", _GIVEN_AT + G_KD + j, f"joint {j + 1} damping", "N m s/rad") for j in range(9)),
-    Tunable("contact_threshold", _GIVEN_AT + G_THRESHOLD, "normal force above which a finger carries the object",
+    *(Tunable(f"kp[{j + 1}]", _GIVEN_AT + GIVEN.KP + j, f"joint {j + 1} stiffness", "N m/rad") for j in range(9)),
+    *(Tunable(f"kd[{j + 1}]", _GIVEN_AT + GIVEN.KD + j, f"joint {j + 1} damping", "N m s/rad") for j in range(9)),
+    Tunable("contact_threshold", _GIVEN_AT + GIVEN.THRESHOLD, "normal force above which a finger carries the object",
             "N"),
 )
 """ManipulationPD's parameters an exported FMU lets an importer set."""

@@ -1,6 +1,6 @@
 """The suppresser block: lets voluntary motion override the grasping reflex, joint by joint.
 
-Its law is ``suppresser_kernel`` (compiled, ``hierhand/csrc/suppresser.c``).
+Its law is ``suppresser_law`` (compiled, ``hierhand/csrc/suppresser.c``).
 """
 
 from __future__ import annotations
@@ -13,26 +13,13 @@ from blocks import Block
 from blocks.arrays import flat_float64, float_array
 from blocks.engine.kernel import Kernel, Tunable
 
-from ..kernels import KERNELS, context_of, record
+from ..layouts import SUPPRESS_GIVEN as GIVEN, SUPPRESS_INPUTS, SUPPRESS_OUT, SUPPRESS_RECORD, port_columns, ports
 from ..model.port_info import DescribesHandPorts
+from ..records import KERNELS, context_of, record
+from .suppresser_law import check_steepness, mode_code, pack_params, suppress_output, suppress_update
 
-from .suppresser_kernel import (
-    G_ENABLED,
-    G_MODE,
-    G_S_A,
-    G_S_B,
-    G_TIME_CONSTANT,
-    N_GIVEN,
-    N_OUT,
-    O_SHARE,
-    O_TAU,
-    O_TAU_G_EFF,
-    check_steepness,
-    mode_code,
-    pack_params,
-    suppress_output,
-    suppress_update,
-)
+_PORTS = port_columns(SUPPRESS_OUT)
+"""The output ports (tau, tau_g_eff, share) and their columns of the law's output."""
 
 
 class Suppresser(DescribesHandPorts, Block):
@@ -92,14 +79,14 @@ class Suppresser(DescribesHandPorts, Block):
         self.mode = mode
         self.enabled = bool(enabled)
         self.time_constant = float(time_constant)
-        self.inputs = {"tau_g": 9, "tau_m": 9, "tau_ff": 9}
+        self.inputs = dict(SUPPRESS_INPUTS)
         self.input_defaults = {"tau_ff": np.zeros(9)}
-        self.outputs = {"tau": 9, "tau_g_eff": 9, "share": 3}
+        self.outputs = dict(ports(SUPPRESS_OUT))
         self.feedthrough = (True if not self.filtered else
                             {"tau": {"tau_g", "tau_m", "tau_ff"}, "tau_g_eff": {"tau_g"}, "share": {"tau_g"}})
-        given = np.empty(N_GIVEN)
-        given[G_S_A:G_S_A + 9], given[G_S_B:G_S_B + 9] = self.S_a, self.S_b
-        given[G_MODE], given[G_ENABLED], given[G_TIME_CONSTANT] = code, self.enabled, self.time_constant
+        given = np.empty(GIVEN.size)
+        given[GIVEN.slice("S_A")], given[GIVEN.slice("S_B")] = self.S_a, self.S_b
+        given[GIVEN.MODE], given[GIVEN.ENABLED], given[GIVEN.TIME_CONSTANT] = code, self.enabled, self.time_constant
         self._given = given
         # the native calls' parameters, checked and packed in C (the filter's step by bind)
         self._params = pack_params(given, None, np.nan)
@@ -128,14 +115,13 @@ class Suppresser(DescribesHandPorts, Block):
         or the mode changed on the object afterwards are not seen). Inputs the native call
         refuses for their type (lists, other dtypes, strided views) are converted to float64
         first; inputs of the wrong width raise ``ValueError`` naming the port."""
-        out = np.empty(N_OUT)
+        out = np.empty(SUPPRESS_OUT.size)
         tau_g, tau_m, tau_ff = inputs["tau_g"], inputs["tau_m"], inputs.get("tau_ff", self.input_defaults["tau_ff"])
         try:
             suppress_output(self._params, tau_g, state, tau_m, tau_ff, out)
         except TypeError:
             suppress_output(self._params, flat_float64(tau_g), state, flat_float64(tau_m), flat_float64(tau_ff), out)
-        return {"tau": out[O_TAU:O_TAU + 9], "tau_g_eff": out[O_TAU_G_EFF:O_TAU_G_EFF + 9],
-                "share": out[O_SHARE:O_SHARE + 3]}
+        return {port: out[columns] for port, columns in _PORTS}
 
     def update(self, t: float, state: Any, inputs: Mapping[str, np.ndarray]) -> Any:
         """The low-pass step of the suppression inputs (a fresh array); None when static."""
@@ -161,11 +147,14 @@ class Suppresser(DescribesHandPorts, Block):
         return held
 
 
+_GIVEN_AT = SUPPRESS_RECORD.GIVEN
 _TUNABLES = (
-    *(Tunable(f"S_a[{j + 1}]", G_S_A + j, f"joint {j + 1} sigmoid steepness", "1/(N m)") for j in range(9)),
-    *(Tunable(f"S_b[{j + 1}]", G_S_B + j, f"joint {j + 1} manipulation torque halving the grasping torque", "N m")
+    *(Tunable(f"S_a[{j + 1}]", _GIVEN_AT + GIVEN.S_A + j, f"joint {j + 1} sigmoid steepness", "1/(N m)")
       for j in range(9)),
-    Tunable("time_constant", G_TIME_CONSTANT, "time constant of the low-pass before the sigmoid (> 0)", "s"),
+    *(Tunable(f"S_b[{j + 1}]", _GIVEN_AT + GIVEN.S_B + j, f"joint {j + 1} manipulation torque halving the grasping "
+              "torque", "N m") for j in range(9)),
+    Tunable("time_constant", _GIVEN_AT + GIVEN.TIME_CONSTANT, "time constant of the low-pass before the sigmoid (> 0)",
+            "s"),
 )
 """Suppresser's parameters an exported FMU lets an importer set (time_constant only when
 it filters: 0 would change the block's state and feedthrough)."""

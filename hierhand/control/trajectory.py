@@ -19,11 +19,12 @@ from typing import Any, Sequence
 import numpy as np
 
 from .. import _native
+from ..layouts import MANIP_INTERP
 
 __all__ = ["Trajectory"]
 
-INTERPOLATIONS = {"linear": _native.LAYOUT["MANIP_INTERP_LINEAR"], "minjerk": _native.LAYOUT["MANIP_INTERP_MINJERK"]}
-"""The interpolations by name, with their codes in the C's trajectory arrays."""
+INTERPOLATIONS = {name.lower(): code for name, code, _ in MANIP_INTERP.slots}
+"""The interpolations by name ("linear", "minjerk"), with their codes in the C's trajectory arrays."""
 
 
 class Trajectory:

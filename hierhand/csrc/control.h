@@ -3,7 +3,7 @@
  *
  * Each law is one call over flat double arrays that the caller owns: the block's
  * constants packed once into a parameter vector (slots HH_REFLEX_P_*, HH_MANIP_P_*,
- * HH_SUPPRESS_P_*), the inputs of one hit, and an output vector. Nothing is allocated and
+ * HH_SUPPRESS_P_*, declared with every other layout in layouts.h), the inputs of one hit, and an output vector. Nothing is allocated and
  * nothing global changes, so a call costs microseconds and calls are independent. The
  * finger geometry comes from an hh_model through the inline kinematics and dynamics the
  * plant's step uses (kinematics.h, dynamics.h).
@@ -32,39 +32,10 @@
  * until every contact the reflex holds has the normal force it needs; the suppresser's
  * share sets how much it holds each (the hand-over to voluntary motion). */
 
-/* -- parameters: params[HH_REFLEX_P_*] -------------------------------------------------- */
-enum {
-    HH_REFLEX_P_THRESHOLD = 0, /* normal force, N, above which a finger is in contact */
-    HH_REFLEX_P_APPROACH = 1, /* force, N, of a finger approaching the others */
-    HH_REFLEX_P_KI = 2, /* integral gain, 1/s */
-    HH_REFLEX_P_DT = 3, /* period, s (not > 0: unbound, update refuses) */
-    HH_REFLEX_P_MIN_FORCE = 4, /* smallest normal force per contact, N */
-    HH_REFLEX_P_RATIO = 5, /* |f_t| / f_n the loop aims at: safety_ratio / (1 + margin) */
-    HH_REFLEX_P_MAX_FORCE = 6, /* largest force scale, N */
-    HH_REFLEX_P_INITIAL = 7, /* three: non-zero for the fingers listed in 'grasp' */
-    HH_REFLEX_P_COINCIDENT_RTOL = 10, /* points this close, relative to their size, coincide */
-    HH_REFLEX_P_RELEASE_SHARE = 11, /* a finger that loses contact while the suppresser lets through less
-                                       than this share of its grasping torque is not pushed back */
-    HH_REFLEX_P_TIP_RADIUS = 12, /* three: the fingertip radii; a touching finger's contact point is its
-                                    tip centre plus this along the contact normal */
-    HH_REFLEX_P_FOLLOW = 15, /* non-zero: the reflex's hold of a finger follows its share (hand-over) */
-    HH_REFLEX_P_HOLD_SHARE = 16, /* a third finger is held whole down to this share, not at all at release_share */
-    HH_REFLEX_N_PARAMS = 17
-};
-
-/* -- state: [force scale, per finger 1 where the reflex was letting go of it when it last
- *    touched (3), per finger how much the reflex holds it (3)] ---------------------------- */
-enum { HH_REFLEX_S_SCALE = 0, HH_REFLEX_S_HANDED = 1, HH_REFLEX_S_HOLD = 4, HH_REFLEX_N_STATE = 7 };
-
-/* -- output of hh_reflex_output: tau_g (9), |f_i| (3), in the grasp (3, 0 or 1) ---------- */
-enum { HH_REFLEX_O_TAU = 0, HH_REFLEX_O_FORCE = 9, HH_REFLEX_O_ACTIVE = 12, HH_REFLEX_N_OUT = 15 };
-
-/* -- status -------------------------------------------------------------------------------- */
-enum {
-    HH_REFLEX_OK = 0,
-    HH_REFLEX_COINCIDENT = 1, /* the squeeze is undefined: all grasp points coincide */
-    HH_REFLEX_NO_PERIOD = 2 /* update without a period (params[HH_REFLEX_P_DT] not > 0) */
-};
+/* Its arrays' slots are in layouts.h: params HH_REFLEX_P_*, state HH_REFLEX_S_* (the force
+ * scale, per finger whether the reflex was letting go of it when it last touched, per finger
+ * how much it holds it), output HH_REFLEX_O_*, status codes HH_REFLEX_OK, _COINCIDENT,
+ * _NO_PERIOD. */
 
 /* Inputs of one hit, as the plant's output ports give them. */
 typedef struct hh_reflex_inputs {
@@ -139,37 +110,14 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
  * and tracked by a joint PD; the fingers' gravity torques and the object's weight, shared
  * by the fingers carrying it, are fed forward. */
 
-/* -- parameters: params[HH_MANIP_P_*] --------------------------------------------------- */
-enum {
-    HH_MANIP_P_Q0 = 0, /* 9: held by fingers without a trajectory; the IK's reference */
-    HH_MANIP_P_KP = 9, /* 9 joint stiffnesses */
-    HH_MANIP_P_KD = 18, /* 9 joint dampings */
-    HH_MANIP_P_GX = 27, /* gravity */
-    HH_MANIP_P_GY = 28,
-    HH_MANIP_P_WX = 29, /* the object's weight m g */
-    HH_MANIP_P_WY = 30,
-    HH_MANIP_P_THRESHOLD = 31, /* normal force above which a finger carries the object */
-    HH_MANIP_P_GRAVITY_COMP = 32, /* non-zero: feed the fingers' gravity torques forward */
-    HH_MANIP_P_LOAD_COMP = 33, /* non-zero: feed J^T of the shared weight forward */
-    HH_MANIP_P_STEP = 34, /* seconds either side of t for the velocity target */
-    HH_MANIP_P_REACH_RTOL = 35, /* wrist distances this close (relative to l1 + l2)
-                                   outside the reachable annulus count as on it */
-    HH_MANIP_P_DT = 36, /* the controller's period T, s (> 0 where the gains are matched) */
-    HH_MANIP_P_MATCHED = 37, /* non-zero: realise kp, kd for the period (hh_matched_gains);
-                                zero: apply them as they are, held for the period */
-    HH_MANIP_P_CONTACT_COMP = 38, /* non-zero: aim a finger in contact as deep into the object
-                                     as its measured normal force presses it (fn / k_n) */
-    HH_MANIP_N_PARAMS = 39
-};
-
-/* -- trajectories -------------------------------------------------------------------------
- * Finger f's waypoint k is the row waypoints + (f * capacity + k) * HH_MANIP_W_COLS; its
- * meta row meta + f * HH_MANIP_N_META holds the waypoint count (0: no trajectory, the
- * finger holds q0) and the interpolation, both as doubles. Times strictly increase. */
-enum { HH_MANIP_W_T = 0, HH_MANIP_W_X = 1, HH_MANIP_W_Y = 2, HH_MANIP_W_PHI = 3, HH_MANIP_W_COLS = 4 };
-enum { HH_MANIP_M_COUNT = 0, HH_MANIP_M_INTERP = 1, HH_MANIP_N_META = 2 };
-enum { HH_MANIP_INTERP_LINEAR = 0, HH_MANIP_INTERP_MINJERK = 1 };
-
+/* Its arrays' slots are in layouts.h: params HH_MANIP_P_*, output HH_MANIP_O_* (rows tau_m,
+ * tau_ff, q_ref), status HH_MANIP_OK, HH_MANIP_UNREACHABLE + f when a target of finger f is
+ * out of its reach, HH_MANIP_NO_PERIOD when matched gains have no period to be matched to.
+ *
+ * Trajectories: finger f's waypoint k is the row waypoints + (f * capacity + k) *
+ * HH_MANIP_W_COLS (slots HH_MANIP_W_*); its meta row meta + f * HH_MANIP_N_META holds the
+ * waypoint count (0: no trajectory, the finger holds q0) and the interpolation
+ * (HH_MANIP_INTERP_*), both as doubles. Times strictly increase. */
 typedef struct hh_trajectories {
     const double *waypoints; /* HH_FINGERS x capacity x HH_MANIP_W_COLS */
     const double *meta; /* HH_FINGERS x HH_MANIP_N_META */
@@ -195,13 +143,6 @@ typedef struct hh_manip_inputs {
     const double *normal; /* 6: per finger the contact normal (into the object) */
     const double *obj; /* 3: the object's pose x, y, theta */
 } hh_manip_inputs;
-
-/* -- output of hh_manipulation_output: rows tau_m, tau_ff, q_ref (9 each) --------------- */
-enum { HH_MANIP_O_TAU_M = 0, HH_MANIP_O_TAU_FF = 9, HH_MANIP_O_Q_REF = 18, HH_MANIP_N_OUT = 27 };
-
-/* -- status: HH_MANIP_OK, HH_MANIP_UNREACHABLE + f when a target of finger f is out of
- * its reach, HH_MANIP_NO_PERIOD when matched gains have no period to be matched to ------ */
-enum { HH_MANIP_OK = 0, HH_MANIP_UNREACHABLE = 1, HH_MANIP_NO_PERIOD = 4 };
 
 /* An angle wrapped to (-pi, pi]. */
 double hh_wrap_angle(double a);
@@ -265,18 +206,8 @@ int hh_manipulation_output(const hh_model *m, const double *params, const hh_tra
  * torque tau_g_i the suppresser lets through: tau_g_eff_i . tau_g_i / |tau_g_i|^2, 1 where
  * tau_g_i is zero or in pass mode. */
 
-/* -- parameters: params[HH_SUPPRESS_P_*] ------------------------------------------------ */
-enum {
-    HH_SUPPRESS_P_S_A = 0, /* 9 sigmoid steepnesses, 1/(N m) */
-    HH_SUPPRESS_P_S_B = 9, /* 9 suppression inputs, N m, at which the grasping torque is halved */
-    HH_SUPPRESS_P_MODE = 18, /* HH_SUPPRESS_PASS, _MAGNITUDE or _SIGNED */
-    HH_SUPPRESS_P_ALPHA = 19, /* the low-pass step of hh_suppress_update: 1 - exp(-T / time constant) */
-    HH_SUPPRESS_N_PARAMS = 20
-};
-enum { HH_SUPPRESS_PASS = 0, HH_SUPPRESS_MAGNITUDE = 1, HH_SUPPRESS_SIGNED = 2 }; /* params[P_MODE] */
-
-/* -- output: tau (9), tau_g_eff (9), share (3) ------------------------------------------ */
-enum { HH_SUPPRESS_O_TAU = 0, HH_SUPPRESS_O_TAU_G_EFF = 9, HH_SUPPRESS_O_SHARE = 18, HH_SUPPRESS_N_OUT = 21 };
+/* Its arrays' slots are in layouts.h: params HH_SUPPRESS_P_*, modes HH_SUPPRESS_PASS,
+ * _MAGNITUDE, _SIGNED, output HH_SUPPRESS_O_* (tau, tau_g_eff, share). */
 
 /* out (HH_SUPPRESS_N_OUT) from the torques tau_g, tau_m, tau_ff (9 each) and the
  * suppression inputs g (9): the low-passed ones of the block's state, or NULL for the static
@@ -306,65 +237,30 @@ void hh_finger_shares(const double *tau_g, const double *tau_g_eff, double share
 
 /* == the blocks' parameters (control_params.c) ============================================
  *
- * Each controller block's numbers as the block is given them ("given", slots *_G_*),
- * checked and packed into its law's parameter vector: the one definition of the checks
- * and of the values derived from them, which the blocks call when they are made and an
- * exported FMU calls when it rebuilds them (kernels.h). Each returns 0, or 1 with one
- * line in message saying which parameter is wrong and why (numbers written as Python
+ * Each controller block's numbers as the block is given them ("given", slots *_G_* of
+ * layouts.h), checked and packed into its law's parameter vector: the one definition of the
+ * checks and of the values derived from them, which the blocks call when they are made and
+ * an exported FMU calls when it rebuilds them (kernel_types.h). Each returns 0, or 1 with
+ * one line in message saying which parameter is wrong and why (numbers written as Python
  * writes them), the vector then incomplete. A hand is a hand vector (HH_HAND_PARAMS). */
 
 /* Write x as Python's repr of a float does (shortest round trip; "3.0", "nan", "inf"). */
 void hh_number_text(double x, char *out, size_t size);
 
-enum {
-    HH_REFLEX_G_KI = 0,
-    HH_REFLEX_G_SAFETY_RATIO = 1,
-    HH_REFLEX_G_MARGIN = 2,
-    HH_REFLEX_G_MIN_FORCE = 3,
-    HH_REFLEX_G_MAX_FORCE = 4,
-    HH_REFLEX_G_APPROACH = 5,
-    HH_REFLEX_G_THRESHOLD = 6,
-    HH_REFLEX_G_RELEASE_SHARE = 7,
-    HH_REFLEX_G_HOLD_SHARE = 8,
-    HH_REFLEX_G_FOLLOW = 9, /* follow_suppression, 0 or 1 */
-    HH_REFLEX_G_GRASP = 10, /* three: 1 for the fingers listed in 'grasp' */
-    HH_REFLEX_G_COINCIDENT_RTOL = 13, /* Python's internal_forces._COINCIDENT_RTOL */
-    HH_REFLEX_N_GIVEN = 14
-};
 /* params (HH_REFLEX_N_PARAMS) of GraspReflex: the ratio target safety_ratio / (1 + margin),
  * the hand's tip radii, the period dt (NaN: not bound yet). */
 int hh_reflex_pack(const double *given, const double *hand, double dt, double *params, char *message, size_t size);
 
-enum {
-    HH_MANIP_G_KP = 0, /* nine */
-    HH_MANIP_G_KD = 9, /* nine */
-    HH_MANIP_G_THRESHOLD = 18,
-    HH_MANIP_G_GRAVITY_COMP = 19,
-    HH_MANIP_G_LOAD_COMP = 20,
-    HH_MANIP_G_MATCHED = 21, /* discretization 'matched' */
-    HH_MANIP_G_CONTACT_COMP = 22,
-    HH_MANIP_G_STEP = 23, /* Python's manipulation_pd.DERIVATIVE_STEP */
-    HH_MANIP_G_REACH_RTOL = 24, /* Python's inverse_kinematics._REACH_RTOL */
-    HH_MANIP_N_GIVEN = 25
-};
 /* params (HH_MANIP_N_PARAMS) of ManipulationPD: q0 and gravity from the hand, the weight
  * its object's mass times gravity, the period dt (NaN: none). */
 int hh_manip_pack(const double *given, const double *hand, double dt, double *params, char *message, size_t size);
 
-enum {
-    HH_SUPPRESS_G_S_A = 0, /* nine */
-    HH_SUPPRESS_G_S_B = 9, /* nine */
-    HH_SUPPRESS_G_MODE = 18, /* HH_SUPPRESS_MAGNITUDE or _SIGNED */
-    HH_SUPPRESS_G_ENABLED = 19,
-    HH_SUPPRESS_G_TIME_CONSTANT = 20, /* s; > 0: the block low-passes (a state), 0: the static law */
-    HH_SUPPRESS_N_GIVEN = 21
-};
 /* params (HH_SUPPRESS_N_PARAMS) of Suppresser: mode PASS when not enabled, the low-pass
  * step 1 - exp(-period / time_constant) when filtered and period > 0 (else 1). */
 int hh_suppress_pack(const double *given, double period, double *params, char *message, size_t size);
 
-/* ObjectSupport's context [fx, fy, torque, until]: the hand's object weight turned
- * upwards, 0 - m g, while t < until. */
+/* ObjectSupport's context (HH_SUPPORT_C_*: the force fx, fy, torque, then until): the hand's object weight
+ * turned upwards, 0 - m g, while t < until. */
 int hh_support_pack(double until, const double *hand, double *context, char *message, size_t size);
 
 #endif

@@ -183,9 +183,9 @@ int hh_support_pack(double until, const double *hand, double *c, char *message, 
     if (!isfinite(until))
         return not_finite(message, size, "until", until);
     double mass = hand[HH_P_OBJ_MASS];
-    c[0] = 0.0 - mass * hand[HH_P_GX];
-    c[1] = 0.0 - mass * hand[HH_P_GY];
-    c[2] = 0.0;
-    c[3] = until;
+    c[HH_SUPPORT_C_FORCE] = 0.0 - mass * hand[HH_P_GX];
+    c[HH_SUPPORT_C_FORCE + 1] = 0.0 - mass * hand[HH_P_GY];
+    c[HH_SUPPORT_C_FORCE + 2] = 0.0;
+    c[HH_SUPPORT_C_UNTIL] = until;
     return 0;
 }

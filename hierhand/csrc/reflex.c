@@ -300,7 +300,7 @@ int hh_reflex_output(const hh_model *m, const double *params, const double *stat
         hh_finger_point_jacobian((const double(*)[2])pts, pts[3][0] + point[0] - in->tip[3 * i],
                                  pts[3][1] + point[1] - in->tip[3 * i + 1], jac);
         for (int j = 0; j < 3; j++)
-            out[HH_REFLEX_O_TAU + 3 * i + j] = jac[0][j] * f[i][0] + jac[1][j] * f[i][1];
+            out[HH_REFLEX_O_TAU_G + 3 * i + j] = jac[0][j] * f[i][0] + jac[1][j] * f[i][1];
         out[HH_REFLEX_O_FORCE + i] = sqrt(f[i][0] * f[i][0] + f[i][1] * f[i][1]);
         out[HH_REFLEX_O_ACTIVE + i] = grasp[i] ? 1.0 : 0.0;
     }

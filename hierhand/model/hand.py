@@ -19,21 +19,8 @@ import numpy as np
 from blocks.arrays import float_array
 
 from .. import _native
+from ..layouts import BODY, DIMENSIONS, EDGE, FINGER_ROW
 from .handfile import HandFileError, HandParams, merge_with_default, parse_hand, read_hand_file
-from .layout import (
-    E_COUNT,
-    E_DX,
-    E_DY,
-    E_OX,
-    E_OY,
-    E_SPACING,
-    E_START,
-    F_TIP_RADIUS,
-    N_BODY_PARAMS,
-    N_EDGE_COLS,
-    N_EDGES,
-    N_FINGER_PARAMS,
-)
 
 
 def load_hand(path_or_dict: str | Path | Mapping[str, Any]) -> "Hand":
@@ -77,14 +64,14 @@ class Hand:
         self.names = tuple(f.name for f in params.fingers)
         self.vector = params.vector
         self.native = _native.Model(self.vector)
-        self.fingers = np.empty((3, N_FINGER_PARAMS))
-        self.body = np.empty(N_BODY_PARAMS)
-        self.edges = np.empty((N_EDGES, N_EDGE_COLS))
+        self.fingers = np.empty((3, FINGER_ROW.size))
+        self.body = np.empty(BODY.size)
+        self.edges = np.empty((DIMENSIONS["EDGES"], EDGE.size))
         self.q0 = np.empty(9)
         pose0 = np.empty(3)
         self.native.pack_into(self.fingers, self.body, self.edges, self.q0, pose0)
         self.n_points = self.native.npts
-        self.tip_radius = self.fingers[:, F_TIP_RADIUS].copy()
+        self.tip_radius = self.fingers[:, FINGER_ROW.TIP_RADIUS].copy()
         self.gravity = np.array(params.gravity, dtype=float)
         self._pose0 = pose0
         for array in (self.fingers, self.body, self.edges, self.q0, self.tip_radius, self.gravity, pose0):
@@ -169,12 +156,11 @@ class Hand:
     def surface_points(self, pose: np.ndarray | None = None) -> np.ndarray:
         """(n_points, 2): the object's surface points, in the object frame or at ``pose``."""
         local = np.empty((self.n_points, 2))
-        for e in range(N_EDGES):
-            row = self.edges[e]
-            k = np.arange(int(row[E_COUNT]))
-            s = int(row[E_START])
-            local[s : s + k.size, 0] = row[E_OX] + (k * row[E_SPACING]) * row[E_DX]
-            local[s : s + k.size, 1] = row[E_OY] + (k * row[E_SPACING]) * row[E_DY]
+        for row in self.edges:
+            k = np.arange(int(row[EDGE.COUNT]))
+            s = int(row[EDGE.START])
+            local[s : s + k.size, 0] = row[EDGE.OX] + (k * row[EDGE.SPACING]) * row[EDGE.DX]
+            local[s : s + k.size, 1] = row[EDGE.OY] + (k * row[EDGE.SPACING]) * row[EDGE.DY]
         if pose is None:
             return local
         x, y, th = np.asarray(pose, dtype=float)

@@ -3,7 +3,8 @@
 The hand is given once, on the plant. ``GraspReflex``, ``ManipulationPD`` and
 ``ObjectSupport`` have a block-reference parameter ``hand`` (``hand: plant`` in a
 diagram; the loader passes the plant block), so ``--set plant.object.mass=0.36`` changes
-the model of every block at once. The plant may be a ``HandPlant`` or the FMU that
+the model of every block at once; in an exported FMU their records' hand segments are
+linked to the plant's (``hand_link``). The plant may be a ``HandPlant`` or the FMU that
 ``hierhand fmu export`` makes of it; from Python a ``Hand`` will do as well.
 """
 
@@ -12,7 +13,9 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from blocks import Block
+from blocks.engine.kernel import Link
 
+from ..layouts import PLANT_RECORD, SEGMENT
 from .hand import Hand, load_hand
 from .handfile import HandFileError, default_hand_dict
 from .hand_vector import hand_dict, parameter_names
@@ -74,6 +77,13 @@ def hand_of(source: Any, param: str = "hand") -> Hand:
         what = f"got a {type(source).__name__}"
     in_diagram = isinstance(source, Block) and source.name is not None
     raise ValueError(f"parameter '{param}': {what}; {EXPECTED if in_diagram else EXPECTED_FROM_PYTHON}")
+
+
+def hand_link(source: Any, slot: int) -> tuple[Link, ...]:
+    """The link of a record's hand segment at ``slot`` to the plant block ``source``, whose
+    record holds its own at ``PLANT_RECORD.SEGMENT`` (no link when the hand was given
+    otherwise, as a ``Hand``)."""
+    return (Link(slot, SEGMENT.size, source, PLANT_RECORD.SEGMENT),) if isinstance(source, HandPlant) else ()
 
 
 def fmu_hand(fmu: "FMU") -> Hand:

@@ -1,6 +1,6 @@
 """``HandPlant``: the hand/object plant as a block (penalty contact, 0.1 ms typical).
 
-The state is one flat float64 vector (layout in ``hierhand/csrc/hand.h``): joint angles
+The state is one flat float64 vector (layout ``STATE`` of ``hierhand/csrc/layouts.h``): joint angles
 and rates, object pose and velocity, and the contact bookkeeping (per finger and surface
 point an in-contact flag and an anchor). Copying it checkpoints a run. ``views(state)``
 names its parts. All physics runs in the C core (``hierhand/csrc``, through
@@ -21,48 +21,23 @@ from blocks.block import Block, BlockError
 from blocks.engine.kernel import Kernel, KernelRecord
 
 from .. import _native
-from ..kernels import KERNELS, PLANT_SEGMENT, context_of, hand_segment, hand_tunables, inertia_follows, record
+from ..layouts import OUTPUT, PLANT_INPUTS, PLANT_RECORD, PLANT_STATUS, STATE, WRENCH, port_columns, ports
+from ..records import KERNELS, context_of, hand_segment, hand_tunables, inertia_follows, record
 from .hand import Hand
 from .handfile import SECTIONS, default_hand_dict, merge_with_default, parse_hand
-from .layout import (
-    ERR_F_EXT,
-    ERR_OBJ,
-    ERR_OBJ_VEL,
-    ERR_PENETRATION,
-    ERR_Q,
-    ERR_QD,
-    ERR_TAU,
-    N_OUTPUTS,
-    N_WRENCH,
-    OUTPUT_PORTS,
-    S_OBJ,
-    S_OBJ_VEL,
-    S_Q,
-    S_QD,
-    S_TOUCH,
-    S_WINDOW,
-    W_FN,
-    W_FN_PX,
-    W_FN_PY,
-    W_FT,
-    W_OBJ_FX,
-    W_OBJ_FY,
-    W_OBJ_M,
-    W_TIP_M,
-    anchor_offset,
-)
 from .port_info import DescribesHandPorts
 
-_PORT_SLICES = []  # (port, its columns in an output row)
-_offset = 0
-for _name, _width in OUTPUT_PORTS:
-    _PORT_SLICES.append((_name, slice(_offset, _offset + _width)))
-    _offset += _width
+_PORT_SLICES = port_columns(OUTPUT)  # (port, its columns in a row)
 _PORT_COLUMNS = [(name, (slice(None), sl)) for name, sl in _PORT_SLICES]  # ready-made 2-D indices
 _ZERO3 = np.zeros(3)
 _ZERO3.flags.writeable = False
 _advance, _step, _output = _native.advance, _native.step, _native.output
 _KERNEL_FUNCTIONS = {phase: KERNELS[f"HandPlant.{phase}"] for phase in ("output", "update", "advance")}
+
+
+def anchor_offset(npts: int) -> int:
+    """Where the anchors start in the state, after the touching flags (its length: ``Model.state_size``)."""
+    return STATE.TOUCH + 3 * npts
 
 
 @dataclass(frozen=True)
@@ -138,9 +113,9 @@ class HandPlant(DescribesHandPorts, Block):
         diagram does not give it)."""
         self._inertia_derived = object is not None and not given_inertia
         """Whether it was computed from them here."""
-        self.inputs = {"tau": 9, "f_ext": 3}
+        self.inputs = dict(PLANT_INPUTS)
         self.input_defaults = {"f_ext": _ZERO3}
-        self.outputs = dict(OUTPUT_PORTS)
+        self.outputs = dict(ports(OUTPUT))
         self.n_points = self.hand.n_points
         self._state_shape = (self.hand.native.state_size,)
         self._model: _native.Model | None = None  # the hand packed with its step, once bound
@@ -189,12 +164,12 @@ class HandPlant(DescribesHandPorts, Block):
         n = self.n_points
         a = anchor_offset(n)
         return StateViews(
-            q=state[S_Q : S_Q + 9],
-            qd=state[S_QD : S_QD + 9],
-            obj=state[S_OBJ : S_OBJ + 3],
-            obj_vel=state[S_OBJ_VEL : S_OBJ_VEL + 3],
-            window=state[S_WINDOW:S_TOUCH].reshape(3, 4, 2),
-            touching=state[S_TOUCH:a].reshape(3, n),
+            q=state[STATE.slice("Q")],
+            qd=state[STATE.slice("QD")],
+            obj=state[STATE.slice("OBJ")],
+            obj_vel=state[STATE.slice("OBJ_VEL")],
+            window=state[STATE.slice("WINDOW")].reshape(3, 4, 2),
+            touching=state[STATE.TOUCH:a].reshape(3, n),
             anchor=state[a : a + 6 * n].reshape(3, n, 2),
         )
 
@@ -205,7 +180,7 @@ class HandPlant(DescribesHandPorts, Block):
     # refuses goes through ``_arguments``, which converts inputs or names the problem.
 
     def output(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        row = np.empty(N_OUTPUTS)
+        row = np.empty(OUTPUT.size)
         try:
             code, _, which = _output(self._model, state, row)
         except (TypeError, ValueError):
@@ -228,7 +203,7 @@ class HandPlant(DescribesHandPorts, Block):
 
     def advance(self, t: float, state: np.ndarray, inputs: Mapping[str, np.ndarray], n: int):
         tau, f_ext = inputs["tau"], inputs.get("f_ext", _ZERO3)
-        rows = np.empty((n, N_OUTPUTS))
+        rows = np.empty((n, OUTPUT.size))
         try:
             code, done, which = _advance(self._model, state, tau, f_ext, rows)
         except (TypeError, ValueError):
@@ -242,7 +217,7 @@ class HandPlant(DescribesHandPorts, Block):
         return state, {name: rows[index] for name, index in _PORT_COLUMNS}
 
     def kernel(self) -> Kernel | None:
-        """The C step functions (kernel type ``HandPlant``, ``hierhand/csrc/kernels.c``):
+        """The C step functions (kernel type ``HandPlant``, ``hierhand/csrc/kernel_types.c``):
         the native calls of ``output``, ``update`` and ``advance``; None before ``bind``.
         Its ``bind`` builds each run a context of its own from the record (the model and
         the scratch the steps write), so runs in several threads share nothing and run
@@ -258,10 +233,10 @@ class HandPlant(DescribesHandPorts, Block):
                       **_KERNEL_FUNCTIONS)
 
     def kernel_record(self) -> KernelRecord:
-        """``[dt, hand segment]`` with the hand's numbers as tunables (``kernels.h``)."""
+        """``[dt, hand segment]`` (``PLANT_RECORD``) with the hand's numbers as tunables."""
         return record("HandPlant", [self.dt], hand_segment(self.hand, self._inertia_derived),
-                      tunables=hand_tunables(PLANT_SEGMENT),
-                      follows=inertia_follows(PLANT_SEGMENT) if self._inertia_may_follow else ())
+                      tunables=hand_tunables(PLANT_RECORD.SEGMENT),
+                      follows=inertia_follows(PLANT_RECORD.SEGMENT) if self._inertia_may_follow else ())
 
     def _bound_kernel(self, rec: KernelRecord, state: np.ndarray) -> Kernel:
         """``Kernel.bind``: the kernel of one run, stepping ``state`` in a context of its own."""
@@ -288,22 +263,22 @@ class HandPlant(DescribesHandPorts, Block):
         """The contact forces of ``state`` (the same evaluation the step uses)."""
         self._check_state(state)
         tips = np.empty((3, 3))
-        w = np.empty((3, N_WRENCH))
+        w = np.empty((3, WRENCH.size))
         code, _, which = _native.contact(self._model, state, tips, w)
         if code:
             raise self._error(code, which, None)
-        on_obj = w[:, [W_OBJ_FX, W_OBJ_FY]].copy()
-        fn = w[:, W_FN].copy()
+        on_obj = w[:, [WRENCH.OBJ_FX, WRENCH.OBJ_FY]].copy()
+        fn = w[:, WRENCH.FN].copy()
         with np.errstate(invalid="ignore", divide="ignore"):
-            point = np.where(fn[:, None] > 0, w[:, [W_FN_PX, W_FN_PY]] / fn[:, None], np.nan)
+            point = np.where(fn[:, None] > 0, w[:, [WRENCH.FN_PX, WRENCH.FN_PY]] / fn[:, None], np.nan)
         return ContactWrenches(
             on_object=on_obj,
-            object_moment=w[:, W_OBJ_M].copy(),
+            object_moment=w[:, WRENCH.OBJ_M].copy(),
             on_finger=-on_obj,
-            finger_moment=-w[:, W_TIP_M],
+            finger_moment=-w[:, WRENCH.TIP_M],
             point=point,
             fn=fn,
-            ft=w[:, W_FT].copy(),
+            ft=w[:, WRENCH.FT].copy(),
             tip=tips,
         )
 
@@ -324,7 +299,7 @@ class HandPlant(DescribesHandPorts, Block):
         time, so that a run's status names one time (the bad state is the one after it)."""
         names = self.hand.names
         when = "in the given state" if t is None else f"in the step at t={t:.10g} s" if step else f"at t={t:.10g} s"
-        if code == ERR_PENETRATION:
+        if code == PLANT_STATUS.ERR_PENETRATION:
             r = self.hand.tip_radius[which]
             return BlockError(
                 f"HandPlant: contact penetration deeper than the fingertip radius {when}: "
@@ -332,14 +307,16 @@ class HandPlant(DescribesHandPorts, Block):
                 "the contact is too soft for the forces or the step too large",
                 port="contact",
             )
-        joint = f"{names[which // 3]} joint {which % 3 + 1}" if code in (ERR_Q, ERR_QD, ERR_TAU) else ""
+        status = PLANT_STATUS
+        in_joint = code in (status.ERR_Q, status.ERR_QD, status.ERR_TAU)
+        joint = f"{names[which // 3]} joint {which % 3 + 1}" if in_joint else ""
         what = {
-            ERR_Q: ("q", f"joint angle q[{which}] ({joint})"),
-            ERR_QD: ("qd", f"joint velocity qd[{which}] ({joint})"),
-            ERR_OBJ: ("obj", f"object pose obj[{which}] ({('x', 'y', 'theta')[which % 3]})"),
-            ERR_OBJ_VEL: ("obj_vel", f"object velocity obj_vel[{which}] ({('vx', 'vy', 'omega')[which % 3]})"),
-            ERR_TAU: ("tau", f"input torque tau[{which}] ({joint})"),
-            ERR_F_EXT: ("f_ext", f"input f_ext[{which}]"),
+            status.ERR_Q: ("q", f"joint angle q[{which}] ({joint})"),
+            status.ERR_QD: ("qd", f"joint velocity qd[{which}] ({joint})"),
+            status.ERR_OBJ: ("obj", f"object pose obj[{which}] ({('x', 'y', 'theta')[which % 3]})"),
+            status.ERR_OBJ_VEL: ("obj_vel", f"object velocity obj_vel[{which}] ({('vx', 'vy', 'omega')[which % 3]})"),
+            status.ERR_TAU: ("tau", f"input torque tau[{which}] ({joint})"),
+            status.ERR_F_EXT: ("f_ext", f"input f_ext[{which}]"),
         }
         port, quantity = what[code]
         return BlockError(f"HandPlant: non-finite value {when}: {quantity} is not finite", port=port)

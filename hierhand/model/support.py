@@ -17,13 +17,15 @@ from blocks import Block
 from blocks.engine.kernel import Kernel, Tunable
 
 from .. import _native
-from ..kernels import KERNELS, SEGMENT, context_of, hand_link, hand_segment, record
-from .hand_source import ModelsTheHand, hand_of
+from ..layouts import SUPPORT_CONTEXT, SUPPORT_RECORD
+from ..records import KERNELS, context_of, hand_segment, record
+from .hand_source import ModelsTheHand, hand_link, hand_of
 from .port_info import DescribesHandPorts
 
 
 support_pack = _native.support_pack
-"""``support_pack(None, hand_vector, until) -> [fx, fy, torque, until]``: the force, 0 - m g (C)."""
+"""``support_pack(None, hand_vector, until) -> context``: [fx, fy, torque, until]
+(``SUPPORT_CONTEXT``), the force 0 - m g (C)."""
 
 
 class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
@@ -53,9 +55,9 @@ class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
         if isinstance(until, bool) or not isinstance(until, (int, float)) or not math.isfinite(until):
             raise ValueError(f"parameter 'until' must be a finite time in seconds, got {until!r}")
         self.until = float(until)
-        self._links = hand_link(hand)
+        self._links = hand_link(hand, SUPPORT_RECORD.SEGMENT)
         self._context = support_pack(None, self.hand.vector, self.until)  # [force, until], in C
-        self.force = self._context[:3].copy()
+        self.force = self._context[SUPPORT_CONTEXT.slice("FORCE")].copy()
         self.force.flags.writeable = False
         self.inputs = {}
         self.outputs = {"y": 3}
@@ -71,7 +73,7 @@ class ObjectSupport(DescribesHandPorts, ModelsTheHand, Block):
         held = getattr(self, "_kernel", None)
         if held is None:
             rec = record("ObjectSupport", hand_segment(self.hand, False), [self.until],
-                         tunables=(Tunable("until", SEGMENT, "time from which the support is gone", "s"),),
+                         tunables=(Tunable("until", SUPPORT_RECORD.UNTIL, "time from which the support is gone", "s"),),
                          links=self._links)
             ctx = context_of(rec)
             held = self._kernel = Kernel(context=ctx.address, output=KERNELS["ObjectSupport.output"], owners=(ctx,),

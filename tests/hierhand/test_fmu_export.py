@@ -127,8 +127,8 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
         names = set(archive.namelist())
     folder = "linux64" if fmi == 2 else "x86_64-linux"
     assert f"binaries/{folder}/{identifier}.so" in names
-    assert {"sources/plant.c", "sources/hand.h", "sources/core.c", "sources/kernels.c", f"sources/export_fmi{fmi}.c",
-            "resources/diagram.bin"} <= names
+    assert {"sources/plant.c", "sources/hand.h", "sources/core.c", "sources/kernel_types.c", "sources/layouts.h",
+            "sources/joint_low_pass.c", f"sources/export_fmi{fmi}.c", "resources/diagram.bin"} <= names
     assert ("sources/buildDescription.xml" in names) == (fmi == 3)
     listed = md.buildConfigurations[0].sourceFileSets[0].sourceFiles
     assert all(f"sources/{name}" in names for name in listed) and "plant.c" in listed

@@ -14,7 +14,7 @@ from blocks.engine import native_sources as framework_sources
 from blocks.block import BlockError
 from hierhand import _native, native_sources
 from hierhand.model import Hand, HandPlant
-from hierhand.model.layout import N_OUTPUTS, S_TOUCH, S_WINDOW
+from hierhand.layouts import OUTPUT, STATE
 
 REPO = Path(__file__).resolve().parents[2]
 FMI_HEADERS = Path(__import__("fmpy").__file__).parent / "c-code"
@@ -46,7 +46,7 @@ def test_a_model_without_a_step_cannot_step():
     state = np.empty(model.state_size)
     _native.initial_state(model, state)
     with pytest.raises(ValueError, match="no step"):
-        _native.advance(model, state, np.zeros(9), np.zeros(3), np.empty((1, N_OUTPUTS)))
+        _native.advance(model, state, np.zeros(9), np.zeros(3), np.empty((1, OUTPUT.size)))
     with pytest.raises(ValueError, match="dt must be a positive"):
         model.with_dt(0.0)
 
@@ -64,7 +64,7 @@ def test_a_model_without_a_step_cannot_step():
 def test_the_core_refuses_arrays_it_cannot_take(mutate, error, match):
     model = bound_model()
     args = {"model": model, "state": np.empty(model.state_size), "tau": np.zeros(9), "f_ext": np.zeros(3),
-            "rows": np.empty((2, N_OUTPUTS))}
+            "rows": np.empty((2, OUTPUT.size))}
     _native.initial_state(model, args["state"])
     mutate(args)
     with pytest.raises(error, match=match):
@@ -101,13 +101,13 @@ def test_a_hostile_contact_window_in_the_state_cannot_write_outside_it(window):
     model = bound_model()
     state = np.empty(model.state_size)
     _native.initial_state(model, state)
-    state[S_WINDOW:S_TOUCH] = window
+    state[STATE.slice("WINDOW")] = window
     before = state.copy()
-    rows = np.empty((20, N_OUTPUTS))
+    rows = np.empty((20, OUTPUT.size))
     code, done, _ = _native.advance(model, state, np.zeros(9), np.zeros(3), rows)
     assert code == 0 and done == 20
     assert np.isfinite(rows).all()
-    np.testing.assert_array_equal(state[S_TOUCH:], before[S_TOUCH:])  # no finger touches: no anchor moved
+    np.testing.assert_array_equal(state[STATE.TOUCH:], before[STATE.TOUCH:])  # no finger touches: no anchor moved
 
 
 def test_plant_converts_inputs_it_can_and_names_the_ones_it_cannot():

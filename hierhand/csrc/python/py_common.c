@@ -95,3 +95,31 @@ int hh_py_finger(PyObject *obj, int *finger)
     *finger = (int)f;
     return 0;
 }
+
+int hh_py_elementwise(held_buffers *h, PyObject *a, const char *a_name, PyObject *out, const double **values,
+                      double **result, Py_ssize_t *n)
+{
+    if ((*values = hh_py_hold(h, a, -1, 0, a_name)) == NULL)
+        return -1;
+    *n = hh_py_last_count(h);
+    return (*result = hh_py_hold(h, out, *n, 1, "out")) == NULL ? -1 : 0;
+}
+
+PyObject *hh_py_map_values(PyObject *const *args, Py_ssize_t nargs, const char *name, const char *what,
+                          double (*fn)(double))
+{
+    held_buffers h = {.held = 0};
+    const double *values;
+    double *out;
+    Py_ssize_t n;
+    PyObject *result = NULL;
+    if (hh_py_nargs(nargs, 2, name) != 0)
+        return NULL;
+    if (hh_py_elementwise(&h, args[0], what, args[1], &values, &out, &n) == 0) {
+        for (Py_ssize_t i = 0; i < n; i++)
+            out[i] = fn(values[i]);
+        result = Py_NewRef(Py_None);
+    }
+    hh_py_release_all(&h);
+    return result;
+}

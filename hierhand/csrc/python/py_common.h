@@ -10,7 +10,7 @@
 /* A packed hand (hh_model) with the scratch its steps from Python use. The scratch makes
  * a Model unsafe to step from two threads at once; those functions hold the GIL
  * throughout, and the compiled kernel steps with a context of its run instead (its own
- * model and scratch, py_kernels.c). */
+ * model and scratch, py_kernel_types.c). */
 typedef struct {
     PyObject_HEAD
     hh_model model;
@@ -19,7 +19,7 @@ typedef struct {
 
 extern PyTypeObject hh_py_model_type;
 
-/* A kernel's context built by its type's constructor from a record (py_kernels.c). */
+/* A kernel's context built by its type's constructor from a record (py_kernel_types.c). */
 extern PyTypeObject hh_py_context_type;
 
 /* ``obj`` as a Model, or NULL with TypeError naming ``what``. */
@@ -55,12 +55,28 @@ int hh_py_double(PyObject *obj, double *out, const char *what);
 /* Check the argument count of a METH_FASTCALL function. */
 int hh_py_nargs(Py_ssize_t nargs, Py_ssize_t expected, const char *function);
 
+/* a (n values, named a_name) and out (as many, writable) held in h: the elementwise functions' arguments. */
+int hh_py_elementwise(held_buffers *h, PyObject *a, const char *a_name, PyObject *out, const double **values,
+                      double **result, Py_ssize_t *n);
+
+/* fn of every value of args[0] (named what) into args[1], for the function ``name``. */
+PyObject *hh_py_map_values(PyObject *const *args, Py_ssize_t nargs, const char *name, const char *what,
+                          double (*fn)(double));
+
+/* A METH_FASTCALL entry of a method table. */
+#define HH_PY_FASTCALL(function) (PyCFunction)(void (*)(void))(function), METH_FASTCALL
+
+/* The module's functions, one table per concept (module.c joins them). */
 extern PyMethodDef hh_py_model_methods[]; /* py_model.c: the hand vector, queries */
 extern PyMethodDef hh_py_plant_methods[]; /* py_plant.c: stepping */
-extern PyMethodDef hh_py_control_methods[]; /* py_control.c: the controllers */
-extern PyMethodDef hh_py_kernel_methods[]; /* py_kernels.c: the blocks' compiled kernels */
+extern PyMethodDef hh_py_reflex_methods[]; /* py_reflex.c: the grasping reflex, internal forces */
+extern PyMethodDef hh_py_manipulation_methods[]; /* py_manipulation.c: the PD, trajectories, kinematics */
+extern PyMethodDef hh_py_suppresser_methods[]; /* py_suppresser.c: the suppresser */
+extern PyMethodDef hh_py_param_methods[]; /* py_params.c: the blocks' parameters checked and packed */
+extern PyMethodDef hh_py_kernel_methods[]; /* py_kernel_types.c: the blocks' compiled kernels */
 
-/* Add the controllers' layout constants to ``layout`` (py_control.c); -1 on error. */
-int hh_py_control_layout(PyObject *layout);
+/* LAYOUTS, RECORD_LAYOUTS, INPUT_PORTS and DIMENSIONS, layouts.h's tables, into the module
+ * (py_layouts.c); -1 on error. */
+int hh_py_add_layouts(PyObject *module);
 
 #endif

@@ -6,9 +6,9 @@ solve written out by hand, the tip Jacobians from the plant's own kinematics, no
 allocation. ``internal_forces`` calls the same C for its ``project_internal`` and
 ``internal_directions``.
 
-Parameters travel packed in one array (slots ``P_*``, built by ``pack_params``) so that a
-call costs little to dispatch. The slots are defined once, in ``hierhand/csrc/control.h``
-(``hierhand._native.LAYOUT``).
+Parameters travel packed in one array (``REFLEX_PARAMS``, built by ``pack_params`` from the
+block's numbers as given, ``REFLEX_GIVEN``) so that a call costs little to dispatch. The
+slots are declared once, in ``hierhand/csrc/layouts.h`` (``hierhand.layouts``).
 
 The functions here return fresh arrays. Inputs the native call refuses for their type
 (lists, other dtypes, non-contiguous arrays) are converted to float64 and passed again;
@@ -22,32 +22,7 @@ import numpy as np
 from blocks.arrays import flat_float64
 
 from .. import _native
-
-_L = _native.LAYOUT
-
-# -- packed parameters: params[P_*] -----------------------------------------------------
-P_THRESHOLD: int = _L["REFLEX_P_THRESHOLD"]  # contact_threshold, N
-P_APPROACH: int = _L["REFLEX_P_APPROACH"]  # approach_force, N
-P_KI: int = _L["REFLEX_P_KI"]  # integral gain, 1/s
-P_DT: int = _L["REFLEX_P_DT"]  # period, s (NaN until bound)
-P_MIN_FORCE: int = _L["REFLEX_P_MIN_FORCE"]
-P_RATIO: int = _L["REFLEX_P_RATIO"]  # ratio_target = safety_ratio / (1 + margin)
-P_MAX_FORCE: int = _L["REFLEX_P_MAX_FORCE"]
-P_INITIAL: int = _L["REFLEX_P_INITIAL"]  # three slots: 1.0 for the fingers listed in 'grasp'
-P_COINCIDENT_RTOL: int = _L["REFLEX_P_COINCIDENT_RTOL"]  # internal_forces._COINCIDENT_RTOL
-P_RELEASE_SHARE: int = _L["REFLEX_P_RELEASE_SHARE"]  # losing contact below this share: not pushed back
-P_TIP_RADIUS: int = _L["REFLEX_P_TIP_RADIUS"]  # three fingertip radii (contact point = tip + radius * normal)
-P_FOLLOW: int = _L["REFLEX_P_FOLLOW"]  # 1.0: the hold of a finger follows its share (hand-over)
-P_HOLD_SHARE: int = _L["REFLEX_P_HOLD_SHARE"]  # a third finger is held whole down to this share
-N_PARAMS: int = _L["REFLEX_N_PARAMS"]
-
-# -- output vector of reflex_output: tau_g(9) force(3) active(3) ------------------------
-O_TAU: int = _L["REFLEX_O_TAU"]
-O_FORCE: int = _L["REFLEX_O_FORCE"]
-O_ACTIVE: int = _L["REFLEX_O_ACTIVE"]
-N_OUT: int = _L["REFLEX_N_OUT"]
-
-N_STATE: int = _L["REFLEX_N_STATE"]  # [scale, handed over when it last touched (3), hold (3)]
+from ..layouts import REFLEX_OUT, REFLEX_STATE
 
 _directions = _native.reflex_directions
 _forces = _native.reflex_forces
@@ -62,23 +37,9 @@ WHOLE_SHARE = np.ones(3)
 """The ``share`` input when nothing overrides the reflex: every finger's command keeps its whole grasping torque."""
 
 
-G_KI: int = _L["REFLEX_G_KI"]  # -- the block's parameters as given: given[G_*] (control.h)
-G_SAFETY_RATIO: int = _L["REFLEX_G_SAFETY_RATIO"]
-G_MARGIN: int = _L["REFLEX_G_MARGIN"]
-G_MIN_FORCE: int = _L["REFLEX_G_MIN_FORCE"]
-G_MAX_FORCE: int = _L["REFLEX_G_MAX_FORCE"]
-G_APPROACH: int = _L["REFLEX_G_APPROACH"]
-G_THRESHOLD: int = _L["REFLEX_G_THRESHOLD"]
-G_RELEASE_SHARE: int = _L["REFLEX_G_RELEASE_SHARE"]
-G_HOLD_SHARE: int = _L["REFLEX_G_HOLD_SHARE"]
-G_FOLLOW: int = _L["REFLEX_G_FOLLOW"]
-G_GRASP: int = _L["REFLEX_G_GRASP"]  # three: 1.0 for the fingers listed in 'grasp'
-G_COINCIDENT_RTOL: int = _L["REFLEX_G_COINCIDENT_RTOL"]
-N_GIVEN: int = _L["REFLEX_N_GIVEN"]
-
 pack_params = _native.reflex_pack
-"""``pack_params(given, hand_vector, dt) -> params``: the block's parameters (``G_*``)
-checked and packed into the native calls' flat array (``P_*``: the ratio target
+"""``pack_params(given, hand_vector, dt) -> params``: the block's parameters (``REFLEX_GIVEN``)
+checked and packed into the native calls' flat array (``REFLEX_PARAMS``: the ratio target
 ``safety_ratio / (1 + margin)``, the hand's tip radii, the period ``dt``); ValueError
 naming a bad parameter. The checks are hierhand/csrc/control_params.c's, which an exported
 FMU applies too."""
@@ -125,7 +86,7 @@ def reflex_output(model, params, state, q, tip, normal, fn) -> np.ndarray:
     ``tau_g`` stacks ``J_i^T f_i``, ``J_i`` the Jacobian of finger i's tip centre at ``q``
     (``model``: the hand's ``hierhand._native.Model``, ``Hand.native``).
     """
-    out = np.empty(N_OUT)
+    out = np.empty(REFLEX_OUT.size)
     try:
         _output(model, params, state, tip, normal, fn, q, out)
     except TypeError:
@@ -144,7 +105,7 @@ def reflex_update(params, state, tip, normal, fn, ft, share=WHOLE_SHARE) -> np.n
     |g_i|, |ft_i| / ratio_target)``, clipped to ``[0, max_force]``. A touching finger is
     marked handed over (1.0) while its hold is below 1; one out of contact keeps its mark.
     """
-    new = np.empty(N_STATE)
+    new = np.empty(REFLEX_STATE.size)
     try:
         _update(params, state, tip, normal, fn, ft, share, new)
     except TypeError:

@@ -10,20 +10,13 @@ import numpy as np
 import pytest
 
 from hierhand import _native
-from hierhand.control import UnreachableError, manipulation_pd, reflex_kernel, suppresser
+from hierhand.control import UnreachableError, manipulation_pd, reflex_law, suppresser
 from hierhand.control.grasp_reflex import GraspReflex
-from hierhand.control.manipulation_kernel import (
-    M_COUNT,
-    M_INTERP,
-    N_OUT,
-    OK,
-    UNREACHABLE,
-    manipulation_output,
-    pack_trajectories,
-)
+from hierhand.control.manipulation_law import manipulation_output, pack_trajectories
 from hierhand.control.manipulation_pd import ManipulationPD
 from hierhand.control.suppresser import Suppresser
 from hierhand.control.trajectory import INTERPOLATIONS, Trajectory
+from hierhand.layouts import MANIP_META as M, MANIP_OUT, MANIP_STATUS as STATUS
 from hierhand.model import Hand, HandPlant
 
 from . import oracles
@@ -166,7 +159,7 @@ def test_float64_arrays_with_a_distinct_dtype_object_take_the_native_path(monkey
     def refuse(*args, **kwargs):
         raise AssertionError("conversion taken")
 
-    for module in (manipulation_pd, suppresser, reflex_kernel):
+    for module in (manipulation_pd, suppresser, reflex_law):
         monkeypatch.setattr(module, "flat_float64", refuse)
     pd = bound_pd(hand=hand, trajectories=REGRASP)
     s = Suppresser()
@@ -229,10 +222,12 @@ def test_native_output_reports_the_unreachable_finger():
                                                                         [1.0, 0.035, -0.038, math.pi / 2]]}})
     inputs = (hand.q0, np.zeros(9), np.zeros(3), np.zeros(3), np.zeros(6), hand.object_pose0)
     out = np.empty((3, 9))
-    assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, out) == OK
-    assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.5, *inputs, out) == UNREACHABLE + 1
+    assert manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, out) == STATUS.OK
+    status = manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.5, *inputs, out)
+    assert status == STATUS.UNREACHABLE + 1
     with pytest.raises(ValueError, match="out must hold 27 values"):
-        manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs, np.empty(N_OUT - 1))
+        manipulation_output(hand.native, pd._params, pd._waypoints, pd._meta, 0.1, *inputs,
+                            np.empty(MANIP_OUT.size - 1))
     with pytest.raises(UnreachableError, match="^fore: unreachable"):
         pd.output(0.5, None, dict(zip(("q", "qd", "fn", "support", "normal", "obj"), inputs)))
 
@@ -265,16 +260,16 @@ def test_trajectory_arrays_are_checked():
     hand = Hand.default()
     pd = bound_pd(hand=hand)
     waypoints, meta = pack_trajectories([None, Trajectory([[0.0, 0.03, 0.06, 3.0], [1.0, 0.031, 0.06, 3.0]]), None])
-    assert meta.dtype == np.float64 and meta[1, M_COUNT] == 2 and meta[1, M_INTERP] == INTERPOLATIONS["minjerk"]
+    assert meta.dtype == np.float64 and meta[1, M.COUNT] == 2 and meta[1, M.INTERP] == INTERPOLATIONS["minjerk"]
     inputs = (hand.q0, np.zeros(9), np.zeros(3), np.zeros(3), np.zeros(6), hand.object_pose0, np.empty((3, 9)))
-    assert manipulation_output(hand.native, pd._params, waypoints, meta, 0.5, *inputs) == OK
+    assert manipulation_output(hand.native, pd._params, waypoints, meta, 0.5, *inputs) == STATUS.OK
     for bad in (2.5, 3.0, -1.0, np.nan):
         wrong = meta.copy()
-        wrong[1, M_COUNT] = bad
+        wrong[1, M.COUNT] = bad
         with pytest.raises(ValueError, match="waypoint count"):
             manipulation_output(hand.native, pd._params, waypoints, wrong, 0.5, *inputs)
     wrong = meta.copy()
-    wrong[1, M_INTERP] = 7
+    wrong[1, M.INTERP] = 7
     with pytest.raises(ValueError, match="interpolation"):
         manipulation_output(hand.native, pd._params, waypoints, wrong, 0.5, *inputs)
     with pytest.raises(ValueError, match="3 x n x 4"):

@@ -1,7 +1,7 @@
-/* The hierhand blocks' compiled kernels for Python: their kernel types (kernels.h) and
- * Context, a context built by a type's constructor from a block's record.
+/* The hierhand blocks' compiled kernels for Python: their kernel types (kernel_types.h)
+ * and Context, a context built by a type's constructor from a block's record.
  *
- * A block's kernel() writes its record (hierhand.kernels) and makes a Context of it: the
+ * A block's kernel() writes its record (hierhand.records) and makes a Context of it: the
  * constructor checks the record's numbers and builds what the adapters read (the plant's
  * model and scratch, a law's packed parameters), exactly as an exported FMU rebuilds it.
  * The Context frees it when it goes away; its address is the Kernel's context. kernels()
@@ -12,7 +12,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "../kernels.h"
+#include "../kernel_types.h"
 #include "blocks_kernel.h"
 
 typedef struct {
@@ -21,11 +21,14 @@ typedef struct {
     blk_built built;
 } ContextObject;
 
+static const blk_kernel_type *const TABLES[] = {HH_KERNEL_TYPE_TABLES};
+
 static const blk_kernel_type *type_named(const char *name)
 {
-    for (const blk_kernel_type *k = hh_kernel_types; k->name != NULL; k++)
-        if (strcmp(k->name, name) == 0)
-            return k;
+    for (const blk_kernel_type *const *table = TABLES; *table != NULL; table++)
+        for (const blk_kernel_type *k = *table; k->name != NULL; k++)
+            if (strcmp(k->name, name) == 0)
+                return k;
     return NULL;
 }
 
@@ -115,7 +118,7 @@ PyTypeObject hh_py_context_type = {
     .tp_basicsize = sizeof(ContextObject),
     .tp_dealloc = (destructor)context_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Context(kind, record): the context the constructor of kernel type kind (kernels.h) builds from "
+    .tp_doc = "Context(kind, record): the context the constructor of kernel type kind (kernel_types.h) builds from "
               "record (float64), ValueError with the constructor's message when it refuses the record; freed "
               "with the object.",
     .tp_getset = context_getset,
@@ -144,12 +147,12 @@ static PyObject *py_kernels(PyObject *module, PyObject *unused)
     (void)module;
     (void)unused;
     PyObject *found = PyDict_New();
-    for (const blk_kernel_type *k = hh_kernel_types; found != NULL && k->name != NULL; k++) {
-        if (add_kernel(found, k->name, "output", (void *)(uintptr_t)k->output) != 0 ||
-            add_kernel(found, k->name, "update", (void *)(uintptr_t)k->update) != 0 ||
-            add_kernel(found, k->name, "advance", (void *)(uintptr_t)k->advance) != 0)
-            Py_CLEAR(found);
-    }
+    for (const blk_kernel_type *const *table = TABLES; found != NULL && *table != NULL; table++)
+        for (const blk_kernel_type *k = *table; found != NULL && k->name != NULL; k++)
+            if (add_kernel(found, k->name, "output", (void *)(uintptr_t)k->output) != 0 ||
+                add_kernel(found, k->name, "update", (void *)(uintptr_t)k->update) != 0 ||
+                add_kernel(found, k->name, "advance", (void *)(uintptr_t)k->advance) != 0)
+                Py_CLEAR(found);
     return found;
 }
 
@@ -163,7 +166,7 @@ static PyObject *py_kernel_abi(PyObject *module, PyObject *unused)
 PyMethodDef hh_py_kernel_methods[] = {
     {"kernels", py_kernels, METH_NOARGS,
      "kernels() -> {name: address}: the blocks' compiled kernels ('HandPlant.output', ...), functions of the types "
-     "of blocks/csrc/blocks_kernel.h, from the kernel types of kernels.h."},
+     "of blocks/csrc/blocks_kernel.h, from the kernel types of kernel_types.h."},
     {"kernel_abi", py_kernel_abi, METH_NOARGS, "kernel_abi(): BLK_KERNEL_ABI of blocks_kernel.h built against."},
     {NULL, NULL, 0, NULL},
 };

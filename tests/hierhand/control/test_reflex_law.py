@@ -12,39 +12,8 @@ import numpy as np
 import pytest
 
 from hierhand.control.grasp_reflex import GraspReflex
-from hierhand.control.reflex_kernel import (
-    G_APPROACH,
-    G_COINCIDENT_RTOL,
-    G_FOLLOW,
-    G_GRASP,
-    G_HOLD_SHARE,
-    G_KI,
-    G_MARGIN,
-    G_MAX_FORCE,
-    G_MIN_FORCE,
-    G_RELEASE_SHARE,
-    G_SAFETY_RATIO,
-    G_THRESHOLD,
-    N_GIVEN,
-    N_PARAMS,
-    P_APPROACH,
-    P_COINCIDENT_RTOL,
-    P_DT,
-    P_FOLLOW,
-    P_HOLD_SHARE,
-    P_INITIAL,
-    P_KI,
-    P_MAX_FORCE,
-    P_MIN_FORCE,
-    P_RATIO,
-    P_RELEASE_SHARE,
-    P_THRESHOLD,
-    P_TIP_RADIUS,
-    pack_params,
-    reflex_directions,
-    reflex_output,
-    reflex_update,
-)
+from hierhand.control.reflex_law import pack_params, reflex_directions, reflex_output, reflex_update
+from hierhand.layouts import REFLEX_GIVEN as G, REFLEX_PARAMS as P
 from hierhand.model import Hand
 
 from . import oracles
@@ -237,32 +206,27 @@ def test_input_widths_are_checked_naming_the_port(port, width):
         reflex.update(0.0, np.zeros(3), random_case(np.random.default_rng(9), reflex, 2, inward=True)[1])
 
 
-def test_packed_parameters_land_in_the_slots_control_h_defines():
-    """Every value at its own slot (the slots come from control.h), including the
-    coincidence tolerance that internal_forces defines."""
+def test_packed_parameters_land_in_their_slots():
+    """Every value at its own slot (layouts.h), including the coincidence tolerance that
+    internal_forces defines."""
     from hierhand.control.internal_forces import _COINCIDENT_RTOL
-
-    slots = [P_THRESHOLD, P_APPROACH, P_KI, P_DT, P_MIN_FORCE, P_RATIO, P_MAX_FORCE, P_INITIAL, P_INITIAL + 1,
-             P_INITIAL + 2, P_COINCIDENT_RTOL, P_RELEASE_SHARE, P_TIP_RADIUS, P_TIP_RADIUS + 1, P_TIP_RADIUS + 2,
-             P_FOLLOW, P_HOLD_SHARE]
-    assert sorted(slots) == list(range(N_PARAMS))
     from hierhand.model.hand_vector import parameter_names
 
-    given = np.zeros(N_GIVEN)
-    given[G_THRESHOLD], given[G_APPROACH], given[G_KI], given[G_MIN_FORCE] = 0.05, 0.5, 50.0, 1.0
-    given[G_SAFETY_RATIO], given[G_MARGIN], given[G_MAX_FORCE] = 0.6, 0.05, 30.0
-    given[G_GRASP:G_GRASP + 3] = [1.0, 0.0, 1.0]
-    given[G_RELEASE_SHARE], given[G_HOLD_SHARE], given[G_FOLLOW] = 0.75, 0.85, 0.0
-    given[G_COINCIDENT_RTOL] = _COINCIDENT_RTOL
+    given = np.zeros(G.size)
+    given[G.THRESHOLD], given[G.APPROACH], given[G.KI], given[G.MIN_FORCE] = 0.05, 0.5, 50.0, 1.0
+    given[G.SAFETY_RATIO], given[G.MARGIN], given[G.MAX_FORCE] = 0.6, 0.05, 30.0
+    given[G.slice("GRASP")] = [1.0, 0.0, 1.0]
+    given[G.RELEASE_SHARE], given[G.HOLD_SHARE], given[G.FOLLOW] = 0.75, 0.85, 0.0
+    given[G.COINCIDENT_RTOL] = _COINCIDENT_RTOL
     hand = Hand.default().vector.copy()
     names = parameter_names()
     for f, radius in enumerate((0.009, 0.008, 0.007)):
         hand[names.index(f"fingers[{f + 1}].tip_radius")] = radius
     p = pack_params(given, hand, 0.001)
-    assert p[P_COINCIDENT_RTOL] == _COINCIDENT_RTOL and p[P_RELEASE_SHARE] == 0.75 and p[P_FOLLOW] == 0.0
-    assert p[P_HOLD_SHARE] == 0.85 and p[P_DT] == 0.001 and p[P_RATIO] == 0.6 / 1.05
-    assert p[P_TIP_RADIUS:P_TIP_RADIUS + 3].tolist() == [0.009, 0.008, 0.007]
-    assert p[P_INITIAL:P_INITIAL + 3].tolist() == [1.0, 0.0, 1.0] and p[P_KI] == 50.0
-    given[G_KI] = -5.0
+    assert p[P.COINCIDENT_RTOL] == _COINCIDENT_RTOL and p[P.RELEASE_SHARE] == 0.75 and p[P.FOLLOW] == 0.0
+    assert p[P.HOLD_SHARE] == 0.85 and p[P.DT] == 0.001 and p[P.RATIO] == 0.6 / 1.05
+    assert p[P.slice("TIP_RADIUS")].tolist() == [0.009, 0.008, 0.007]
+    assert p[P.slice("INITIAL")].tolist() == [1.0, 0.0, 1.0] and p[P.KI] == 50.0
+    given[G.KI] = -5.0
     with pytest.raises(ValueError, match=r"^parameter 'ki' must be a positive number, got -5.0$"):
         pack_params(given, hand, 0.001)

@@ -20,7 +20,7 @@ from blocks import _native as blocks_native
 from blocks.block import BlockError
 from hierhand import _native
 from hierhand.control.inverse_kinematics import UnreachableError
-from hierhand.model.layout import ERR_TAU, N_OUTPUTS
+from hierhand.layouts import OUTPUT, PLANT_STATUS
 
 ROOT = Path(__file__).resolve().parents[2]
 REGRASP = ROOT / "diagrams" / "regrasp.yaml"
@@ -92,7 +92,7 @@ def test_every_block_of_the_regrasp_diagram_has_a_kernel(diagram):
     kernels = _native.kernels()
     assert set(kernels) == {"HandPlant.output", "HandPlant.update", "HandPlant.advance", "GraspReflex.output",
                             "GraspReflex.update", "ManipulationPD.output", "Suppresser.output", "Suppresser.update",
-                            "ObjectSupport.output"}
+                            "ObjectSupport.output", "JointLowPass.output", "JointLowPass.update"}
     assert all(isinstance(a, int) and a != 0 for a in kernels.values())
     plant, reflex = b["plant"].kernel(), b["ctrl.reflex"].kernel()
     assert plant.output and plant.update and plant.advance and plant.bind and plant.nogil
@@ -144,7 +144,7 @@ def test_kernels_equal_the_python_methods_along_a_regrasp(diagram):
         # the plant's stretch to the next reflex hit: Python's advance against the kernel's
         listed, mapping = _inputs(plant, plant_in)
         kernel = _run_kernel(plant)
-        rows = np.full((steps, N_OUTPUTS), np.nan)
+        rows = np.full((steps, OUTPUT.size), np.nan)
         mine = x.copy()
         code, done, which = call("advance", kernel.advance, kernel.context, t, mine, listed, rows, steps)
         x, out = plant.advance(t, x, mapping, steps)
@@ -200,8 +200,8 @@ def test_a_non_finite_torque_fails_as_the_python_step_does(diagram):
             done = 0
         else:
             code, done, which = call("advance", kernel.advance, kernel.context, 0.25, x.copy(), listed,
-                                     np.empty((3, N_OUTPUTS)), 3)
-        assert (code, which, done) == (ERR_TAU, 4, 0)
+                                     np.empty((3, OUTPUT.size)), 3)
+        assert (code, which, done) == (PLANT_STATUS.ERR_TAU, 4, 0)
         error = kernel.error(code, which, 0.25, phase)
         assert isinstance(error, BlockError)
         assert str(error) == str(python.value) and error.port == python.value.port == "tau"
@@ -217,7 +217,7 @@ def test_a_blow_up_part_way_through_an_advance_keeps_the_rows_before_it(diagram)
     n, t0 = 20, 0.5
     with pytest.raises(BlockError) as python:
         plant.advance(t0, x.copy(), mapping, n)
-    rows = np.full((n, N_OUTPUTS), np.nan)
+    rows = np.full((n, OUTPUT.size), np.nan)
     mine = x.copy()
     code, done, which = call("advance", kernel.advance, kernel.context, t0, mine, listed, rows, n)
     assert code != 0 and 0 < done < n
@@ -242,7 +242,7 @@ def test_a_bad_state_fails_in_the_output_as_in_python(diagram):
     with pytest.raises(BlockError) as python:
         plant.output(0.125, x, {})
     code, which = call("output", kernel.output, kernel.context, 0.125, x, [np.zeros(9), np.zeros(3)],
-                       np.empty(N_OUTPUTS))
+                       np.empty(OUTPUT.size))
     assert code != 0
     assert str(kernel.error(code, which, 0.125, "output")) == str(python.value)
 

@@ -1,7 +1,7 @@
 /* The hand blocks' kernel types: constructors from records, and adapters from the kernel
  * calling convention to the very functions the blocks' Python methods call (the plant's
  * step, the laws of control.h), with the same arguments, so results are equal to the last
- * bit. See kernels.h for the records.
+ * bit. See kernel_types.h and layouts.h for the records.
  *
  * None calls Python or writes anything but the state, the outputs and its own context
  * (the plant's hh_work), so each run constructs its own plant context and the blocks'
@@ -10,7 +10,7 @@
  * methods return fresh arrays; the reflex update reads a copy of the state, since it
  * writes the new state in place.
  */
-#include "kernels.h"
+#include "kernel_types.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -60,7 +60,7 @@ static int model_of(const double *segment, double dt, hh_model *m, char *message
     return hh_model_from_hand(m, hand, dt, keep_first, &p) != 0;
 }
 
-/* -- HandPlant: inputs tau (9), f_ext (3); out: the output row (HH_N_OUTPUTS) ---------------- */
+/* -- HandPlant: inputs HH_PLANT_I_*; out: the output row (HH_O_*) --------------------------------- */
 
 typedef struct {
     hh_model model;
@@ -69,14 +69,15 @@ typedef struct {
 
 static int plant_construct(const double *r, long n, blk_built *built, char *message, long size)
 {
-    if (n != 1 + HH_SEGMENT)
-        return wrong_length(message, size, "HandPlant", n, 1 + HH_SEGMENT);
-    if (!(r[0] > 0.0 && isfinite(r[0])))
-        return refuse(message, size, "HandPlant needs a positive period, got %g s", r[0]);
+    if (n != HH_PLANT_RECORD)
+        return wrong_length(message, size, "HandPlant", n, HH_PLANT_RECORD);
+    double dt = r[HH_PLANT_R_DT];
+    if (!(dt > 0.0 && isfinite(dt)))
+        return refuse(message, size, "HandPlant needs a positive period, got %g s", dt);
     plant_context *c = calloc(1, sizeof *c);
     if (c == NULL)
         return refuse(message, size, "no memory for the plant's model");
-    if (model_of(r + 1, r[0], &c->model, message, size) != 0) {
+    if (model_of(r + HH_PLANT_R_SEGMENT, dt, &c->model, message, size) != 0) {
         free(c);
         return 1;
     }
@@ -119,7 +120,7 @@ static int plant_update(const void *ctx, double t, double *state, const double *
     (void)t;
     plant_context *c = (plant_context *)ctx;
     int done;
-    return hh_step(&c->model, &c->work, state, inputs[0], inputs[1], &done, which);
+    return hh_step(&c->model, &c->work, state, inputs[HH_PLANT_I_TAU], inputs[HH_PLANT_I_F_EXT], &done, which);
 }
 
 static int plant_advance(const void *ctx, double t, double *state, const double *const *inputs, int n, double *rows,
@@ -128,8 +129,8 @@ static int plant_advance(const void *ctx, double t, double *state, const double 
     (void)t;
     plant_context *c = (plant_context *)ctx;
     long stepped = 0;
-    int code = hh_advance(&c->model, &c->work, state, inputs[0], inputs[1], (long)n, rows, HH_N_OUTPUTS, &stepped,
-                          which);
+    int code = hh_advance(&c->model, &c->work, state, inputs[HH_PLANT_I_TAU], inputs[HH_PLANT_I_F_EXT], (long)n, rows,
+                          HH_N_OUTPUTS, &stepped, which);
     /* hh_advance counts the failing update; the rows before it are complete (as
        HandPlant.advance: written = max(done - 1, 0)) */
     *done = code == HH_OK ? n : (stepped > 1 ? (int)(stepped - 1) : 0);
@@ -182,27 +183,24 @@ static void plant_failure(const void *ctx, int code, int which, const char *phas
     }
 }
 
-/* -- GraspReflex: inputs q, tip, fn, ft, normal, share; out: tau_g, force, active ------------ */
+/* -- GraspReflex: inputs HH_REFLEX_I_*; out: HH_REFLEX_O_* --------------------------------------- */
 
 typedef struct {
     hh_model model;
     double params[HH_REFLEX_N_PARAMS];
 } reflex_context;
 
-enum { RI_Q = 0, RI_TIP = 1, RI_FN = 2, RI_FT = 3, RI_NORMAL = 4, RI_SHARE = 5 };
-
 static int reflex_construct(const double *r, long n, blk_built *built, char *message, long size)
 {
-    long expected = HH_SEGMENT + 1 + HH_REFLEX_N_GIVEN;
-    if (n != expected)
-        return wrong_length(message, size, "GraspReflex", n, expected);
+    if (n != HH_REFLEX_RECORD)
+        return wrong_length(message, size, "GraspReflex", n, HH_REFLEX_RECORD);
     reflex_context *c = calloc(1, sizeof *c);
     if (c == NULL)
         return refuse(message, size, "no memory for the reflex's model");
     double hand[HH_HAND_PARAMS];
-    hh_hand_of_segment(r, hand);
-    if (model_of(r, 0.0, &c->model, message, size) != 0 ||
-        hh_reflex_pack(r + HH_SEGMENT + 1, hand, r[HH_SEGMENT], c->params, message, (size_t)size) != 0) {
+    hh_hand_of_segment(r + HH_REFLEX_R_SEGMENT, hand);
+    if (model_of(r + HH_REFLEX_R_SEGMENT, 0.0, &c->model, message, size) != 0 ||
+        hh_reflex_pack(r + HH_REFLEX_R_GIVEN, hand, r[HH_REFLEX_R_DT], c->params, message, (size_t)size) != 0) {
         free(c);
         return 1;
     }
@@ -229,10 +227,13 @@ static int reflex_output(const void *ctx, double t, const double *state, const d
 {
     (void)t;
     const reflex_context *c = ctx;
-    hh_reflex_inputs in = {.tip = inputs[RI_TIP], .normal = inputs[RI_NORMAL], .fn = inputs[RI_FN], .share = NULL};
+    hh_reflex_inputs in = {.tip = inputs[HH_REFLEX_I_TIP],
+                           .normal = inputs[HH_REFLEX_I_NORMAL],
+                           .fn = inputs[HH_REFLEX_I_FN],
+                           .share = NULL};
     double buffer[HH_REFLEX_N_OUT];
     *which = 0;
-    int code = hh_reflex_output(&c->model, c->params, state, &in, inputs[RI_Q], buffer);
+    int code = hh_reflex_output(&c->model, c->params, state, &in, inputs[HH_REFLEX_I_Q], buffer);
     if (code == HH_REFLEX_OK)
         memcpy(out, buffer, sizeof buffer);
     return code;
@@ -242,12 +243,14 @@ static int reflex_update(const void *ctx, double t, double *state, const double 
 {
     (void)t;
     const reflex_context *c = ctx;
-    hh_reflex_inputs in = {
-        .tip = inputs[RI_TIP], .normal = inputs[RI_NORMAL], .fn = inputs[RI_FN], .share = inputs[RI_SHARE]};
+    hh_reflex_inputs in = {.tip = inputs[HH_REFLEX_I_TIP],
+                           .normal = inputs[HH_REFLEX_I_NORMAL],
+                           .fn = inputs[HH_REFLEX_I_FN],
+                           .share = inputs[HH_REFLEX_I_SHARE]};
     double current[HH_REFLEX_N_STATE], next[HH_REFLEX_N_STATE];
     memcpy(current, state, sizeof current);
     *which = 0;
-    int code = hh_reflex_update(c->params, current, &in, inputs[RI_FT], next);
+    int code = hh_reflex_update(c->params, current, &in, inputs[HH_REFLEX_I_FT], next);
     if (code == HH_REFLEX_OK)
         memcpy(state, next, sizeof next);
     return code;
@@ -265,7 +268,7 @@ static void reflex_failure(const void *ctx, int code, int which, const char *pha
         snprintf(message, (size_t)size, "%s at t=%.10g s failed with code %d", phase, t, code);
 }
 
-/* -- ManipulationPD: inputs q, qd, fn, support, normal, obj; out: tau_m, tau_ff, q_ref ------- */
+/* -- ManipulationPD: inputs HH_MANIP_I_*; out: HH_MANIP_O_* ---------------------------------------- */
 
 typedef struct {
     hh_model model;
@@ -277,18 +280,18 @@ typedef struct {
 
 static int manip_construct(const double *r, long n, blk_built *built, char *message, long size)
 {
-    long head = HH_SEGMENT + 1 + HH_MANIP_N_GIVEN;
-    if (n < head + 1)
-        return wrong_length(message, size, "ManipulationPD", n, head + 1);
-    double capacity = r[head];
+    long head = HH_MANIP_RECORD_HEAD;
+    if (n < head)
+        return wrong_length(message, size, "ManipulationPD", n, head);
+    double capacity = r[HH_MANIP_R_CAPACITY];
     long rows = (long)capacity;
     if (!(capacity >= 1 && capacity == (double)rows && rows <= (n - head) / (HH_FINGERS * HH_MANIP_W_COLS)))
         return refuse(message, size, "a ManipulationPD record gives %g waypoint rows per finger for %ld numbers",
                       capacity, n);
-    long points = HH_FINGERS * rows * HH_MANIP_W_COLS, expected = head + 1 + points + HH_FINGERS * HH_MANIP_N_META;
+    long points = HH_FINGERS * rows * HH_MANIP_W_COLS, expected = head + points + HH_FINGERS * HH_MANIP_N_META;
     if (n != expected)
         return wrong_length(message, size, "ManipulationPD", n, expected);
-    const double *meta = r + head + 1 + points;
+    const double *meta = r + HH_MANIP_R_WAYPOINTS + points;
     for (int f = 0; f < HH_FINGERS; f++) {
         double count = meta[f * HH_MANIP_N_META + HH_MANIP_M_COUNT];
         if (!(count >= 0 && count <= (double)rows && count == floor(count)))
@@ -298,14 +301,14 @@ static int manip_construct(const double *r, long n, blk_built *built, char *mess
     if (c == NULL)
         return refuse(message, size, "no memory for the PD's trajectories");
     double hand[HH_HAND_PARAMS];
-    hh_hand_of_segment(r, hand);
-    if (model_of(r, 0.0, &c->model, message, size) != 0 ||
-        hh_manip_pack(r + HH_SEGMENT + 1, hand, r[HH_SEGMENT], c->params, message, (size_t)size) != 0) {
+    hh_hand_of_segment(r + HH_MANIP_R_SEGMENT, hand);
+    if (model_of(r + HH_MANIP_R_SEGMENT, 0.0, &c->model, message, size) != 0 ||
+        hh_manip_pack(r + HH_MANIP_R_GIVEN, hand, r[HH_MANIP_R_DT], c->params, message, (size_t)size) != 0) {
         free(c);
         return 1;
     }
     c->capacity = rows;
-    memcpy(c->waypoints, r + head + 1, (size_t)points * sizeof(double));
+    memcpy(c->waypoints, r + HH_MANIP_R_WAYPOINTS, (size_t)points * sizeof(double));
     memcpy(c->meta, meta, sizeof c->meta);
     built->ctx = c;
     built->outputs = HH_MANIP_N_OUT;
@@ -320,8 +323,12 @@ static int manip_output(const void *ctx, double t, const double *state, const do
     const manip_context *c = ctx;
     hh_trajectories tr = {.waypoints = c->waypoints, .meta = c->meta, .capacity = c->capacity};
     double buffer[HH_MANIP_N_OUT];
-    hh_manip_inputs in = {.q = inputs[0], .qd = inputs[1], .fn = inputs[2], .support = inputs[3],
-                          .normal = inputs[4], .obj = inputs[5]};
+    hh_manip_inputs in = {.q = inputs[HH_MANIP_I_Q],
+                          .qd = inputs[HH_MANIP_I_QD],
+                          .fn = inputs[HH_MANIP_I_FN],
+                          .support = inputs[HH_MANIP_I_SUPPORT],
+                          .normal = inputs[HH_MANIP_I_NORMAL],
+                          .obj = inputs[HH_MANIP_I_OBJ]};
     int status = hh_manipulation_output(&c->model, c->params, &tr, t, &in, buffer);
     if (status == HH_MANIP_OK) {
         *which = 0;
@@ -344,22 +351,23 @@ static void manip_failure(const void *ctx, int code, int which, const char *phas
                  which + 1);
 }
 
-/* -- Suppresser: inputs tau_g, tau_m, tau_ff; out: tau, tau_g_eff, share ---------------------- */
+/* -- Suppresser: inputs HH_SUPPRESS_I_*; out: HH_SUPPRESS_O_* -------------------------------------- */
 
 static int suppress_construct(const double *r, long n, blk_built *built, char *message, long size)
 {
-    if (n != HH_SUPPRESS_N_GIVEN + 1)
-        return wrong_length(message, size, "Suppresser", n, HH_SUPPRESS_N_GIVEN + 1);
+    if (n != HH_SUPPRESS_RECORD)
+        return wrong_length(message, size, "Suppresser", n, HH_SUPPRESS_RECORD);
     double *params = malloc(HH_SUPPRESS_N_PARAMS * sizeof(double));
     if (params == NULL)
         return refuse(message, size, "no memory for the suppresser's parameters");
-    if (hh_suppress_pack(r, r[HH_SUPPRESS_N_GIVEN], params, message, (size_t)size) != 0) {
+    const double *given = r + HH_SUPPRESS_R_GIVEN;
+    if (hh_suppress_pack(given, r[HH_SUPPRESS_R_PERIOD], params, message, (size_t)size) != 0) {
         free(params);
         return 1;
     }
     built->ctx = params;
     built->outputs = HH_SUPPRESS_N_OUT;
-    built->state_size = r[HH_SUPPRESS_G_TIME_CONSTANT] > 0 ? HH_JOINTS : 0;
+    built->state_size = given[HH_SUPPRESS_G_TIME_CONSTANT] > 0 ? HH_JOINTS : 0;
     return 0;
 }
 
@@ -376,7 +384,8 @@ static int suppress_output(const void *ctx, double t, const double *state, const
 {
     (void)t;
     *which = 0;
-    hh_suppress((const double *)ctx, inputs[0], state, inputs[1], inputs[2], out); /* state NULL: static law */
+    hh_suppress((const double *)ctx, inputs[HH_SUPPRESS_I_TAU_G], state, inputs[HH_SUPPRESS_I_TAU_M],
+                inputs[HH_SUPPRESS_I_TAU_FF], out); /* state NULL: static law */
     return 0;
 }
 
@@ -385,7 +394,7 @@ static int suppress_update(const void *ctx, double t, double *state, const doubl
     (void)t;
     *which = 0;
     double next[HH_JOINTS];
-    hh_suppress_update((const double *)ctx, state, inputs[0], inputs[1], next);
+    hh_suppress_update((const double *)ctx, state, inputs[HH_SUPPRESS_I_TAU_G], inputs[HH_SUPPRESS_I_TAU_M], next);
     memcpy(state, next, sizeof next);
     return 0;
 }
@@ -394,13 +403,13 @@ static int suppress_update(const void *ctx, double t, double *state, const doubl
 
 static int support_construct(const double *r, long n, blk_built *built, char *message, long size)
 {
-    if (n != HH_SEGMENT + 1)
-        return wrong_length(message, size, "ObjectSupport", n, HH_SEGMENT + 1);
-    double hand[HH_HAND_PARAMS], *c = malloc(4 * sizeof(double));
+    if (n != HH_SUPPORT_RECORD)
+        return wrong_length(message, size, "ObjectSupport", n, HH_SUPPORT_RECORD);
+    double hand[HH_HAND_PARAMS], *c = malloc(HH_SUPPORT_N_CONTEXT * sizeof(double));
     if (c == NULL)
         return refuse(message, size, "no memory for the support's force");
-    hh_hand_of_segment(r, hand);
-    if (hh_support_pack(r[HH_SEGMENT], hand, c, message, (size_t)size) != 0) {
+    hh_hand_of_segment(r + HH_SUPPORT_R_SEGMENT, hand);
+    if (hh_support_pack(r[HH_SUPPORT_R_UNTIL], hand, c, message, (size_t)size) != 0) {
         free(c);
         return 1;
     }
@@ -416,21 +425,33 @@ static int support_output(const void *ctx, double t, const double *state, const 
     (void)state;
     (void)inputs;
     const double *c = (const double *)ctx;
-    int on = t < c[3];
+    int on = t < c[HH_SUPPORT_C_UNTIL];
     for (int i = 0; i < 3; i++)
-        out[i] = on ? c[i] : 0.0;
+        out[i] = on ? c[HH_SUPPORT_C_FORCE + i] : 0.0;
     *which = 0;
     return 0;
 }
 
-/* -- the table ------------------------------------------------------------------------------ */
+/* -- the types (layouts.h lists them with their records) ---------------------------------------- */
 
-const blk_kernel_type hh_kernel_types[] = {
+const blk_kernel_type hh_plant_kernel_type[] = {
     {"HandPlant", plant_construct, plant_destroy, plant_initial, plant_output, plant_update, plant_advance,
      plant_failure},
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
+};
+const blk_kernel_type hh_reflex_kernel_type[] = {
     {"GraspReflex", reflex_construct, free, reflex_initial, reflex_output, reflex_update, NULL, reflex_failure},
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
+};
+const blk_kernel_type hh_manip_kernel_type[] = {
     {"ManipulationPD", manip_construct, free, NULL, manip_output, NULL, NULL, manip_failure},
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
+};
+const blk_kernel_type hh_suppress_kernel_type[] = {
     {"Suppresser", suppress_construct, free, suppress_initial, suppress_output, suppress_update, NULL, NULL},
+    {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
+};
+const blk_kernel_type hh_support_kernel_type[] = {
     {"ObjectSupport", support_construct, free, NULL, support_output, NULL, NULL, NULL},
     {NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL},
 };

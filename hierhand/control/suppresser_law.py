@@ -21,8 +21,9 @@ steepness. Note that ``S_a = 0`` halves ``tau_g`` everywhere; "no suppression" i
 
 The law is C (``hierhand/csrc/suppresser.c``): ``suppress_output`` is the ``Suppresser``
 block's one call per hit, and ``sigmoid``, ``suppress`` and ``finger_shares`` are the
-same functions for any number of joints, for users and tests. The parameter slots are
-defined once, in ``hierhand/csrc/control.h`` (``hierhand._native.LAYOUT``).
+same functions for any number of joints, for users and tests. The slots of its arrays
+are declared once, in ``hierhand/csrc/layouts.h`` (``hierhand.layouts``:
+``SUPPRESS_PARAMS``, ``SUPPRESS_GIVEN``, ``SUPPRESS_OUT``, ``SUPPRESS_MODE``).
 """
 
 from __future__ import annotations
@@ -34,30 +35,18 @@ import numpy as np
 from blocks.arrays import flat_float64
 
 from .. import _native
+from ..layouts import SUPPRESS_MODE
 
 __all__ = ["sigmoid", "suppress", "finger_shares", "MODES"]
 
-_L = _native.LAYOUT
-P_S_A: int = _L["SUPPRESS_P_S_A"]  # 9 sigmoid steepnesses
-P_S_B: int = _L["SUPPRESS_P_S_B"]  # 9 half-suppression torques
-P_MODE: int = _L["SUPPRESS_P_MODE"]  # PASS, MAGNITUDE or SIGNED
-P_ALPHA: int = _L["SUPPRESS_P_ALPHA"]  # the low-pass step 1 - exp(-T / time constant)
-N_PARAMS: int = _L["SUPPRESS_N_PARAMS"]
-PASS: int = _L["SUPPRESS_PASS"]
-MAGNITUDE: int = _L["SUPPRESS_MAGNITUDE"]
-SIGNED: int = _L["SUPPRESS_SIGNED"]
-O_TAU: int = _L["SUPPRESS_O_TAU"]
-O_TAU_G_EFF: int = _L["SUPPRESS_O_TAU_G_EFF"]
-O_SHARE: int = _L["SUPPRESS_O_SHARE"]
-N_OUT: int = _L["SUPPRESS_N_OUT"]
-
-MODES = {"magnitude": MAGNITUDE, "signed": SIGNED}
-"""The modes by name, with their codes in the packed parameters."""
+MODES = {"magnitude": SUPPRESS_MODE.MAGNITUDE, "signed": SUPPRESS_MODE.SIGNED}
+"""The modes a block may be given by name, with their codes in the packed parameters
+(``SUPPRESS_MODE.PASS`` is a disabled block's)."""
 
 suppress_output = _native.suppress
-"""``suppress_output(params, tau_g, g, tau_m, tau_ff, out)``: over the 9 joints,
-``out[O_TAU_G_EFF:]`` = ``tau_g * sigmoid(S_a (S_b - g))`` (``tau_g`` for mode ``PASS``),
-``out[O_TAU:]`` = that ``+ tau_m + tau_ff`` and ``out[O_SHARE:]`` = ``finger_shares``
+"""``suppress_output(params, tau_g, g, tau_m, tau_ff, out)``: over the 9 joints, into
+``out`` (``SUPPRESS_OUT``), ``TAU_G_EFF`` = ``tau_g * sigmoid(S_a (S_b - g))`` (``tau_g``
+for mode ``PASS``), ``TAU`` = that ``+ tau_m + tau_ff`` and ``SHARE`` = ``finger_shares``
 (ones for ``PASS``). ``g``: the low-passed suppression inputs (the block's state), or None
 for the static law (``g`` of ``tau_m`` now). Takes C-contiguous float64 arrays only
 (``TypeError`` otherwise)."""
@@ -81,18 +70,11 @@ def check_steepness(S_a: Any) -> None:
         raise ValueError(f"S_a must be >= 0, got {S_a!r}")
 
 
-G_S_A: int = _L["SUPPRESS_G_S_A"]  # -- the block's parameters as given: given[G_*] (control.h); nine
-G_S_B: int = _L["SUPPRESS_G_S_B"]  # nine
-G_MODE: int = _L["SUPPRESS_G_MODE"]  # MAGNITUDE or SIGNED
-G_ENABLED: int = _L["SUPPRESS_G_ENABLED"]
-G_TIME_CONSTANT: int = _L["SUPPRESS_G_TIME_CONSTANT"]
-N_GIVEN: int = _L["SUPPRESS_N_GIVEN"]
-
 _pack = _native.suppress_pack
 
 
 def pack_params(given: np.ndarray, hand: None, period: float) -> np.ndarray:
-    """The ``params`` vector of ``suppress_output`` from the block's parameters (``G_*``),
+    """The ``params`` vector of ``suppress_output`` from the block's parameters (``SUPPRESS_GIVEN``),
     checked (hierhand/csrc/control_params.c): mode ``PASS`` when not enabled, the low-pass
     step ``1 - exp(-period / time_constant)`` for a filtered block with a period (else 1);
     ValueError naming a bad parameter."""
