@@ -24,12 +24,16 @@ import zlib
 CSRC = "hierhand/csrc"
 KERNEL_SET = "fmu_kernel_set.c"
 
-_FOLDER = Path(__file__).resolve().parent / "csrc"
+_FOLDER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "csrc")
 
 
 def _names(pattern: str) -> list[str]:
-    """The files of ``hierhand/csrc`` matching ``pattern``, sorted (relative to it)."""
-    return sorted(p.relative_to(_FOLDER).as_posix() for p in _FOLDER.glob(pattern))
+    """The files of ``hierhand/csrc`` matching ``pattern`` (``*.c``, ``python/*.c``), sorted,
+    relative to it (os.path, not pathlib: this module is read on every import of hierhand)."""
+    folder, _, suffix = pattern.rpartition("/")
+    here = os.path.join(_FOLDER, folder)
+    return sorted(f"{folder}/{name}" if folder else name for name in os.listdir(here)
+                  if name.endswith(suffix.lstrip("*")) and os.path.isfile(os.path.join(here, name)))
 
 
 HAND_SOURCES = [name for name in _names("*.c") if name != KERNEL_SET]
