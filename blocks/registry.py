@@ -1,5 +1,12 @@
 """Block types by name: the framework's library plus every ``blocks.types`` entry point.
 
+An entry point names one Block subclass, registered under the entry point's name, or a
+collection: a list or tuple of Block subclasses or their ``"module:Class"`` references, each
+registered under its ``registered_name()``, so a package with many types needs one entry
+point and keeps their list where it likes. A type that fails to load is left out with its
+reason. A name that two plug-ins give to different classes is left out too, with both
+named, whatever the install order; a plug-in cannot replace a library type.
+
 A diagram can only name registered types. ``python:module:Class`` names arbitrary
 code and is refused unless the caller passes ``trust=True`` (``--trust`` on the CLI),
 because loading a diagram must never run code the user did not choose to run. Its module
@@ -14,6 +21,8 @@ import importlib
 import importlib.util
 import sys
 from pathlib import Path
+
+from importlib.metadata import EntryPoint
 
 from .block import Block
 from .plugins import load_group
@@ -40,16 +49,66 @@ def block_types() -> dict[str, type[Block]]:
     if _cache is None:
         from .library import LIBRARY
 
-        types: dict[str, type[Block]] = {cls.registered_name(): cls for cls in LIBRARY}
-        installed, errors = load_group(ENTRY_POINT_GROUP, _not_a_block)
-        types.update(installed)
+        library: dict[str, type[Block]] = {cls.registered_name(): cls for cls in LIBRARY}
+        loaded, errors = load_group(ENTRY_POINT_GROUP, _not_a_block_or_collection)
+        claims: dict[str, set[type[Block]]] = {}
+        for entry, obj in loaded.items():
+            for name, cls in _registrations(entry, obj, errors):
+                claims.setdefault(name, set()).add(cls)
+        types = dict(library)
+        for name in sorted(claims):
+            classes = claims[name] - {library.get(name)}
+            if name in library and classes:
+                errors[name] = f"{_names(classes)} cannot replace the library's type"
+            elif len(classes) == 1:
+                types[name] = classes.pop()
+            elif classes:
+                errors[name] = f"{_names(classes)} all register it; uninstall all but one"
         _load_errors.update(errors)
         _cache = types
     return _cache
 
 
-def _not_a_block(obj) -> str | None:
-    return None if isinstance(obj, type) and issubclass(obj, Block) else "is not a Block subclass"
+def _is_block(obj) -> bool:
+    return isinstance(obj, type) and issubclass(obj, Block)
+
+
+def _not_a_block_or_collection(obj) -> str | None:
+    return None if _is_block(obj) or isinstance(obj, (list, tuple)) else \
+        "is neither a Block subclass nor a list or tuple of them"
+
+
+def _registrations(entry: str, obj, errors: dict[str, str]) -> list[tuple[str, type[Block]]]:
+    """(name, class) of what the entry point ``entry`` loaded: a Block subclass under the
+    entry point's name, or each type of a collection under its own; what fails goes to
+    ``errors`` (a reference that does not load under its class's name, anything else that
+    is not a Block under the entry point's)."""
+    if _is_block(obj):
+        return [(entry, obj)]
+    found = []
+    for item in obj:
+        if isinstance(item, str):
+            name = item.rpartition(":")[2]
+            try:
+                cls = EntryPoint(name, item, ENTRY_POINT_GROUP).load()
+            except Exception as exc:  # a broken type must not break the collection's others
+                errors[name] = f"{item}: {exc}"
+                continue
+            if not _is_block(cls):
+                errors[name] = f"{item} is not a Block subclass"
+                continue
+        elif _is_block(item):
+            cls = item
+        else:
+            errors[entry] = f"{errors[entry]}; " if entry in errors else ""
+            errors[entry] += f"holds {item!r}, which is neither a Block subclass nor a 'module:Class' reference"
+            continue
+        found.append((cls.registered_name(), cls))
+    return found
+
+
+def _names(classes) -> str:
+    return " and ".join(sorted(f"{cls.__module__}:{cls.__qualname__}" for cls in classes))
 
 
 def resolve_type(name: str, trust: bool = False, base_dir: str | Path | None = None) -> type[Block]:
@@ -73,6 +132,9 @@ def resolve_type(name: str, trust: bool = False, base_dir: str | Path | None = N
     close = difflib.get_close_matches(name, types, n=3)
     hint = f"did you mean {', '.join(repr(c) for c in close)}?" if close else \
         "run 'hierhand blocks' to list the registered types"
+    if _load_errors:  # a collection that failed to load leaves its types unknown: say so
+        hint += "; left out because they failed to load: " + \
+            "; ".join(f"'{entry}' ({why})" for entry, why in sorted(_load_errors.items()))
     raise RegistryError(f"unknown block type '{name}'", hint)
 
 

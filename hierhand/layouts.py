@@ -6,9 +6,9 @@ and this module turns each into a ``Layout`` named as the header names it:
 ``REFLEX_PARAMS.KI`` is the C's ``HH_REFLEX_P_KI``, ``STATE.slice("QD")`` the joint rates
 of the plant's state, ``REFLEX_RECORD.size`` the length of GraspReflex's kernel record.
 Python writes no offset of its own. ``RECORDS`` gives each kernel type's record layout,
-``INPUT_PORTS`` its input ports in the order its kernel reads them (the blocks' ``inputs``),
-``ports(OUTPUT)`` the output ports of an output layout, ``DIMENSIONS`` the hand's sizes
-(fingers, joints, ...).
+``BLOCK_CLASSES`` the block types that write them, ``INPUT_PORTS`` its input ports in the
+order its kernel reads them (the blocks' ``inputs``), ``ports(OUTPUT)`` the output ports of
+an output layout, ``DIMENSIONS`` the hand's sizes (fingers, joints, ...).
 """
 
 from __future__ import annotations
@@ -62,6 +62,11 @@ RECORDS: dict[str, Layout] = {kind: LAYOUTS[name] for kind, name in _native.RECO
 """The record layout of each kernel type by the type's name (``RECORDS["GraspReflex"]`` is
 ``REFLEX_RECORD``)."""
 
+BLOCK_CLASSES: tuple[str, ...] = tuple(_native.BLOCK_CLASSES)
+"""hierhand's block types, as ``"module:Class"`` references: the class each record of
+``HH_RECORDS`` names. This tuple is hierhand's one ``blocks.types`` entry point, so a new
+block type is registered by its line in layouts.h and needs no line in pyproject.toml."""
+
 def ports(layout: Layout) -> Mapping[str, int]:
     """The ports of a layout's slots, in order: each slot's name in lower case and its width
     (a kernel's output row, or its list of input ports)."""
@@ -83,5 +88,5 @@ DIMENSIONS: dict[str, int] = dict(_native.DIMENSIONS)
 
 globals().update(LAYOUTS)
 globals().update(INPUT_PORTS)
-__all__ = ["DIMENSIONS", "INPUT_PORTS", "LAYOUTS", "Layout", "RECORDS", "port_columns", "ports", *LAYOUTS,
+__all__ = ["BLOCK_CLASSES", "DIMENSIONS", "INPUT_PORTS", "LAYOUTS", "Layout", "RECORDS", "port_columns", "ports", *LAYOUTS,
            *INPUT_PORTS]

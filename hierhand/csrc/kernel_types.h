@@ -18,12 +18,12 @@
 #include "layouts.h"
 
 /* Each type's table (its type, then a NULL name), as HH_RECORDS names it. */
-#define HH_DECLARE_KERNEL_TYPE(NAME, P, SLOTS, SIZE, TYPES) extern const blk_kernel_type TYPES[];
+#define HH_DECLARE_KERNEL_TYPE(NAME, P, SLOTS, SIZE, TYPES, BLOCK) extern const blk_kernel_type TYPES[];
 HH_RECORDS(HH_DECLARE_KERNEL_TYPE)
 
 /* Every table of HH_RECORDS, then NULL: the kernel types the extension and the FMU
  * binaries hold (a list of the form of blk_export_kernel_sets). */
-#define HH_KERNEL_TYPE_TABLE(NAME, P, SLOTS, SIZE, TYPES) TYPES,
+#define HH_KERNEL_TYPE_TABLE(NAME, P, SLOTS, SIZE, TYPES, BLOCK) TYPES,
 #define HH_KERNEL_TYPE_TABLES HH_RECORDS(HH_KERNEL_TYPE_TABLE) NULL
 
 #endif

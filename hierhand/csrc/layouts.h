@@ -13,11 +13,11 @@
  *
  * Codes are declared the same way (a code of width 3 takes three values: one per finger).
  * Each kernel type's record (the numbers its context is built from, kernel_types.h) is a
- * layout too, listed in HH_RECORDS with the table of its kernel type; that list is also
- * the list of the hand's kernel types. The input ports a kernel reads (inputs[i]) are
- * lists too (HH_INPUT_PORTS), from which the blocks take their inputs. So a new block
- * type's C side is its own .c file and its lines here; docs/tutorials/c-kernel-block.md
- * walks through one.
+ * layout too, listed in HH_RECORDS with the table of its kernel type and the Python block
+ * class that writes it; that list is also the list of the hand's kernel types and of its
+ * block types. The input ports a kernel reads (inputs[i]) are lists too (HH_INPUT_PORTS),
+ * from which the blocks take their inputs. So a new block type is its own .c file, its
+ * Python block file and its lines here; docs/tutorials/c-kernel-block.md walks through one.
  */
 #ifndef HIERHAND_LAYOUTS_H
 #define HIERHAND_LAYOUTS_H
@@ -29,7 +29,7 @@
 #define HH_SLOT_ENUM(P, NAME, WIDTH) P##NAME, P##NAME##_LAST_ = P##NAME + (WIDTH)-1,
 #define HH_LAYOUT_ENUM(P, SLOTS, SIZE) enum { SLOTS(HH_SLOT_ENUM, P) SIZE };
 #define HH_LAYOUT_ENUM_OF(NAME, P, SLOTS, SIZE) HH_LAYOUT_ENUM(P, SLOTS, SIZE)
-#define HH_RECORD_ENUM_OF(NAME, P, SLOTS, SIZE, TYPES) HH_LAYOUT_ENUM(P, SLOTS, SIZE)
+#define HH_RECORD_ENUM_OF(NAME, P, SLOTS, SIZE, TYPES, BLOCK) HH_LAYOUT_ENUM(P, SLOTS, SIZE)
 /* HH_PORTS_ENUM_OF(NAME, P, PORTS, COUNT): the indices P##NAME of a list of ports, and COUNT. */
 #define HH_PORT_ENUM(P, NAME, WIDTH) P##NAME,
 #define HH_PORTS_ENUM_OF(NAME, P, PORTS, COUNT) enum { PORTS(HH_PORT_ENUM, P) COUNT };
@@ -358,18 +358,24 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
 #define HH_SUPPORT_RECORD_SLOTS(SLOT, P) SLOT(P, SEGMENT, HH_SEGMENT) SLOT(P, UNTIL, 1)
 #define HH_JOINT_LOW_PASS_RECORD_SLOTS(SLOT, P) SLOT(P, TIME_CONSTANT, 1) SLOT(P, PERIOD, 1)
 
-/* X(NAME, P, SLOTS, SIZE, TYPES): as HH_LAYOUTS, and TYPES the table (ending with a NULL
- * name) that defines the kernel type of the record. These tables are the hand's kernel
- * types: the extension and the FMU binaries hold every one listed here. */
+/* X(NAME, P, SLOTS, SIZE, TYPES, BLOCK): as HH_LAYOUTS, TYPES the table (ending with a NULL
+ * name) that defines the kernel type of the record, and BLOCK the Python block class that
+ * writes the record ("module:Class"). These lines are the hand's kernel types, which the
+ * extension and the FMU binaries hold, and its block types, which hierhand registers
+ * (hierhand.layouts.BLOCK_CLASSES, its blocks.types entry point): no other list names them. */
 #define HH_RECORDS(X)                                                                                  \
-    X(PLANT_RECORD, HH_PLANT_R_, HH_PLANT_RECORD_SLOTS, HH_PLANT_RECORD, hh_plant_kernel_type)         \
-    X(REFLEX_RECORD, HH_REFLEX_R_, HH_REFLEX_RECORD_SLOTS, HH_REFLEX_RECORD, hh_reflex_kernel_type)    \
-    X(MANIP_RECORD, HH_MANIP_R_, HH_MANIP_RECORD_SLOTS, HH_MANIP_RECORD_HEAD, hh_manip_kernel_type)    \
+    X(PLANT_RECORD, HH_PLANT_R_, HH_PLANT_RECORD_SLOTS, HH_PLANT_RECORD, hh_plant_kernel_type,         \
+      "hierhand.model.plant:HandPlant")                                                                \
+    X(REFLEX_RECORD, HH_REFLEX_R_, HH_REFLEX_RECORD_SLOTS, HH_REFLEX_RECORD, hh_reflex_kernel_type,    \
+      "hierhand.control.grasp_reflex:GraspReflex")                                                     \
+    X(MANIP_RECORD, HH_MANIP_R_, HH_MANIP_RECORD_SLOTS, HH_MANIP_RECORD_HEAD, hh_manip_kernel_type,    \
+      "hierhand.control.manipulation_pd:ManipulationPD")                                               \
     X(SUPPRESS_RECORD, HH_SUPPRESS_R_, HH_SUPPRESS_RECORD_SLOTS, HH_SUPPRESS_RECORD,                   \
-      hh_suppress_kernel_type)                                                                         \
-    X(SUPPORT_RECORD, HH_SUPPORT_R_, HH_SUPPORT_RECORD_SLOTS, HH_SUPPORT_RECORD, hh_support_kernel_type) \
+      hh_suppress_kernel_type, "hierhand.control.suppresser:Suppresser")                               \
+    X(SUPPORT_RECORD, HH_SUPPORT_R_, HH_SUPPORT_RECORD_SLOTS, HH_SUPPORT_RECORD, hh_support_kernel_type, \
+      "hierhand.model.support:ObjectSupport")                                                          \
     X(JOINT_LOW_PASS_RECORD, HH_JOINT_LOW_PASS_R_, HH_JOINT_LOW_PASS_RECORD_SLOTS,                     \
-      HH_JOINT_LOW_PASS_RECORD, hh_joint_low_pass_kernel_type)
+      HH_JOINT_LOW_PASS_RECORD, hh_joint_low_pass_kernel_type, "hierhand.control.joint_low_pass:JointLowPass")
 
 /* == the input ports of the kernel types =====================================================
  * A kernel reads input port i at inputs[i], in the order of its block's inputs

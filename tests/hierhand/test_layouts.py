@@ -12,11 +12,15 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+import tomllib
+from importlib.metadata import EntryPoint
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from blocks import registry
+from blocks.registry import block_types
 from hierhand import _native, layouts
 from hierhand.layouts import (
     DIMENSIONS,
@@ -129,6 +133,20 @@ def test_every_kernel_type_has_its_record_layout():
     kinds = {name.split(".")[0] for name in _native.kernels()}
     assert set(RECORDS) == kinds
     assert RECORDS["GraspReflex"] is layouts.REFLEX_RECORD and RECORDS["JointLowPass"] is layouts.JOINT_LOW_PASS_RECORD
+
+
+def test_the_records_block_classes_are_hierhands_registered_types_with_no_line_of_their_own_in_pyproject():
+    """A new block type is registered by its record's line in layouts.h (its class named
+    there), through hierhand's one ``blocks.types`` entry point: every class named there is
+    the registered type of its name, one per kernel type, and pyproject.toml lists none."""
+    types = block_types()
+    named = [EntryPoint("", reference, "").load() for reference in layouts.BLOCK_CLASSES]
+    assert {cls.registered_name() for cls in named} == set(RECORDS)
+    assert all(types[cls.registered_name()] is cls for cls in named)
+    assert {name for name, cls in types.items() if cls.__module__.startswith("hierhand.")} == set(RECORDS)
+    with open(CSRC.parents[1] / "pyproject.toml", "rb") as f:
+        declared = tomllib.load(f)["project"]["entry-points"][registry.ENTRY_POINT_GROUP]
+    assert [v for v in declared.values() if v.startswith("hierhand.")] == ["hierhand.layouts:BLOCK_CLASSES"]
 
 
 # The hand-file name of each slot of the hand vector (hand_params.c's table), as the oracle.

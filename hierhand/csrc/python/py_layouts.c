@@ -1,11 +1,12 @@
-/* hierhand._native.LAYOUTS, RECORD_LAYOUTS, INPUT_PORTS and DIMENSIONS: layouts.h's tables for
- * Python.
+/* hierhand._native.LAYOUTS, RECORD_LAYOUTS, BLOCK_CLASSES, INPUT_PORTS and DIMENSIONS: layouts.h's
+ * tables for Python.
  *
  * LAYOUTS[name] is (size, ((slot, offset, width), ...), prefix, size name) for every layout
  * of HH_LAYOUTS and HH_RECORDS, the offsets being the C enum's very constants (HH_REFLEX_P_KI
  * for LAYOUTS["REFLEX_PARAMS"]'s slot KI, prefix "HH_REFLEX_P_"): the preprocessor writes
  * this table and the enums from the one declaration of each array. RECORD_LAYOUTS names the record layout of each
- * kernel type ({"GraspReflex": "REFLEX_RECORD", ...}). INPUT_PORTS[name] is a list of input
+ * kernel type ({"GraspReflex": "REFLEX_RECORD", ...}), BLOCK_CLASSES the block class of each
+ * record ("hierhand.control.grasp_reflex:GraspReflex", ...) in HH_RECORDS' order. INPUT_PORTS[name] is a list of input
  * ports in the same form, each port's index in place of an offset. hierhand.layouts makes
  * them Layout objects and port mappings.
  */
@@ -28,13 +29,13 @@ typedef struct {
 
 #define SLOT_ENTRY(P, NAME, WIDTH) {#NAME, P##NAME, (WIDTH)},
 #define SLOT_TABLE(NAME, P, SLOTS, SIZE) static const slot_entry NAME##_SLOTS_[] = {SLOTS(SLOT_ENTRY, P)};
-#define RECORD_SLOT_TABLE(NAME, P, SLOTS, SIZE, TYPES) SLOT_TABLE(NAME, P, SLOTS, SIZE)
+#define RECORD_SLOT_TABLE(NAME, P, SLOTS, SIZE, TYPES, BLOCK) SLOT_TABLE(NAME, P, SLOTS, SIZE)
 HH_LAYOUTS(SLOT_TABLE)
 HH_RECORDS(RECORD_SLOT_TABLE)
 
 #define LAYOUT_ENTRY(NAME, P, SLOTS, SIZE)                                                                         \
     {#NAME, NAME##_SLOTS_, sizeof NAME##_SLOTS_ / sizeof NAME##_SLOTS_[0], SIZE, #P, #SIZE},
-#define RECORD_LAYOUT_ENTRY(NAME, P, SLOTS, SIZE, TYPES) LAYOUT_ENTRY(NAME, P, SLOTS, SIZE)
+#define RECORD_LAYOUT_ENTRY(NAME, P, SLOTS, SIZE, TYPES, BLOCK) LAYOUT_ENTRY(NAME, P, SLOTS, SIZE)
 static const layout_entry LAYOUTS[] = {HH_LAYOUTS(LAYOUT_ENTRY) HH_RECORDS(RECORD_LAYOUT_ENTRY)};
 
 #define PORT_TABLE(NAME, P, PORTS, COUNT) static const slot_entry NAME##_SLOTS_[] = {PORTS(SLOT_ENTRY, P)};
@@ -79,7 +80,7 @@ static int add_layouts(PyObject *module, const char *name, const layout_entry *e
     return add_owned(module, name, layouts);
 }
 
-#define RECORD_OF_TYPES(NAME, P, SLOTS, SIZE, TYPES) {#NAME, TYPES},
+#define RECORD_OF_TYPES(NAME, P, SLOTS, SIZE, TYPES, BLOCK) {#NAME, TYPES},
 static const struct {
     const char *layout;
     const blk_kernel_type *types;
@@ -96,6 +97,23 @@ static int add_record_layouts(PyObject *module)
             Py_XDECREF(layout);
         }
     return add_owned(module, "RECORD_LAYOUTS", records);
+}
+
+#define BLOCK_CLASS(NAME, P, SLOTS, SIZE, TYPES, BLOCK) BLOCK,
+static const char *const BLOCK_CLASSES[] = {HH_RECORDS(BLOCK_CLASS)};
+
+static int add_block_classes(PyObject *module)
+{
+    const size_t n = sizeof BLOCK_CLASSES / sizeof BLOCK_CLASSES[0];
+    PyObject *classes = PyTuple_New((Py_ssize_t)n);
+    for (size_t i = 0; classes != NULL && i < n; i++) {
+        PyObject *path = PyUnicode_FromString(BLOCK_CLASSES[i]);
+        if (path == NULL)
+            Py_CLEAR(classes);
+        else
+            PyTuple_SET_ITEM(classes, (Py_ssize_t)i, path);
+    }
+    return add_owned(module, "BLOCK_CLASSES", classes);
 }
 
 #define DIMENSION_ENTRY(NAME, VALUE) {#NAME, HH_##NAME},
@@ -120,7 +138,7 @@ int hh_py_add_layouts(PyObject *module)
 {
     return add_layouts(module, "LAYOUTS", LAYOUTS, sizeof LAYOUTS / sizeof LAYOUTS[0]) != 0 ||
                    add_layouts(module, "INPUT_PORTS", INPUT_PORTS, sizeof INPUT_PORTS / sizeof INPUT_PORTS[0]) != 0 ||
-                   add_record_layouts(module) != 0 || add_dimensions(module) != 0
+                   add_record_layouts(module) != 0 || add_block_classes(module) != 0 || add_dimensions(module) != 0
                ? -1
                : 0;
 }
