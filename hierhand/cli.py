@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Sequence
 
 from blocks.cli import EXIT_FAILED, EXIT_OK, Program, UsageError, block_types, entry as run_program
-from blocks.cli import fmu, graph, main as run_main, plot, run, ssp, sweep, validate
+from blocks.cli import fmu, graph, main as run_main, plot, run, schema, ssp, sweep, validate
 
 DESCRIPTION = "Multirate block-diagram co-simulation: run YAML diagrams, inspect and plot them."
 MEASURES_HELP = "a hand task measure: separation_time, object_dropped, peak_ratio[(T)], recovery_time[(T)]"
@@ -157,7 +157,7 @@ PROGRAM = Program(
     commands=(run.add, validate.add, graph.add, plot.add, add_animate, add_reproduce,
               fmu.group("export a diagram or the hand plant as an FMU, or describe an FMU", add_fmu_export,
                         fmu.info),
-              ssp.add, sweep.command(MEASURES_HELP), sweep.plot, block_types.add))
+              ssp.add, sweep.command(MEASURES_HELP), sweep.plot, block_types.add, schema.add))
 """The ``hierhand`` command: its commands in the order of its help."""
 
 
