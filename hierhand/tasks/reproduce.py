@@ -16,6 +16,7 @@ from typing import Callable
 import blocks
 from blocks import Results
 
+from ..examples import SHIPPED
 from ..model import load_hand
 from .ablations import shipped_outcomes
 from .figures import draw_figures
@@ -27,16 +28,7 @@ from .summaries import (FORE, MIDDLE, THUMB, TaskBlocks, grasp_summary, handover
 TASKS = ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed")
 
 
-def shipped_diagrams() -> Path:
-    """The folder of the shipped diagrams: the copy an installed wheel carries in the
-    package (``hierhand/diagrams``, made by setup.py), else the repository's ``diagrams/``
-    (a clone, or an editable install of it)."""
-    package = Path(__file__).resolve().parents[1]
-    packaged = package / "diagrams"
-    return packaged if (packaged / "regrasp.yaml").is_file() else package.parent / "diagrams"
-
-
-DEFAULT_DIAGRAMS = shipped_diagrams()
+DEFAULT_DIAGRAMS = SHIPPED
 SETTLED = 0.01
 """Seconds after the hand-over, the middle finger's first touch or the push from which the
 ratio excursions are counted (the contact's first milliseconds settle its anchors)."""
