@@ -60,6 +60,7 @@ def add_animate(sub, program) -> argparse.ArgumentParser:
     timing.add_argument("--every", type=int, metavar="N",
                         help="instead of --speed: a frame at every N-th logged sample of PLANT.q")
     animate.add_argument("--plant", metavar="NAME", help="the HandPlant block (needed if the run has several)")
+    animate.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no report")
     animate.set_defaults(handler=cmd_animate)
     return animate
 
@@ -74,6 +75,7 @@ def add_reproduce(sub, program) -> argparse.ArgumentParser:
     rep.add_argument("--diagrams", type=Path, default=None,
                      help="folder of the task diagrams (default: the shipped ones, diagrams/ of the "
                           "repository or of the installed package)")
+    rep.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no report")
     rep.set_defaults(handler=cmd_reproduce)
     return rep
 
@@ -113,11 +115,12 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
     results = Results.load(args.run_dir)
     try:
-        written = animate_run(results, args.output, fps=args.fps, speed=args.speed,
-                              plant=args.plant, every=args.every, report=print)
+        written = animate_run(results, args.output, fps=args.fps, speed=args.speed, plant=args.plant,
+                              every=args.every, report=None if args.quiet else print, progress=not args.quiet)
     except AnimationError as exc:
         raise UsageError(str(exc)) from None
-    print(f"wrote {written}")
+    if not args.quiet:
+        print(f"wrote {written}")
     return EXIT_OK
 
 
@@ -125,12 +128,15 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, MissingDiagram, ReproduceError, reproduce
 
     try:
-        summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS, report=print)
+        summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS,
+                            report=(lambda s: None) if args.quiet else print, progress=not args.quiet)
     except MissingDiagram as exc:
         raise UsageError(str(exc)) from None
     except ReproduceError as exc:
         print(f"hierhand: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    if args.quiet:
+        return EXIT_OK
     r = summary["regrasp"]
 
     def seconds(value: float | None) -> str:

@@ -124,5 +124,5 @@ def by_name(b: TaskBlocks, values: Mapping[str, Any]) -> dict[str, Any]:
 
 
 def _outcome(task: Task, path: Path, overrides: dict[str, Any]) -> str:
-    results = blocks.engine.simulate(blocks.load_diagram(path, overrides=overrides))
+    results = blocks.simulate(blocks.load_diagram(path, overrides=overrides))
     return task.outcome(results) if results.complete else f"run failed: {results.status}"
