@@ -83,7 +83,7 @@ class BuildNative(build_ext):
 
 
 class BuildPy(build_py):
-    """build_py that also puts the shipped diagrams (``diagrams/*.yaml``) into the package,
+    """build_py that also puts the shipped diagrams (``diagrams/*.yaml``, with their schema) into the package,
     as ``hierhand/diagrams/``, so that an installed wheel runs ``hierhand reproduce``
     without the repository. An editable install reads the repository's folder itself."""
 
@@ -93,15 +93,21 @@ class BuildPy(build_py):
             return
         target = Path(self.build_lib) / SHIPPED_DIAGRAMS
         target.mkdir(parents=True, exist_ok=True)
-        for diagram in sorted((ROOT / "diagrams").glob("*.yaml")):
+        for diagram in shipped_files():
             self.copy_file(str(diagram), str(target / diagram.name))
 
     def get_outputs(self, include_bytecode: bool = True) -> list[str]:
-        shipped = [str(Path(self.build_lib) / SHIPPED_DIAGRAMS / p.name) for p in (ROOT / "diagrams").glob("*.yaml")]
+        shipped = [str(Path(self.build_lib) / SHIPPED_DIAGRAMS / p.name) for p in shipped_files()]
         return super().get_outputs(include_bytecode) + shipped
 
 
 SHIPPED_DIAGRAMS = Path("hierhand", "diagrams")
+
+
+def shipped_files() -> list[Path]:
+    """The shipped diagrams and the diagram file's JSON Schema that their first lines name."""
+    return sorted([*(ROOT / "diagrams").glob("*.yaml"), ROOT / "diagrams" / "diagram.schema.json"])
+
 
 setup(
     ext_modules=[

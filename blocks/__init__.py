@@ -7,6 +7,21 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 """
 
 import importlib
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # what type checkers and IDEs see; at run time the names come from __getattr__
+    from .block import Block, BlockError, EndRun, ParameterError
+    from .builder.diagram import Diagram
+    from .builder.diagram_builder import DiagramBuilder
+    from .diagram_file.load import load_diagram, loads_diagram
+    from .diagram_file.reader import read_builder
+    from .diagram_file.writer import WriteError, dump_diagram, save_diagram
+    from .engine.schedule import Schedule, build_schedule
+    from .engine.simulate import SimulationError, simulate
+    from .issues import DiagramError, Issue
+    from .process.stop import StopRequest
+    from .results.signals import Results, ResultsError
+    from .timebase import parse_duration
 
 from blocks.builder.params_reader import use_params_reader as _use_params_reader
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import inspect
 import re
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from blocks.block import Block, checked_units
 
@@ -99,56 +99,131 @@ def _indent(line: str) -> int:
     return len(line) - len(line.lstrip())
 
 
-
-
-
 def summary(cls: type[Block]) -> str:
     """The first paragraph of the class docstring, on one line."""
     doc = inspect.getdoc(cls) or ""
     return " ".join(doc.split("\n\n")[0].split())
 
 
-def describe_type(cls: type[Block]) -> str:
-    """Text for ``hierhand blocks``: name, summary, parameters with defaults, ports."""
-    lines = [f"{cls.registered_name()}  ({cls.__module__}.{cls.__qualname__})"]
-    if summary(cls):
-        lines.append(f"  {summary(cls)}")
+class ParamInfo(NamedTuple):
+    """A parameter as documentation and the diagram file's schema show it."""
+
+    name: str
+    type: str
+    """The numpydoc type text (may be empty)."""
+    text: str
+    default: Any
+    """The signature's default, or ``REQUIRED``."""
+    block_reference: bool
+    """True when the value names another block of the diagram."""
+
+
+class PortInfo(NamedTuple):
+    """A port of a block's example instance: its width (None: inferred), units and element
+    names (None where the block gives none), and whether an input is optional."""
+
+    name: str
+    width: int | None
+    units: str | list[str] | None
+    labels: list[str] | None
+    optional: bool = False
+
+
+class TypeInfo(NamedTuple):
+    """A block type described for people and tools: ``hierhand blocks``, the generated
+    block reference and the diagram file's JSON Schema all read this one record."""
+
+    name: str
+    qualname: str
+    summary: str
+    parameters: list[ParamInfo]
+    any_parameter: bool
+    """True when the block takes any parameter (``**kwargs``)."""
+    inputs: list[PortInfo] | None
+    """None: the ports depend on the parameters, or on a block the type needs (``ports_note``)."""
+    outputs: list[PortInfo] | None
+    ports_note: str
+    feedthrough: str
+    initial_feedthrough: str | None
+    time_varying: bool
+
+
+REQUIRED = inspect.Parameter.empty
+"""The default of a required parameter."""
+
+
+def type_info(cls: type[Block]) -> TypeInfo:
+    """The record of ``cls``: parameters from the signature and the numpydoc section, ports
+    and feedthrough from its example instance (``Block.example``)."""
     params = cls.parameters()
     docs = parameter_docs(cls)
-    if params:
-        lines.append("  parameters:")
-        for name, p in params.items():
-            doc = docs.get(name)
-            notes = [doc.type] if doc is not None and doc.type else []
-            notes.append("required" if p.default is p.empty else f"default {p.default!r}")
-            if name in cls.block_params:
-                notes.append("the name of another block of the diagram")
-            lines.append(f"    {name} ({'; '.join(notes)})" + (f": {doc.text}" if doc is not None and doc.text else ""))
+    parameters = [ParamInfo(name, docs[name].type if name in docs else "", docs[name].text if name in docs else "",
+                            p.default, name in cls.block_params) for name, p in params.items()]
+    inputs = outputs = None
+    note = feedthrough = ""
+    initial = None
     try:
         block = cls.example()
     except Exception:
         needs = [n for n in cls.block_params if n in params and params[n].default is params[n].empty]
-        lines.append(f"  ports: see 'hierhand validate' of a diagram using it (it needs the block named by "
-                     f"{', '.join(needs)})" if needs else "  ports: depend on the parameters")
+        note = (f"see 'hierhand validate' of a diagram using it (it needs the block named by {', '.join(needs)})"
+                if needs else "depend on the parameters")
     else:
-        def ports(d: dict) -> str:
-            return ", ".join(f"{p}[{'n' if w is None else w}]" for p, w in d.items()) or "none"
-
-        optional = f" (optional: {', '.join(block.input_defaults)})" if block.input_defaults else ""
-        details = {p: _port_details(block, p, w) for p, w in (*block.inputs.items(), *block.outputs.items())}
-        if any(details.values()):  # a port per line, with its unit and elements
-            shown = {p: f"{p}[{'n' if w is None else w}]" for p, w in (*block.inputs.items(), *block.outputs.items())}
-            pad = max(map(len, shown.values()))
-            for what, d, extra in (("inputs", block.inputs, optional), ("outputs", block.outputs, "")):
-                lines.append(f"  {what}{extra}:" if d else f"  {what}: none")
-                lines += [f"    {shown[p]:<{pad}}  {details[p]}".rstrip() for p in d]
-        else:
-            lines.append(f"  inputs: {ports(block.inputs)}{optional}")
-            lines.append(f"  outputs: {ports(block.outputs)}")
-        lines.append(f"  feedthrough: {_feedthrough(block.feedthrough)}")
+        inputs = [_port_info(block, p, w, p in block.input_defaults) for p, w in block.inputs.items()]
+        outputs = [_port_info(block, p, w) for p, w in block.outputs.items()]
+        feedthrough = _feedthrough(block.feedthrough)
         if block.initial_feedthrough is not None:
-            lines.append(f"  feedthrough at t = 0: {_feedthrough(block.initial_feedthrough)}")
-    if cls.time_varying:
+            initial = _feedthrough(block.initial_feedthrough)
+    return TypeInfo(cls.registered_name(), f"{cls.__module__}.{cls.__qualname__}", summary(cls), parameters,
+                    cls.accepts_any_parameter(), inputs, outputs, note, feedthrough, initial, cls.time_varying)
+
+
+def _port_info(block: Block, port: str, width: int | None, optional: bool = False) -> PortInfo:
+    """A port's record; units and labels that the example cannot give are left out."""
+    try:
+        units = checked_units(block.port_units(port), width, port)
+        labels = block.element_labels(port)
+    except Exception:  # a block whose example cannot say: the port bare
+        return PortInfo(port, width, None, None, optional)
+    labels = [str(x) for x in labels] if labels is not None and (width is None or len(labels) == width) else None
+    return PortInfo(port, width, units, labels, optional)
+
+
+def describe_type(cls: type[Block]) -> str:
+    """Text for ``hierhand blocks``: name, summary, parameters with defaults, ports."""
+    info = type_info(cls)
+    lines = [f"{info.name}  ({info.qualname})"]
+    if info.summary:
+        lines.append(f"  {info.summary}")
+    if info.parameters:
+        lines.append("  parameters:")
+        for p in info.parameters:
+            notes = [p.type] if p.type else []
+            notes.append("required" if p.default is REQUIRED else f"default {p.default!r}")
+            if p.block_reference:
+                notes.append("the name of another block of the diagram")
+            lines.append(f"    {p.name} ({'; '.join(notes)})" + (f": {p.text}" if p.text else ""))
+    if info.inputs is None:
+        lines.append(f"  ports: {info.ports_note}")
+    else:
+        def shown(port: PortInfo) -> str:
+            return f"{port.name}[{'n' if port.width is None else port.width}]"
+
+        optional = [p.name for p in info.inputs if p.optional]
+        optional_text = f" (optional: {', '.join(optional)})" if optional else ""
+        details = {p.name: port_details(p) for p in (*info.inputs, *info.outputs)}
+        if any(details.values()):  # a port per line, with its unit and elements
+            pad = max(len(shown(p)) for p in (*info.inputs, *info.outputs))
+            for what, ports, extra in (("inputs", info.inputs, optional_text), ("outputs", info.outputs, "")):
+                lines.append(f"  {what}{extra}:" if ports else f"  {what}: none")
+                lines += [f"    {shown(p):<{pad}}  {details[p.name]}".rstrip() for p in ports]
+        else:
+            lines.append(f"  inputs: {', '.join(map(shown, info.inputs)) or 'none'}{optional_text}")
+            lines.append(f"  outputs: {', '.join(map(shown, info.outputs)) or 'none'}")
+        lines.append(f"  feedthrough: {info.feedthrough}")
+        if info.initial_feedthrough is not None:
+            lines.append(f"  feedthrough at t = 0: {info.initial_feedthrough}")
+    if info.time_varying:
         lines.append("  time-varying source: needs a period")
     return "\n".join(lines)
 
@@ -158,15 +233,10 @@ def unit_text(unit: str) -> str:
     return "1 (dimensionless)" if unit == "1" else unit
 
 
-def _port_details(block: Block, port: str, width: int | None) -> str:
+def port_details(port: PortInfo) -> str:
     """A port's unit and element names, "rad; elements thumb.1, thumb.2, ..." (each element
     with its own unit where they differ: "x (m), y (m), theta (rad)"); "" if it has neither."""
-    try:
-        units = checked_units(block.port_units(port), width, port)
-        labels = block.element_labels(port)
-    except Exception:  # a block whose example cannot say: list the port bare
-        return ""
-    labels = [str(x) for x in labels] if labels is not None and (width is None or len(labels) == width) else None
+    units, labels = port.units, port.labels
     if isinstance(units, list):
         names = labels or [f"[{i}]" for i in range(len(units))]
         return ", ".join(f"{n} ({u or 'unit unknown'})" for n, u in zip(names, units))

@@ -32,6 +32,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from blocks.process.progress import progress_bar
 from blocks.results.signals import held_index
 
 from .tasks.phases import FINGER_WORDS, Phase, phase_at, task_phases
@@ -56,7 +57,7 @@ class AnimationError(ValueError):
 def animate_run(results: Any, path: str | Path, fps: float = 25, speed: float | None = None,
                 plant: str | None = None, every: int | None = None,
                 newtons_per_mm: float | None = None, max_frames: int = MAX_FRAMES,
-                dpi: int = 100, report: Callable[[str], None] | None = None) -> Path:
+                dpi: int = 100, report: Callable[[str], None] | None = None, progress: bool = False) -> Path:
     """Write an animated GIF (or MP4) of the hand plant in ``results`` to ``path``; return the path.
 
     ``results``: a ``blocks.Results`` or its folder. ``path``: ``*.gif`` or ``*.mp4`` (MP4
@@ -66,7 +67,7 @@ def animate_run(results: Any, path: str | Path, fps: float = 25, speed: float | 
     every ``every``-th sample of ``<plant>.q``. ``plant``: the ``HandPlant`` block's name
     (needed only if the run has several). ``newtons_per_mm``: arrow scale (default: a
     round number drawing the largest force at most a fifth of the view long). ``report``: told the speed
-    chosen and the frame count. Raises ``AnimationError`` with a one-line message for
+    chosen and the frame count. ``progress``: a bar of the frames written, on a terminal. Raises ``AnimationError`` with a one-line message for
     runs that cannot be animated.
     """
     path = Path(path)
@@ -84,7 +85,8 @@ def animate_run(results: Any, path: str | Path, fps: float = 25, speed: float | 
     if report is not None:
         report(scene.timing_line(fps))
     path.parent.mkdir(parents=True, exist_ok=True)
-    scene.save(path, writer, dpi)
+    with progress_bar(len(scene.times), "animate", unit="frame", enabled=progress) as bar:
+        scene.save(path, writer, dpi, done=lambda: bar.update(1))
     return path
 
 
@@ -361,11 +363,13 @@ class _Scene:
                 fig.draw_artist(artist)
             yield np.asarray(canvas.buffer_rgba())
 
-    def save(self, path: Path, writer, dpi: int) -> None:
-        """Draw the frames into ``writer`` (``hierhand.frame_writers``), which keeps none."""
+    def save(self, path: Path, writer, dpi: int, done: Callable[[], None] = lambda: None) -> None:
+        """Draw the frames into ``writer`` (``hierhand.frame_writers``), which keeps none;
+        ``done`` is called after each frame."""
         try:
             for rgba in self.frames(dpi):
                 writer.add(rgba)
+                done()
         finally:
             try:
                 writer.close()

@@ -3,7 +3,8 @@
 ``blocks.cli`` provides run, validate, graph, plot, fmu info, sweep, sweep-plot and
 blocks, with the exit codes and messages of every command; this module adds what only
 the hand application does: ``animate`` (a GIF of a run), ``reproduce`` (the paper's
-tasks) and ``fmu export`` (a diagram of library and hand blocks, or the plant, as an FMU).
+tasks), ``fmu export`` (a diagram of library and hand blocks, or the plant, as an FMU) and
+``examples`` (the shipped diagrams, which every diagram command also takes by name).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from pathlib import Path
 from typing import Sequence
 
 from blocks.cli import EXIT_FAILED, EXIT_OK, Program, UsageError, block_types, entry as run_program
-from blocks.cli import fmu, graph, main as run_main, plot, run, ssp, sweep, validate
+from blocks.cli import fmu, graph, main as run_main, plot, run, schema, ssp, sweep, validate
 
 DESCRIPTION = "Multirate block-diagram co-simulation: run YAML diagrams, inspect and plot them."
 MEASURES_HELP = "a hand task measure: separation_time, object_dropped, peak_ratio[(T)], recovery_time[(T)]"
@@ -29,7 +30,10 @@ EXPORTED_FMU = re.compile(r"FMU file not found: looked at (?P<path>\S*HandPlant_
 
 
 def advice(issue) -> str | None:
-    """How to make a missing plant FMU of this package: ``hierhand fmu export``."""
+    """How to make a missing plant FMU of this package (``hierhand fmu export``), and where
+    the shipped diagrams are when a diagram file is not found."""
+    if issue.message == "diagram file not found":
+        return "check the path, or name a shipped diagram: 'hierhand examples' lists them"
     found = EXPORTED_FMU.search(issue.message)
     if found is None:
         return None
@@ -56,6 +60,7 @@ def add_animate(sub, program) -> argparse.ArgumentParser:
     timing.add_argument("--every", type=int, metavar="N",
                         help="instead of --speed: a frame at every N-th logged sample of PLANT.q")
     animate.add_argument("--plant", metavar="NAME", help="the HandPlant block (needed if the run has several)")
+    animate.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no report")
     animate.set_defaults(handler=cmd_animate)
     return animate
 
@@ -70,8 +75,23 @@ def add_reproduce(sub, program) -> argparse.ArgumentParser:
     rep.add_argument("--diagrams", type=Path, default=None,
                      help="folder of the task diagrams (default: the shipped ones, diagrams/ of the "
                           "repository or of the installed package)")
+    rep.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no report")
     rep.set_defaults(handler=cmd_reproduce)
     return rep
+
+
+def add_examples(sub, program) -> argparse.ArgumentParser:
+    """The ``examples`` command."""
+    examples = sub.add_parser("examples", help="list the shipped diagrams, or copy them into a folder",
+                              description="List the diagrams shipped with hierhand (the paper's tasks, the "
+                                          "controller, the toy), which any diagram command also takes by name "
+                                          "('hierhand run regrasp'); with DIR, copy them and the diagram file's "
+                                          "JSON Schema into DIR, to read and change.")
+    examples.add_argument("folder", type=Path, nargs="?", metavar="DIR",
+                          help="the folder to copy them into (made if need be; files already there are not "
+                               "overwritten)")
+    examples.set_defaults(handler=cmd_examples)
+    return examples
 
 
 def add_fmu_export(sub, program) -> argparse.ArgumentParser:
@@ -95,11 +115,12 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
     results = Results.load(args.run_dir)
     try:
-        written = animate_run(results, args.output, fps=args.fps, speed=args.speed,
-                              plant=args.plant, every=args.every, report=print)
+        written = animate_run(results, args.output, fps=args.fps, speed=args.speed, plant=args.plant,
+                              every=args.every, report=None if args.quiet else print, progress=not args.quiet)
     except AnimationError as exc:
         raise UsageError(str(exc)) from None
-    print(f"wrote {written}")
+    if not args.quiet:
+        print(f"wrote {written}")
     return EXIT_OK
 
 
@@ -107,12 +128,15 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     from hierhand.tasks.reproduce import DEFAULT_DIAGRAMS, MissingDiagram, ReproduceError, reproduce
 
     try:
-        summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS, report=print)
+        summary = reproduce(args.output, args.diagrams or DEFAULT_DIAGRAMS,
+                            report=(lambda s: None) if args.quiet else print, progress=not args.quiet)
     except MissingDiagram as exc:
         raise UsageError(str(exc)) from None
     except ReproduceError as exc:
         print(f"hierhand: {exc}", file=sys.stderr)
         return EXIT_FAILED
+    if args.quiet:
+        return EXIT_OK
     r = summary["regrasp"]
 
     def seconds(value: float | None) -> str:
@@ -124,6 +148,30 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
           f"{seconds(r['suppressed']['fore_separation_time_s'])} with suppresser, "
           f"{seconds(r['unsuppressed']['fore_separation_time_s'])} without")
     print(f"wrote {args.output}/summary.json, report.md and fig09.png ... fig14.png")
+    return EXIT_OK
+
+
+def cmd_examples(args: argparse.Namespace) -> int:
+    from blocks.diagram_file.yaml_source import YamlSourceError, load_yaml, read_yaml_file
+
+    from hierhand.examples import copy_examples, example_files
+
+    if args.folder is None:
+        for path in example_files():
+            if path.suffix == ".yaml":
+                try:
+                    description = " ".join(str(load_yaml(read_yaml_file(path)).get("description", "")).split())
+                except (OSError, YamlSourceError, AttributeError):
+                    description = ""
+                print(f"{path.stem:22} {description.split('. ')[0]}")
+        return EXIT_OK
+    try:
+        written = copy_examples(args.folder)
+    except FileExistsError as exc:
+        raise UsageError(f"examples: already there, not overwritten: {exc} (hint: choose a new folder)") from None
+    except OSError as exc:
+        raise UsageError(f"examples: cannot write into {args.folder}: {exc.strerror or exc}") from None
+    print(f"copied {len(written)} files into {args.folder}")
     return EXIT_OK
 
 
@@ -152,12 +200,20 @@ def cmd_fmu_export(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _shipped(name: str) -> Path | None:
+    """A shipped diagram by name (imported when a DIAGRAM names no file)."""
+    from hierhand.examples import shipped_diagram
+
+    return shipped_diagram(name)
+
+
 PROGRAM = Program(
     name="hierhand", description=DESCRIPTION, distribution="hierhand", env_prefix="HIERHAND", advice=advice,
     commands=(run.add, validate.add, graph.add, plot.add, add_animate, add_reproduce,
               fmu.group("export a diagram or the hand plant as an FMU, or describe an FMU", add_fmu_export,
                         fmu.info),
-              ssp.add, sweep.command(MEASURES_HELP), sweep.plot, block_types.add))
+              ssp.add, sweep.command(MEASURES_HELP), sweep.plot, block_types.add, schema.add, add_examples),
+    shipped=lambda name: _shipped(name))
 """The ``hierhand`` command: its commands in the order of its help."""
 
 

@@ -96,7 +96,7 @@ class ForkedCLI:
 
     def close(self) -> None:
         self.server.stdin.close()
-        self.server.wait(timeout=30)
+        self.server.wait(timeout=120)
 
 
 _shared: ForkedCLI | None = None

@@ -18,7 +18,8 @@ from .program import UsageError
 def diagram_args(p: argparse.ArgumentParser) -> None:
     """Add DIAGRAM, --set, --t-end (alias --stop-time), --step and --trust to a command's parser."""
     p.add_argument("diagram", type=Path, metavar="DIAGRAM",
-                   help="YAML diagram file, or an SSP (.ssp archive, or a folder with SystemStructure.ssd)")
+                   help="YAML diagram file, or an SSP (.ssp archive, or a folder with SystemStructure.ssd); "
+                        "a name that is no file: a diagram the program ships, if it has one of that name")
     p.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
                    help="override a parameter (value read as YAML; repeatable), e.g. --set prop.k=2")
     p.add_argument("--t-end", "--stop-time", dest="t_end", metavar="T",

@@ -24,6 +24,7 @@ import dataclasses
 import os
 import sys
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Sequence
 
 if TYPE_CHECKING:
@@ -56,6 +57,9 @@ class Program:
     advice: Callable[[Issue], str | None] | None = None
     """The application's hint for a problem it knows how to fix (an FMU that its own
     exporter makes), in place of the problem's own; None: no better hint."""
+    shipped: Callable[[str], Path | None] | None = None
+    """The application's own diagram of a name (``regrasp``), for a DIAGRAM argument that
+    names no file: so its documented commands work in any folder after any install."""
 
     def env(self, suffix: str) -> str:
         """The name of one of the program's environment variables, e.g. ``HIERHAND_DEBUG``."""
@@ -107,6 +111,9 @@ def main(program: Program, argv: Sequence[str] | None = None) -> int:
     args = build_parser(program).parse_args(argv)
     from blocks import DiagramError, ResultsError
 
+    if hasattr(args, "diagram"):
+        args.diagram = shipped_or_given(args.diagram, program)
+
     try:
         return args.handler(args)
     except DiagramError as exc:
@@ -121,6 +128,14 @@ def main(program: Program, argv: Sequence[str] | None = None) -> int:
 
         print(f"{program.name}: interrupted", file=sys.stderr)
         return exit_code(exc)
+
+
+def shipped_or_given(diagram: Path | None, program: Program) -> Path | None:
+    """A command's DIAGRAM: the path as given, unless no such file exists and the program
+    ships a diagram of that name."""
+    if diagram is None or program.shipped is None or diagram.exists():
+        return diagram
+    return program.shipped(str(diagram)) or diagram
 
 
 def entry(program: Program) -> None:

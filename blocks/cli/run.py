@@ -6,7 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from blocks.process.status_line import StatusLine
+from blocks.process.progress import progress_bar
 from .options import diagram_args, end_time, load
 from .program import EXIT_FAILED, EXIT_OK, UsageError
 
@@ -37,23 +37,21 @@ def add(sub, program) -> argparse.ArgumentParser:
 
 
 class ProgressBar:
-    """The run's progress on stderr: only on a terminal, and only once a run takes a second."""
+    """The run's progress in simulated seconds on stderr (``blocks.process.progress``): only
+    on a terminal, without -q, and only once a run takes a second."""
 
     def __init__(self, t_end: float, enabled: bool):
         self.t_end = t_end
-        self.line = StatusLine(enabled)
+        self.bar = progress_bar(t_end, "run", unit="s", enabled=enabled, delay=1.0,
+                                bar_format="{desc}: {percentage:5.1f}%|{bar}| t = {n:.4g} / {total:.4g} s "
+                                           "[{elapsed}<{remaining}]")
 
     def __call__(self, fraction: float, elapsed: float) -> None:
-        if elapsed < 1.0 and not self.line.shown:
-            return
-        width = 30
-        filled = int(width * fraction)
-        eta = elapsed * (1 - fraction) / fraction if fraction > 0 else float("nan")
-        self.line.show(f"[{'#' * filled}{'.' * (width - filled)}] {100 * fraction:5.1f}%  "
-                       f"t = {fraction * self.t_end:.4g} / {self.t_end:.4g} s  eta {eta:5.1f} s")
+        """The simulate callback: ``fraction`` of the run done after ``elapsed`` seconds."""
+        self.bar.update(fraction * self.t_end - self.bar.n)
 
     def close(self) -> None:
-        self.line.close()
+        self.bar.close()
 
 
 def check_formats(args: argparse.Namespace) -> None:

@@ -1,1 +1,1 @@
-"""The program's process: signals as stop requests, forked children, private temporary files, the status line."""
+"""The program's process: signals as stop requests, forked children, private temporary files, progress bars."""

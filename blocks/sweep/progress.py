@@ -1,32 +1,28 @@
-"""The sweep's one-line progress report on stderr: done/total, failed, elapsed and ETA.
+"""The sweep's progress on stderr: points done of all, failed, elapsed and the time left.
 
-Shown only on a terminal (like a run's progress bar), so logs and pipes stay clean.
+A ``blocks.process.progress`` bar: shown only on a terminal (like a run's), so logs and
+pipes stay clean.
 """
 
 from __future__ import annotations
 
-import time
 from typing import TextIO
 
-from blocks.process.status_line import StatusLine
+from blocks.process.progress import progress_bar
 
 
 class SweepProgress:
-    """Redrawn after every finished run; the ETA assumes the remaining runs take as long on average."""
+    """Advanced after every finished run; the time left assumes the remaining runs take as
+    long on average."""
 
     def __init__(self, total: int, enabled: bool = True, stream: TextIO | None = None):
-        self.line = StatusLine(enabled, stream)
-        self.total = total
-        self.done = self.failed = 0
-        self.start = time.perf_counter()
+        self.bar = progress_bar(total, "sweep", unit="point", enabled=enabled, stream=stream)
+        self.failed = 0
 
     def update(self, ok: bool) -> None:
-        self.done += 1
         self.failed += 0 if ok else 1
-        elapsed = time.perf_counter() - self.start
-        eta = elapsed * (self.total - self.done) / self.done
-        self.line.show(f"sweep: {self.done}/{self.total} done, {self.failed} failed, "
-                       f"{elapsed:.1f} s elapsed, eta {eta:.1f} s")
+        self.bar.set_postfix_str(f"{self.failed} failed", refresh=False)
+        self.bar.update(1)
 
     def close(self) -> None:
-        self.line.close()
+        self.bar.close()

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any, Callable, Mapping
 
 from .robustness import TASKS, Task
 
@@ -88,13 +88,17 @@ ABLATIONS = (
 """The additions beyond the paper, in the order the report tables them."""
 
 
-def shipped_outcomes(diagrams: Path, ablations=ABLATIONS, tasks: tuple[Task, ...] = TASKS) -> list[dict[str, Any]]:
+def shipped_outcomes(diagrams: Path, ablations=ABLATIONS, tasks: tuple[Task, ...] = TASKS,
+                     done: Callable[[], None] = lambda: None) -> list[dict[str, Any]]:
     """Each ablation's outcomes at the shipped point: rows ``{name, off, why, <task>: outcome}``
-    (``""`` for success), first the shipped diagrams as they are."""
+    (``""`` for success), first the shipped diagrams as they are. ``done`` is called after
+    each row (its tasks run)."""
     from .robustness import run_shipped
 
     rows = [{"name": "as shipped", "off": "", "why": "", **run_shipped(diagrams, {}, tasks)}]
+    done()
     for ablation in ablations:
         rows.append({"name": ablation.name, "off": ablation.off, "why": ablation.why,
                      **run_shipped(diagrams, ablation.extra(), tasks)})
+        done()
     return rows

@@ -10,6 +10,9 @@ from blocks import Results
 
 from .summaries import ANGLE_TOLERANCE, FACTOR_LEAVES, POSITION_TOLERANCE, grasp_succeeded, manipulation_succeeded
 
+PAPER_TITLE = "Hierarchical Control Method for Manipulating/Grasping Tasks using Multi-fingered Robot Hand"
+"""The paper whose tasks, figures 9-14 and claims the report reproduces, cited by its title."""
+
 HOLDING_KEPT = 0.9
 """The share of their grasp torque the holding fingers must keep through the suppresser
 (99 % of the time from the middle finger's touch) for the claim that only the leaving
@@ -224,6 +227,9 @@ def report_markdown(summary: dict, runs: dict[str, Results]) -> str:
     timing = "\n".join(f"| {task} | {res.info['t_end']:g} s | {res.info['wall_time_s']:.2f} s |"
                        for task, res in runs.items())
     return f"""# Reproduction of the paper's tasks
+
+The paper: "{PAPER_TITLE}". Its three tasks (grasp, manipulation, re-grasp), its figures 9-14
+and its claims, reproduced with this project's model of the hand.
 
 Hierarchical control of a three-fingered hand: a grasping reflex (1 ms, internal forces,
 friction safety ratio 0.6, integral control), a manipulation PD on fingertip

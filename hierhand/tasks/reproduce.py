@@ -15,28 +15,21 @@ from typing import Callable
 
 import blocks
 from blocks import Results
+from blocks.process.progress import above, progress_bar
 
+from ..examples import SHIPPED
 from ..model import load_hand
-from .ablations import shipped_outcomes
+from .ablations import ABLATIONS, shipped_outcomes
 from .figures import draw_figures
 from .report import report_markdown
-from .separation import separation_relation
+from .separation import RUNS as SEPARATION_RUNS, separation_relation
 from .summaries import (FORE, MIDDLE, THUMB, TaskBlocks, grasp_summary, handover_time, manipulation_summary,
                         ratio_excursions, reaction_times, regrasp_succeeded, regrasp_summary, withdrawal)
 
 TASKS = ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed")
 
 
-def shipped_diagrams() -> Path:
-    """The folder of the shipped diagrams: the copy an installed wheel carries in the
-    package (``hierhand/diagrams``, made by setup.py), else the repository's ``diagrams/``
-    (a clone, or an editable install of it)."""
-    package = Path(__file__).resolve().parents[1]
-    packaged = package / "diagrams"
-    return packaged if (packaged / "regrasp.yaml").is_file() else package.parent / "diagrams"
-
-
-DEFAULT_DIAGRAMS = shipped_diagrams()
+DEFAULT_DIAGRAMS = SHIPPED
 SETTLED = 0.01
 """Seconds after the hand-over, the middle finger's first touch or the push from which the
 ratio excursions are counted (the contact's first milliseconds settle its anchors)."""
@@ -59,7 +52,9 @@ def check_diagrams(diagrams: Path) -> None:
                                  f"holding {', '.join(f'{t}.yaml' for t in TASKS)})")
 
 
-def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda s: None) -> dict[str, Results]:
+def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda s: None,
+              done: Callable[[], None] = lambda: None) -> dict[str, Results]:
+    """Run and save each task's diagram; ``done`` is called after each."""
     check_diagrams(diagrams)
     runs = {}
     for task in TASKS:
@@ -71,6 +66,7 @@ def run_tasks(diagrams: Path, out: Path, report: Callable[[str], None] = lambda 
             raise ReproduceError(f"{path}: {results.status} (partial results in {out / 'runs' / task})")
         report(f"{task}: {results.info['t_end']:g} s simulated in {results.info['wall_time_s']:.2f} s")
         runs[task] = results
+        done()
     return runs
 
 
@@ -113,16 +109,23 @@ def summarize(runs: dict[str, Results]) -> dict:
     }
 
 
-def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[str], None] = lambda s: None) -> dict:
-    """Run the tasks, write summary.json, the figures and report.md; return the summary."""
+def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[str], None] = lambda s: None,
+              progress: bool = False) -> dict:
+    """Run the tasks, write summary.json, the figures and report.md; return the summary.
+    ``progress``: a bar on a terminal, a step per run of a task, of the separation
+    relation and of each ablation row, and one for the figures and report."""
     check_diagrams(diagrams)
     out.mkdir(parents=True, exist_ok=True)
-    runs = run_tasks(diagrams, out, report)
-    summary = summarize(runs)
-    summary["separation_relation"] = separation_relation(diagrams / "regrasp.yaml")
-    summary["ablations"] = shipped_outcomes(diagrams)
-    report(f"ablations: {len(summary['ablations']) - 1} additions switched off one by one")
-    (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
-    draw_figures(runs, summary, out)
-    (out / "report.md").write_text(report_markdown(summary, runs), encoding="utf-8")
+    steps = len(TASKS) + SEPARATION_RUNS + 1 + len(ABLATIONS) + 1
+    with progress_bar(steps, "reproduce", unit="step", enabled=progress) as bar:
+        say, done = above(bar, report), lambda: bar.update(1)
+        runs = run_tasks(diagrams, out, say, done)
+        summary = summarize(runs)
+        summary["separation_relation"] = separation_relation(diagrams / "regrasp.yaml", done)
+        summary["ablations"] = shipped_outcomes(diagrams, done=done)
+        say(f"ablations: {len(summary['ablations']) - 1} additions switched off one by one")
+        (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
+        draw_figures(runs, summary, out)
+        (out / "report.md").write_text(report_markdown(summary, runs), encoding="utf-8")
+        done()
     return summary

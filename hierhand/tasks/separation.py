@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 from pathlib import Path
+from typing import Callable
 
 import blocks
 
@@ -22,9 +23,13 @@ S_B_SCALES = (0.8, 1.0, 1.2)
 """Factors on the suppresser's S_b."""
 
 
-def separation_relation(diagram: Path) -> list[dict]:
+RUNS = len(SHIFTS) * len(S_B_SCALES)
+"""How many runs ``separation_relation`` makes."""
+
+
+def separation_relation(diagram: Path, done: Callable[[], None] = lambda: None) -> list[dict]:
     """One row per run of the re-grasp ``diagram``: the withdrawal start, S_b, and when the
-    forefinger separated (None if it did not)."""
+    forefinger separated (None if it did not). ``done`` is called after each run."""
     loaded = blocks.load_diagram(diagram)
     b, base = TaskBlocks.of_diagram(loaded), loaded.parameters()
     fore = base[b.block("manip")]["trajectories"]["fore"]
@@ -38,4 +43,5 @@ def separation_relation(diagram: Path) -> list[dict]:
             results = blocks.simulate(blocks.load_diagram(diagram, overrides=overrides))
             rows.append({"withdrawal_start_s": moved["waypoints"][0][0], "S_b": s_b * scale,
                          "fore_separation_time_s": regrasp_events(results, b)["fore_separation_time_s"]})
+            done()
     return rows

@@ -18,7 +18,7 @@ def test_a_missing_exported_plant_fmu_is_made_with_fmu_export(tmp_path, monkeypa
     assert main(["validate", "diagrams/regrasp_fmu.yaml"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1
-    assert err.startswith("diagrams/regrasp_fmu.yaml:14: block 'plant' (FMU): FMU file not found")
+    assert err.startswith("diagrams/regrasp_fmu.yaml:15: block 'plant' (FMU): FMU file not found")
     assert err.endswith("(hint: make it with 'hierhand fmu export --fmi 2 -o fmu/HandPlant_fmi2.fmu')")
 
 

@@ -314,6 +314,19 @@ blocks:
 log: [{signal: ramp.y, decimate: 10000}]
 """
 
+FAILS_AT_ONCE = """\
+name: long
+time: {t_end: 100000 s}
+blocks:
+  big: {type: Constant, params: {value: 1.0e308}}
+  g: {type: Gain, params: {k: 1.0e308}}
+connections: [big.y -> g.u]
+log: [g.y]
+"""
+"""A long run that fails at its first tick (an infinite output: exit 1): a command that
+answers it with exit 2 about its output folder checked the folder before running, whatever
+the machine's speed (where a long run proved it only by answering within a timeout)."""
+
 
 @pytest.mark.skipif(not hasattr(signal, "SIGINT") or os.name != "posix", reason="POSIX signals")
 def test_ctrl_c_saves_the_run_so_far_and_exits_130(tmp_path):

@@ -55,7 +55,7 @@ def test_generic_messages_begin_with_the_programs_name(tmp_path, capsys):
 
 def test_the_generic_program_lists_every_generic_command():
     assert command_names(Program("p", "", GENERIC_COMMANDS)) == ["run", "validate", "graph", "plot", "fmu", "ssp", "sweep",
-                                                                 "sweep-plot", "blocks"]
+                                                                 "sweep-plot", "blocks", "schema"]
 
 
 @pytest.mark.parametrize("args, code, stream, text", [

@@ -15,7 +15,7 @@ import pytest
 from blocks import Results
 from blocks.cli.run_output import save_run
 
-from .test_cli import LONG_DIAGRAM
+from .test_cli import FAILS_AT_ONCE, LONG_DIAGRAM
 from ..test_results_folder import read_only_folder
 
 REPO = Path(__file__).resolve().parents[3]
@@ -31,8 +31,8 @@ def hierhand(tmp_path: Path, *args: str, timeout: float = 60) -> subprocess.Comp
 
 def test_a_read_only_output_folder_is_refused_before_the_run(tmp_path):
     folder = read_only_folder(tmp_path)
-    (tmp_path / "d.yaml").write_text(LONG_DIAGRAM, encoding="utf-8")
-    proc = hierhand(tmp_path, "run", "d.yaml", "-o", str(folder), timeout=30)
+    (tmp_path / "d.yaml").write_text(FAILS_AT_ONCE, encoding="utf-8")
+    proc = hierhand(tmp_path, "run", "d.yaml", "-o", str(folder))
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr == f"hierhand: error: output folder {folder} is not writable: Permission denied\n"
 

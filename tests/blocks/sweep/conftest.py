@@ -38,10 +38,10 @@ def stop(procs: list[subprocess.Popen]) -> None:
             p.terminate()
     for p in procs:
         try:
-            p.wait(timeout=10)
+            p.wait(timeout=60)
         except subprocess.TimeoutExpired:
             p.kill()
-            p.wait(timeout=5)
+            p.wait(timeout=60)
 
 
 @pytest.fixture(scope="session")

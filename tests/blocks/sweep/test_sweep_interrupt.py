@@ -92,13 +92,13 @@ def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait(timeout=10)
+            proc.wait(timeout=60)
     assert proc.returncode == 130
     assert "Traceback" not in err
     lines = [line for line in err.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith("hierhand: sweep interrupted: ")
     assert "run the same command again" in lines[0]
-    assert _group_gone(proc.pid, timeout=20), "a worker process outlived the interrupted sweep"
+    assert _group_gone(proc.pid, timeout=120), "a worker process outlived the interrupted sweep"
     assert _left_in(tmp_path / "tmp") == []
 
     kept = _rows(out)
@@ -131,10 +131,10 @@ def test_sigterm_to_the_sweep_leaves_nothing_in_tmpdir_and_no_process(tmp_path, 
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-            proc.wait(timeout=10)
+            proc.wait(timeout=60)
     assert proc.returncode == 143, err
     assert err.startswith("hierhand: sweep interrupted: ") and len(err.splitlines()) == 1, err
-    assert _group_gone(proc.pid, timeout=20), "a worker process outlived the stopped sweep"
+    assert _group_gone(proc.pid, timeout=120), "a worker process outlived the stopped sweep"
     assert _left_in(tmp_path / "tmp") == []
 
 

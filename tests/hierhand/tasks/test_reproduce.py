@@ -104,6 +104,9 @@ def test_figures_and_report_are_written(reproduced):
     for n in range(9, 15):
         assert (out / f"fig{n:02d}.png").stat().st_size > 10_000
     report = (out / "report.md").read_text()
+    from hierhand.tasks.report import PAPER_TITLE
+
+    assert f'"{PAPER_TITLE}"' in report.split("\n## ")[0]  # the paper cited by its title, at the top
     assert "![Fig. 14](fig14.png)" in report
     assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 10
     assert "| NOT reproduced |" not in report
