@@ -14,7 +14,7 @@ import pytest
 from blocks.process import scratch
 
 REPO = Path(__file__).resolve().parents[2]
-CHILD = "from blocks import scratch; print(scratch.folder('child-'), scratch.root())"
+CHILD = "from blocks.process import scratch; print(scratch.folder('child-'), scratch.root())"
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")
 
