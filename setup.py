@@ -43,7 +43,7 @@ def _module(name: str, path: Path):
     return module
 
 
-framework = _module("blocks_native_sources", ROOT / "blocks" / "native_sources.py")
+framework = _module("blocks_native_sources", ROOT / "blocks" / "engine" / "native_sources.py")
 hand = _module("hierhand_native_sources", ROOT / "hierhand" / "native_sources.py")
 
 FMU_BINARIES = {
