@@ -1,5 +1,5 @@
-"""A run's plots drawn beside it: a process forked as ``run --plot`` starts imports the
-drawing code and loads its fonts while the diagram loads and runs, then draws the saved
+"""A run's plots drawn beside it: a process forked as ``run --plot`` starts imports
+matplotlib and loads its fonts while the diagram loads and runs, then draws the saved
 results' pages, shared out between a process per core, so that the pictures cost little
 more than the run.
 
@@ -213,16 +213,17 @@ def _plotter(parent: int, requests: int, replies: int) -> None:
 
 
 def _warm() -> None:
-    """Import what drawing needs (the installed marker sources too) and paint a small page
-    of every kind of thing a page has, into memory: a first page costs half as much again
-    as later ones (fonts, and numpy's and Pillow's first calls), here while the run runs."""
+    """Import what drawing needs (matplotlib, the installed marker sources too) and draw a
+    small page of every kind of thing a page has, into memory: a first page costs much
+    more than later ones (imports, the font cache, first calls), here while the run runs."""
     import io
 
     import numpy as np
 
+    from blocks.plot.figure import signal_figure
     from blocks.plot.markers import Marker, marker_sources
-    from blocks.plot.page_layout import layout
-    from blocks.plot.paint import paint
+    from blocks.plot.pages import SAVE_OPTIONS
+    from blocks.plot.select import select
     from blocks.results.signals import Results
 
     marker_sources()  # what a source that fails to load says comes with the plot
@@ -230,15 +231,15 @@ def _warm() -> None:
     run = Results({"w.y": (t, np.column_stack([np.sin(t), np.cos(t)]))},
                   {"diagram": "warm", "status": "failed at t=1 s: warm", "t_end": 2.0, "t_stop": 1.0,
                    "element_labels": {"w.y": ["a.1", "a.2"]}, "units": {"w.y": "m"}})
-    page = layout(run, ["w.y"], markers=[Marker(0.2, 0.2, "", "warm"), Marker(0.4, 0.6, "span", "warm")])
-    paint(page).save(io.BytesIO())
+    fig = signal_figure(run, [select(run, "w.y")],
+                        markers=[Marker(0.2, 0.2, "", "warm"), Marker(0.4, 0.6, "span", "warm")])
+    fig.savefig(io.BytesIO(), format="png", **SAVE_OPTIONS[".png"])
 
 
 def _draw(folder: Path, path: Path, signals: list[str] | None, markers: bool) -> list[Path]:
     """The plot of the results in ``folder``, its pages shared out between the cores: the
     first share drawn here, every other in a forked drawer (a process per page would pay
-    for more forks than the cores give back: 3 pages on 2 cores took 0.14 s so, 0.13 s
-    in two processes)."""
+    for more forks than the cores give back)."""
     from blocks.plot.pages import Pages, balanced
     from blocks.results.signals import Results
 
