@@ -43,9 +43,9 @@ USER_ENV = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE
 """The environment of the timed processes: bytecode caches on."""
 
 
-def timed(*args: str, script: Path | None = None) -> tuple[float, float]:
-    """Wall seconds and peak resident MB of ``python -m hierhand ARGS`` (or of ``python
-    SCRIPT ARGS``) in a fresh process."""
+def timed(*args: str, script: Path | None = None) -> tuple[float, float, float]:
+    """Wall seconds, peak resident MB and CPU seconds (its own and its children's) of
+    ``python -m hierhand ARGS`` (or of ``python SCRIPT ARGS``) in a fresh process."""
     start = time.perf_counter()
     command = [sys.executable, *([str(script)] if script else ["-m", "hierhand"]), *args]
     proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=USER_ENV)
@@ -54,7 +54,7 @@ def timed(*args: str, script: Path | None = None) -> tuple[float, float]:
     proc.returncode = os.waitstatus_to_exitcode(status)
     if proc.returncode:
         raise SystemExit(f"{' '.join(command[1:])} failed: {proc.stderr.read().decode()}")
-    return wall, usage.ru_maxrss / 1024
+    return wall, usage.ru_maxrss / 1024, usage.ru_utime + usage.ru_stime
 
 
 def median(values) -> float:
@@ -96,22 +96,24 @@ def bare_spec(run: Path, spec: Path) -> int:
     return len(pages)
 
 
-def page_seconds(run: Path, out: Path, repeat: int) -> list[float]:
-    """Seconds per page of ``run``'s plot drawn and saved in this process, warm (each page
-    drawn once before)."""
+def page_seconds(run: Path, out: Path, repeat: int) -> tuple[list[float], list[float]]:
+    """Wall and CPU seconds per page of ``run``'s plot drawn and saved in this process,
+    warm (each page drawn once before); the CPU seconds say what a page costs on a machine
+    that others keep busy."""
     from blocks import Results
     from blocks.plot.pages import Pages
 
     pages = Pages.of(Results.load(run), out / "warm" / "signals.png")
     for number in range(1, len(pages) + 1):
         pages.draw(number)
-    seconds = []
+    wall, cpu = [], []
     for _ in range(repeat):
         for number in range(1, len(pages) + 1):
-            start = time.perf_counter()
+            start, start_cpu = time.perf_counter(), time.process_time()
             pages.draw(number)
-            seconds.append(time.perf_counter() - start)
-    return seconds
+            wall.append(time.perf_counter() - start)
+            cpu.append(time.process_time() - start_cpu)
+    return wall, cpu
 
 
 def main() -> None:
@@ -129,18 +131,18 @@ def main() -> None:
         if not args.plots_only:
             timed("graph", str(REGRASP), "-o", str(out / "wiring.png"))
         for _ in range(args.repeat):
-            runs.append(timed("run", str(REGRASP), "-q", "-o", str(out / "run"))[0])
-            plotted.append(timed("run", str(REGRASP), "-q", "--plot", "-o", str(out / "plotted"))[0])
-            plots.append(timed("plot", str(out / "run"), "-o", str(out / "again.png"))[0])
-            bares.append(timed(str(out / "spec.json"), str(out), script=BARE)[0])
+            runs.append(timed("run", str(REGRASP), "-q", "-o", str(out / "run")))
+            plotted.append(timed("run", str(REGRASP), "-q", "--plot", "-o", str(out / "plotted")))
+            plots.append(timed("plot", str(out / "run"), "-o", str(out / "again.png")))
+            bares.append(timed(str(out / "spec.json"), str(out), script=BARE))
             if args.plots_only:
                 continue
-            wall, mb = timed("animate", str(out / "run"), "-o", str(out / "hand.gif"))
+            wall, mb, _ = timed("animate", str(out / "run"), "-o", str(out / "hand.gif"))
             animated.append(wall)
             memory.append(mb)
             validates.append(timed("validate", str(REGRASP))[0])
             graphs.append(timed("graph", str(REGRASP), "-o", str(out / "wiring.png"))[0])
-        per_page = page_seconds(out / "run", out, args.repeat)
+        per_page, per_page_cpu = page_seconds(out / "run", out, args.repeat)
         drawing = []
         if not args.plots_only:
             import blocks
@@ -153,17 +155,19 @@ def main() -> None:
                 start = time.perf_counter()
                 render(diagram, schedule, out / "drawn.png")
                 drawing.append(time.perf_counter() - start)
-    run_s, bare_s = median(runs), median(bares)
-    floor = run_s + bare_s
+    run_s, bare_s, plotted_s, plot_s = (median(t[0] for t in times) for times in (runs, bares, plotted, plots))
+    run_cpu, bare_cpu, plotted_cpu, plot_cpu = (median(t[2] for t in times) for times in (runs, bares, plotted, plots))
     print(f"medians of {args.repeat} fresh processes each; the re-grasp's plot: {count} pages; "
           f"{len(os.sched_getaffinity(0))} cores")
-    print(f"run --plot: {median(plotted):.2f} s, against run {run_s:.2f} s + the bare script's pages "
-          f"{bare_s:.2f} s = {floor:.2f} s: {median(plotted) / floor:.2f}x (target <= 1.15x); "
-          f"{median(plotted) / run_s:.2f}x run")
-    print(f"plot RUN: {median(plots):.2f} s, against the bare script's pages {bare_s:.2f} s: "
-          f"{median(plots) / bare_s:.2f}x (target <= 1.15x)")
-    print(f"a page drawn and saved as PNG in a warm process: {median(per_page):.3f} s "
-          f"(median of {len(per_page)})")
+    print(f"run --plot: {plotted_s:.2f} s, against run {run_s:.2f} s + the bare script's pages {bare_s:.2f} s "
+          f"= {run_s + bare_s:.2f} s: {plotted_s / (run_s + bare_s):.2f}x (target <= 1.15x); "
+          f"{plotted_s / run_s:.2f}x run; CPU {plotted_cpu:.2f} s against {run_cpu + bare_cpu:.2f} s: "
+          f"{plotted_cpu / (run_cpu + bare_cpu):.2f}x")
+    print(f"plot RUN: {plot_s:.2f} s, against the bare script's pages {bare_s:.2f} s: {plot_s / bare_s:.2f}x "
+          f"(target <= 1.15x); CPU {plot_cpu:.2f} s against {bare_cpu:.2f} s: {plot_cpu / bare_cpu:.2f}x")
+    print(f"a page drawn and saved as PNG in a warm process: {median(per_page):.3f} s, "
+          f"{median(per_page_cpu):.3f} s of CPU (medians of {len(per_page)}); load average "
+          f"{os.getloadavg()[0]:.1f}")
     if args.plots_only:
         return
     print(f"animate to GIF (default speed): {median(animated):.2f} s ({median(animated) / run_s:.1f}x run), "
