@@ -90,7 +90,8 @@ def _draw(results: Any, axes_traces: list[list[Trace]], title: str | None, marke
     legends = [_axis(ax, axis_of(results, traces, end, stop, columns), stop, fit, axes_px)
                for ax, traces in zip(axes, axes_traces)]
     axes[0].set_xlim(*time_limits(results, axes_traces, end, stop))
-    draw_markers(axes, [Marker(m.start, m.end, fit(m.label, axes_px - 6, X_SMALL)) for m in markers])
+    words = axes_px - 6  # a marker's words start 2 points below the axis's top, on a backdrop
+    draw_markers(axes, [Marker(m.start, m.end, fit(m.label, words, X_SMALL)) for m in markers])
     if stop is not None:
         axes[0].annotate(results.status.split(": ", 1)[0], xy=(stop, 1.0), xycoords=("data", "axes fraction"),
                          xytext=(0, 3), textcoords="offset points", ha="right", va="bottom",
