@@ -38,7 +38,7 @@ def cmd_plot(args: argparse.Namespace) -> int:
     (``blocks.plot.beside_run``, the pages shared out between a process per core) where there is one, else here."""
     from blocks.plot.beside_run import plotter_beside
 
-    with plotter_beside() as plotter:
+    with plotter_beside(warm_page=False) as plotter:  # no run to overlap: a warm-up page would only delay
         return plot_folder(args, plotter)
 
 
