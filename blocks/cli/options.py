@@ -72,11 +72,14 @@ def end_time(args: argparse.Namespace, diagram):
         raise UsageError(str(exc)) from None
 
 
-def png_output(path: Path) -> Path:
-    """``path`` as the PNG file an ``-o`` option names: UsageError for a name that does not
-    end in .png (the picture would be written under another name) or for a folder."""
+def picture_output(path: Path, suffixes: Sequence[str] = (".png",)) -> Path:
+    """``path`` as the picture file an ``-o`` option names: UsageError for a name that does
+    not end in one of ``suffixes`` (the picture would be written under another name, or as
+    another kind of file) or for a folder."""
+    kinds = suffixes[0] if len(suffixes) == 1 else f"{', '.join(suffixes[:-1])} or {suffixes[-1]}"
     if path.is_dir():
-        raise UsageError(f"-o {path}: is a folder; name the .png file to write (e.g. -o {path / 'signals.png'})")
-    if path.suffix.lower() != ".png":
-        raise UsageError(f"-o {path}: write a .png file (e.g. -o {path.with_suffix('.png')})")
+        raise UsageError(f"-o {path}: is a folder; name the {kinds} file to write "
+                         f"(e.g. -o {path / ('signals' + suffixes[0])})")
+    if path.suffix.lower() not in suffixes:
+        raise UsageError(f"-o {path}: write a {kinds} file (e.g. -o {path.with_suffix(suffixes[0])})")
     return path

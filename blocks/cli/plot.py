@@ -1,5 +1,5 @@
-"""``plot``: the logged signals of a results folder as PNG: an axis per selection, elements
-by label or index, signals overlaid, the diagram's events marked."""
+"""``plot``: the logged signals of a results folder as PNG, SVG or PDF: an axis per
+selection, elements by label or index, signals overlaid, the diagram's events marked."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from .options import png_output
+from .options import picture_output
 from .program import EXIT_FAILED, EXIT_OK, UsageError
 
 SELECTION_HELP = ("an axis: a signal (plant.q), elements of it by label or 0-based index "
@@ -26,8 +26,8 @@ def add(sub, program) -> argparse.ArgumentParser:
     plot.add_argument("-s", "--signal", action="append", dest="signals", metavar="SELECTION", help=SELECTION_HELP)
     plot.add_argument("--no-markers", action="store_true", help="do not mark the diagram's events")
     plot.add_argument("-o", "--output", type=Path, metavar="FILE.png",
-                      help="PNG file (default: RUN_DIR/plots/signals.png); more axes than fit one page "
-                           "make pages FILE-1.png, FILE-2.png, ...")
+                      help="the picture: FILE.png, FILE.svg or FILE.pdf (default: RUN_DIR/plots/signals.png); "
+                           "more axes than fit one page make pages FILE-1.png, FILE-2.png, ...")
     plot.set_defaults(handler=cmd_plot)
     return plot
 
@@ -38,19 +38,19 @@ def cmd_plot(args: argparse.Namespace) -> int:
     (``blocks.plot.beside_run``, the pages shared out between a process per core) where there is one, else here."""
     from blocks.plot.beside_run import plotter_beside
 
-    with plotter_beside() as plotter:
+    with plotter_beside(warm_page=False) as plotter:  # no run to overlap: a warm-up page would only delay
         return plot_folder(args, plotter)
 
 
 def plot_folder(args: argparse.Namespace, plotter) -> int:
     from blocks import Results
-    from blocks.plot.pages import Pages, plot_signals
+    from blocks.plot.pages import FORMATS, Pages, plot_signals
     from blocks.plot.markers import markers
     from blocks.plot.beside_run import PlotProcessError
 
     from .run_output import describe
 
-    out = png_output(args.output) if args.output is not None else args.run_dir / "plots" / "signals.png"
+    out = args.run_dir / "plots" / "signals.png" if args.output is None else picture_output(args.output, FORMATS)
     results = Results.load(args.run_dir)
     events: list = []
     if not args.no_markers:

@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from .options import end_time, png_output, trust_arg
+from .options import end_time, picture_output, trust_arg
 from .program import EXIT_FAILED, EXIT_OK, Command, UsageError
 
 REDUCERS_HELP = ("a column per run (repeatable): REDUCER(BLOCK.PORT[i]) with final, max, min, mean, "
@@ -178,7 +178,7 @@ def cmd_sweep_plot(args: argparse.Namespace) -> int:
     from blocks.sweep.plot import plot_sweep
     from blocks.sweep.store import NotASweep
 
-    png_output(args.output)
+    picture_output(args.output)
     try:
         written = plot_sweep(args.sweep_dir, args.x, args.metric, args.output, y=args.y)
     except NotASweep as exc:

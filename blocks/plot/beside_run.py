@@ -1,5 +1,5 @@
-"""A run's plots drawn beside it: a process forked as ``run --plot`` starts imports the
-drawing code and loads its fonts while the diagram loads and runs, then draws the saved
+"""A run's plots drawn beside it: a process forked as ``run --plot`` starts imports
+matplotlib and loads its fonts while the diagram loads and runs, then draws the saved
 results' pages, shared out between a process per core, so that the pictures cost little
 more than the run.
 
@@ -49,8 +49,9 @@ class PlotProcess:
         self._ended = False
 
     @classmethod
-    def start(cls) -> "PlotProcess | None":
-        """Fork the plotter (None where it cannot be: not Linux, or the fork failed)."""
+    def start(cls, warm_page: bool = True) -> "PlotProcess | None":
+        """Fork the plotter (None where it cannot be: not Linux, or the fork failed); with
+        ``warm_page`` it draws a page into memory while it waits (``_warm``)."""
         if not FORKS:
             return None
         requests = replies = None
@@ -65,7 +66,7 @@ class PlotProcess:
         if pid == 0:
             os.close(requests[1])
             os.close(replies[0])
-            _plotter(parent, requests[0], replies[1])
+            _plotter(parent, requests[0], replies[1], warm_page)
         os.close(requests[0])
         os.close(replies[1])
         try:  # the child makes its group too: whichever runs first, killpg finds it
@@ -132,10 +133,10 @@ class PlotProcess:
 
 
 @contextlib.contextmanager
-def plotter_beside(wanted: bool = True) -> Iterator[PlotProcess | None]:
+def plotter_beside(wanted: bool = True, warm_page: bool = True) -> Iterator[PlotProcess | None]:
     """A started plotter (None if not ``wanted`` or where it cannot be forked), closed at
-    the block's end whatever happens."""
-    plotter = PlotProcess.start() if wanted else None
+    the block's end whatever happens; ``warm_page`` as ``PlotProcess.start`` takes it."""
+    plotter = PlotProcess.start(warm_page) if wanted else None
     try:
         yield plotter
     finally:
@@ -193,13 +194,13 @@ def _detached(parent: int) -> None:
     die_with(parent)
 
 
-def _plotter(parent: int, requests: int, replies: int) -> None:
+def _plotter(parent: int, requests: int, replies: int, warm_page: bool) -> None:
     """The plotter's life: get ready to draw, answer the request, exit (never returns)."""
     try:
         _detached(parent)
         os.setpgid(0, 0)
         gc.disable()  # a short life, one page each: collections would only cost time (and copy pages)
-        _warm()
+        _warm(warm_page)
         line = _read_line(requests)
         if line is None:  # the run ended without plots
             os._exit(0)
@@ -212,33 +213,37 @@ def _plotter(parent: int, requests: int, replies: int) -> None:
     os._exit(0)
 
 
-def _warm() -> None:
-    """Import what drawing needs (the installed marker sources too) and paint a small page
-    of every kind of thing a page has, into memory: a first page costs half as much again
-    as later ones (fonts, and numpy's and Pillow's first calls), here while the run runs."""
+def _warm(page: bool) -> None:
+    """Import what drawing needs (matplotlib, the installed marker sources too) and, with
+    ``page``, draw a small page of every kind of thing a page has, into memory: a first page
+    costs more than later ones (the fonts, first calls), here while the run runs. Where
+    no run is there to overlap (``plot``) the page would only delay the first real one."""
     import io
 
     import numpy as np
 
+    from blocks.plot.figure import signal_figure
     from blocks.plot.markers import Marker, marker_sources
-    from blocks.plot.page_layout import layout
-    from blocks.plot.paint import paint
+    from blocks.plot.pages import SAVE_OPTIONS
+    from blocks.plot.select import select
     from blocks.results.signals import Results
 
     marker_sources()  # what a source that fails to load says comes with the plot
+    if not page:
+        return
     t = np.linspace(0.0, 1.0, 5000)
     run = Results({"w.y": (t, np.column_stack([np.sin(t), np.cos(t)]))},
                   {"diagram": "warm", "status": "failed at t=1 s: warm", "t_end": 2.0, "t_stop": 1.0,
                    "element_labels": {"w.y": ["a.1", "a.2"]}, "units": {"w.y": "m"}})
-    page = layout(run, ["w.y"], markers=[Marker(0.2, 0.2, "", "warm"), Marker(0.4, 0.6, "span", "warm")])
-    paint(page).save(io.BytesIO())
+    fig = signal_figure(run, [select(run, "w.y")],
+                        markers=[Marker(0.2, 0.2, "", "warm"), Marker(0.4, 0.6, "span", "warm")])
+    fig.savefig(io.BytesIO(), format="png", **SAVE_OPTIONS[".png"])
 
 
 def _draw(folder: Path, path: Path, signals: list[str] | None, markers: bool) -> list[Path]:
     """The plot of the results in ``folder``, its pages shared out between the cores: the
     first share drawn here, every other in a forked drawer (a process per page would pay
-    for more forks than the cores give back: 3 pages on 2 cores took 0.14 s so, 0.13 s
-    in two processes)."""
+    for more forks than the cores give back)."""
     from blocks.plot.pages import Pages, balanced
     from blocks.results.signals import Results
 

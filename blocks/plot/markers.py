@@ -13,19 +13,22 @@ or, from Python, with ``register_markers(name, source)``. A source is a function
 run's ``run.json`` info (``block_types`` and ``parameters`` say what the diagram holds)
 returning objects with ``start``, ``end``, ``during`` and ``after``: Markers, or anything
 shaped like them. A source that fails or returns something else is left out, with the
-reason, so a plot never fails for a marker.
+reason, so a plot never fails for a marker. ``draw_markers`` draws them on matplotlib axes,
+for the signal plots and the application's figures alike.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, Sequence
 
 from blocks.plugins import load_group
 
 MARKER_COLOUR = "dimgray"
 """The colour of every marker, on signal plots and on the application's figures."""
+MARKER_GID = "marker"
+"""The gid of every artist that draws a marker (their lines, spans and texts)."""
 
 ENTRY_POINT_GROUP = "blocks.plot_markers"
 
@@ -114,3 +117,18 @@ def _as_marker(item: Any) -> Marker:
 
 def _finite(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def draw_markers(axes: Sequence, markers: Sequence[Marker]) -> None:
+    """Each marker on every one of matplotlib ``axes``: a dotted line at an instant, a light
+    band over a span; its words at the top of the first axis, cut off at the axis's edge."""
+    for m in markers:
+        for ax in axes:
+            if m.instant:
+                ax.axvline(m.start, color=MARKER_COLOUR, ls=":", lw=1.0, gid=MARKER_GID)
+            else:
+                ax.axvspan(m.start, m.end, color=MARKER_COLOUR, alpha=0.08, lw=0, gid=MARKER_GID)
+        axes[0].annotate(m.label, xy=(m.start, 1.0), xycoords=("data", "axes fraction"), xytext=(2, -2),
+                         textcoords="offset points", rotation=90, ha="left", va="top", fontsize="x-small",
+                         color=MARKER_COLOUR, gid=MARKER_GID, annotation_clip=True, clip_on=True,
+                         bbox={"boxstyle": "square,pad=0.1", "facecolor": "white", "alpha": 0.7, "linewidth": 0})

@@ -10,15 +10,17 @@ connection names them (``blocks.builder.elements``)::
     plant.q[thumb.1,fore.1]      several elements, by label or index
     plant.q[fore.1],ref.y        two signals overlaid on one axis
 
-Commas inside brackets list elements; outside they separate signals.
+Commas inside brackets list elements; outside they separate signals. ``results`` is a
+``blocks.Results`` (typed Any: ``Results.plot`` draws through this package, which
+therefore does not import it back).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 from blocks.builder.elements import ElementError, pick, split_signal
-from blocks.results.signals import Results
 
 
 class SelectionError(ElementError):
@@ -52,7 +54,7 @@ def split_signals(text: str) -> list[str]:
     return [p.strip() for p in parts]
 
 
-def select(results: Results, text: str) -> list[Trace]:
+def select(results: Any, text: str) -> list[Trace]:
     """The traces of one axis, from the text of one selection."""
     traces = []
     for part in split_signals(text):
@@ -67,7 +69,7 @@ def select(results: Results, text: str) -> list[Trace]:
     return traces
 
 
-def by_unit(results: Results, traces: list[Trace]) -> list[list[Trace]]:
+def by_unit(results: Any, traces: list[Trace]) -> list[list[Trace]]:
     """The axes an axis of ``traces`` becomes so that each has one unit: a whole signal
     whose elements differ in unit (``plant.obj``: x, y in m, theta in rad) one axis per
     unit, ``plant.obj[x,y]`` and ``plant.obj[theta]``, in the order the units come; any
@@ -85,7 +87,7 @@ def by_unit(results: Results, traces: list[Trace]) -> list[list[Trace]]:
                    f"{tr.signal}[{','.join(tr.labels[c] for c in cols)}]")] for cols in groups.values()]
 
 
-def _trace(results: Results, signal: str, elements: str | None) -> Trace:
+def _trace(results: Any, signal: str, elements: str | None) -> Trace:
     width = results[signal][1].shape[1]
     given = results.element_labels(signal)
     labels = given or [str(j) for j in range(width)]

@@ -155,6 +155,16 @@ class Results:
             raise ValueError(f"signal '{name}' has no sample at or before t = {t}")
         return values[i]
 
+    def plot(self, *signals: str, title: str | None = None, markers=True):
+        """A matplotlib Figure of ``signals`` (selections, as ``hierhand plot -s`` takes them:
+        ``"plant.q"``, ``"plant.q[fore.1]"``, ``"plant.q[fore.1],ref.y"``; default every
+        logged signal), an axis each, with the diagram's events marked (``markers``: True,
+        False, or a list of ``blocks.plot.markers.Marker``). No window opens and pyplot is
+        not needed: a notebook shows the figure inline, ``fig.savefig("f.pdf")`` writes it."""
+        from blocks.plot.pages import figure_of
+
+        return figure_of(self, list(signals) or None, title, markers)
+
     # -- files ---------------------------------------------------------------------
 
     def save(self, directory: str | Path, csv: bool = False, mat: bool = False,

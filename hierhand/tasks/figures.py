@@ -34,7 +34,7 @@ def _legend(ax) -> None:
 def _phases(axes, results: Results) -> None:
     """The task's phases, read from its diagram as ``hierhand plot`` marks them (the
     support's hand-over, each fingertip trajectory's span, Step times)."""
-    from blocks.plot.pages import draw_markers
+    from blocks.plot.markers import draw_markers
     from blocks.plot.markers import markers
 
     draw_markers(axes, markers(results.info)[0])

@@ -169,7 +169,7 @@ def test_ended_by_is_saved_and_loaded(tmp_path):
 
 
 def test_plots_of_an_ended_run_stop_at_its_end():
-    from blocks.plot.page_layout import time_span
+    from blocks.plot.curves import time_span
 
     assert time_span(run(THREE_RATES)) == (0.008, None)
 

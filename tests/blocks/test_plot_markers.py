@@ -9,7 +9,7 @@ from dataclasses import dataclass
 import pytest
 
 import blocks
-from blocks.plot.pages import markers as plot_markers
+import blocks.plot.markers as plot_markers
 from blocks.plot.markers import Marker, markers, register_markers, unregister_markers
 
 

@@ -1,5 +1,5 @@
 """``plot`` on a run of a diagram with library blocks: selections of elements and overlays,
-markers, and bad selections as one line with exit code 2."""
+markers, SVG and PDF files, and bad selections or outputs as one line with exit code 2."""
 
 from __future__ import annotations
 
@@ -62,3 +62,24 @@ def test_a_plot_that_cannot_be_written_is_one_line_and_exit_1(run_dir, tmp_path)
     proc = blocks_cli("plot", run_dir, "-o", tmp_path / "file" / "p.png", cwd=tmp_path)
     assert proc.returncode == 1
     assert proc.stderr == f"blocks: the plots could not be written: File exists: {tmp_path / 'file'}\n"
+
+
+@pytest.mark.parametrize("suffix", [".svg", ".pdf"])
+def test_an_svg_or_pdf_output_is_a_vector_file(run_dir, tmp_path, suffix):
+    target = tmp_path / f"p{suffix}"
+    proc = blocks_cli("plot", run_dir, "-s", "mux.y", "-o", target, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    data = target.read_bytes()
+    if suffix == ".pdf":
+        assert data.startswith(b"%PDF-") and data.rstrip().endswith(b"%%EOF")
+    else:
+        import xml.etree.ElementTree as ET
+
+        root = ET.fromstring(data)
+        assert root.tag == "{http://www.w3.org/2000/svg}svg" and root.findall(".//{http://www.w3.org/2000/svg}path")
+
+
+def test_another_kind_of_output_is_one_line_and_exit_2(run_dir, tmp_path):
+    proc = blocks_cli("plot", run_dir, "-o", tmp_path / "p.jpg", cwd=tmp_path)
+    assert proc.returncode == 2 and all(kind in proc.stderr for kind in (".png", ".svg", ".pdf"))  # what it takes
+    assert len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "p.jpg").exists()
