@@ -16,7 +16,7 @@ from blocks import Results
 from blocks.cli.run_output import save_run
 
 from .test_cli import FAILS_AT_ONCE, LONG_DIAGRAM
-from ..test_results_folder import read_only_folder
+from ..results.test_folder import read_only_folder
 
 REPO = Path(__file__).resolve().parents[3]
 

@@ -110,7 +110,7 @@ def test_a_signal_while_plotting_stops_the_plots_keeps_the_results_and_leaves_no
 def test_plots_drawn_beside_the_run_are_those_drawn_in_its_process(tmp_path):
     """``run --plot`` (its plotter forked before the run) and ``plot`` of the same results
     (its plotter forked as it starts) draw the same pixels; that these are the pixels drawn
-    in one process is tests/blocks/test_plot_process.py's."""
+    in one process is tests/blocks/plot/test_beside_run.py's."""
     from PIL import Image
 
     (tmp_path / "d.yaml").write_text(PAGES, encoding="utf-8")

@@ -30,7 +30,7 @@ from blocks.fmu_export import export_fmu
 
 from ..library.test_library_diagram import diagram as every_block_diagram
 from ..test_diagram_fuzz import FUZZ_SETTINGS, wired_document
-from ..test_subsystems import PI, TOP
+from ..builder.test_subsystems import PI, TOP
 from .slave import Slave, run
 
 REPO = Path(__file__).resolve().parents[3]

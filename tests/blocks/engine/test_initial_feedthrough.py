@@ -14,7 +14,7 @@ from blocks.library.math_blocks import Gain
 from blocks.engine.schedule import HeldInput
 from hierhand.cli import main
 
-from .blockdefs import StartsFromInput, StartsFromOneInput
+from ..blockdefs import StartsFromInput, StartsFromOneInput
 
 DEFS = "python:tests.blocks.blockdefs"
 RAMP = "{type: Ramp, period: 1 ms, params: {slope: 1000.0, initial: 5.0}}"

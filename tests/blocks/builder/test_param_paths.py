@@ -10,7 +10,7 @@ import pytest
 from blocks import DiagramError, load_diagram, loads_diagram
 from blocks.builder.param_paths import PathError, set_path
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DEFS = "python:tests.blocks.blockdefs"
 WEIGHTS = f"""\
 blocks:

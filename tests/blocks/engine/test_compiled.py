@@ -16,7 +16,7 @@ import pytest
 
 from blocks import loads_diagram, simulate
 
-from .compiled_blocks import CALLS, Leak, Scale, register
+from ..compiled_blocks import CALLS, Leak, Scale, register
 
 
 @pytest.fixture(autouse=True)

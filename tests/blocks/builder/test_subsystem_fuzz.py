@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 import blocks
 
-from .test_diagram_fuzz import FUZZ_SETTINGS, short_t_end, wired_document
+from ..test_diagram_fuzz import FUZZ_SETTINGS, short_t_end, wired_document
 
 
 def parse(conn) -> tuple[str, str, int, object]:

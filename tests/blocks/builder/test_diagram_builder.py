@@ -14,9 +14,9 @@ import blocks
 from blocks import DiagramBuilder, DiagramError, WriteError, dump_diagram, load_diagram, save_diagram, simulate
 from blocks.library import Gain, Step
 
-from .blockdefs import Model, ScaleByModel
+from ..blockdefs import Model, ScaleByModel
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 TOY = ROOT / "diagrams" / "toy.yaml"
 HERE = __file__
 

@@ -13,7 +13,7 @@ import pytest
 
 from blocks.process import scratch
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 CHILD = "from blocks.process import scratch; print(scratch.folder('child-'), scratch.root())"
 
 pytestmark = pytest.mark.skipif(os.name != "posix", reason="POSIX permissions")

@@ -10,7 +10,7 @@ import pytest
 import blocks
 from blocks import loads_diagram, simulate
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DEFS = "python:tests.blocks.blockdefs"
 
 

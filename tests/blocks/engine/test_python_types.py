@@ -19,7 +19,7 @@ import pytest
 import blocks
 from blocks.issues import DiagramError
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 MODULE = '''\
 from pathlib import Path

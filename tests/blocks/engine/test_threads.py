@@ -21,9 +21,9 @@ from blocks import Block, load_diagram, loads_diagram, simulate
 from blocks.engine.kernel import Kernel
 from blocks.registry import block_types
 
-from .kernel_library import function
+from ..kernel_library import function
 
-TOY = Path(__file__).resolve().parents[2] / "diagrams" / "toy.yaml"
+TOY = Path(__file__).resolve().parents[3] / "diagrams" / "toy.yaml"
 ROUNDS = 5
 
 

@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 import blocks
 import blocks.engine.compiled
 
-from .test_diagram_fuzz import FUZZ_SETTINGS, wired_document
-from .test_reference import loaded
+from ..test_diagram_fuzz import FUZZ_SETTINGS, wired_document
+from .test_reference_loop import loaded
 
 
 def run(diagram, t_end, compiled: bool, monkeypatch, engine: str = "native"):

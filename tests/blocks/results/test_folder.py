@@ -15,7 +15,7 @@ import pytest
 from blocks import Results, ResultsError
 from blocks.results.folder import OutputFolderError, prepare, writing
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def results(name: str = "a", value: float = 1.0) -> Results:

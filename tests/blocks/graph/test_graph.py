@@ -15,7 +15,7 @@ from blocks import build_schedule, load_diagram, loads_diagram
 from blocks.graph import (crossings, draw, effective_rate, geometry, is_feedthrough, layered, picture, rate_colors,
                           render, to_dot)
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 TOY = ROOT / "diagrams" / "toy.yaml"
 
 DELAYED_LOOP = """

@@ -18,7 +18,7 @@ import pytest
 from blocks import DiagramError, loads_diagram, simulate
 from blocks.builder.references import Reference, build_order, chain_text
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DEFS = "python:tests.blocks.blockdefs"
 
 # 'use' refers to 'model', which comes after it in the file.

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import blocks
 
-DIAGRAMS = Path(__file__).resolve().parents[2] / "diagrams"
+DIAGRAMS = Path(__file__).resolve().parents[3] / "diagrams"
 
 
 def test_repr_names_the_diagram_its_file_and_its_size():

@@ -16,9 +16,9 @@ from blocks.cli import PROGRAM
 from blocks.cli.program import main
 from blocks.engine.finite import NonFiniteOutput
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 TOY = REPO / "diagrams" / "toy.yaml"
-DEFS = "python:tests.blocks.test_finite"
+DEFS = "python:tests.blocks.engine.test_finite"
 ENGINES = ("native", "reference")
 
 

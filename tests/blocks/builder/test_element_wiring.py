@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import blocks
 from blocks import DiagramBuilder, DiagramError, dump_diagram, loads_diagram, simulate
 
-from .test_diagram_fuzz import FUZZ_SETTINGS
+from ..test_diagram_fuzz import FUZZ_SETTINGS
 
 ENGINES = ("native", "reference")
 

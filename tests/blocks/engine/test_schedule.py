@@ -16,7 +16,7 @@ import blocks
 from blocks import build_schedule, loads_diagram
 from blocks.engine.schedule import _Planner
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 def toy():

@@ -15,7 +15,7 @@ import pytest
 import blocks
 from blocks import EndRun, Results, loads_diagram, simulate
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 DEFS = "python:tests.blocks.blockdefs"
 
 THREE_RATES = f"""

@@ -18,11 +18,11 @@ import pytest
 from blocks import build_schedule, loads_diagram, simulate
 from blocks.engine.optable import L_WIDTH, op_table
 
-from .compiled_blocks import Leak, Scale, Stopper, register
-from .fmu.build import compiler
+from ..compiled_blocks import Leak, Scale, Stopper, register
+from ..fmu.build import compiler
 
-SOURCES = Path(__file__).parent / "kernel_sources"
-CSRC = Path(__file__).resolve().parents[2] / "blocks" / "csrc"
+SOURCES = Path(__file__).parents[1] / "kernel_sources"
+CSRC = Path(__file__).resolve().parents[3] / "blocks" / "csrc"
 
 
 @pytest.fixture(scope="module")

@@ -25,9 +25,9 @@ from blocks import DiagramError, load_diagram, simulate
 from blocks.sweep import grid_points, parse_metrics, run_sweep
 from blocks.sweep.plan import execute, prepare
 
-from .test_builder import structure
+from .test_diagram_builder import structure
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 TOY = ROOT / "diagrams" / "toy.yaml"
 
 PI = """\

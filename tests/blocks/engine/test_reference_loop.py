@@ -25,10 +25,10 @@ import blocks
 import blocks.engine.compiled
 from blocks import load_diagram, loads_diagram, simulate
 
-from .compiled_blocks import register
-from .test_diagram_fuzz import FUZZ_SETTINGS, short_t_end
+from ..compiled_blocks import register
+from ..test_diagram_fuzz import FUZZ_SETTINGS, short_t_end
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 PERIODS = ["0.1 ms", "0.2 ms", "0.5 ms", "1 ms", "2 ms"]
 
 
