@@ -28,7 +28,7 @@ import threading
 import time
 import uuid
 from collections import deque
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from dataclasses import replace
 from typing import Any
 
@@ -52,6 +52,13 @@ LOCAL_CLUSTER_CONFIG = {
 (a stack sample every 10 ms, read only by the dashboard, which a sweep does not start)
 and their fast monitoring ticks take the GIL from the running simulation: with them,
 every 10 s re-grasp run took about 5 % longer on 2 cores."""
+
+KEEP_LOST_WORKERS = {"distributed.deploy.lost-worker-timeout": "36500 days"}
+"""Held while a sweep's LocalCluster runs (it reads the setting when a worker leaves): by
+default the cluster closes a worker's nanny for good when its worker has not come back
+within 15 s. A nanny restarts a worker whose process died (a point that kills it), and on
+a busy machine that restart can take longer; the cluster then had no workers left and the
+sweep waited forever. Its nannies are kept for as long as it runs."""
 
 
 def start_method(requested: str | None = None, source: str = "start_method") -> str:
@@ -215,6 +222,7 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQ
     ready it is told to stop, its run times size the first tasks, and what it sends is
     recorded as tasks complete (``local.LocalRunner``: ``stop()``, ``collect()``, ``walls``).
     """
+    import dask
     from distributed import Client, as_completed
 
     from .worker_plugin import DiagramFiles
@@ -222,6 +230,7 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQ
     report = SweepReport()
     t0 = time.perf_counter()
     cluster = plugin = None
+    held = ExitStack()
     in_flight: dict[Any, list[tuple[str, Point]]] = {}
     try:
         if client is not None:
@@ -229,6 +238,7 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQ
         elif scheduler:
             client = connect(scheduler, connect_timeout)
         else:
+            held.enter_context(dask.config.set(KEEP_LOST_WORKERS))
             cluster = _local_cluster(workers, method)
             client = Client(cluster)
         if job.bundle is not None:  # the files once per worker; each task carries the manifest only
@@ -300,5 +310,6 @@ def run_dask(job: SweepJob, todo: list[tuple[str, Point]] | PointQueue | SharedQ
             client.close()
         if cluster is not None:
             cluster.close()
+        held.close()
     report.wall_s = time.perf_counter() - t0
     return report

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from blocks import Results, loads_diagram, simulate
+from blocks.engine import compiled
 from blocks.fmu import FMU
 from blocks.fmu import compiled_step as fmu_kernel
 
@@ -105,17 +106,32 @@ def test_an_offset_fmu_starts_at_its_first_hit_through_the_kernel(fmus, monkeypa
 
 def test_python_blocks_around_the_compiled_fmu(fmus, monkeypatch):
     """A Python block feeds the FMU and another reads it: values cross between the worlds
-    as they do between Python blocks."""
+    as they do between Python blocks.
+
+    The executor runs the FMU's source and ``h`` through their Python methods (it takes no
+    kernel of theirs); a library block's kernel itself cannot be switched off, since its
+    Python methods call it."""
     extra = ("  g: {type: Gain, params: {k: 0.5}}\n"
              "  h: {type: Gain, params: {k: -2.0}}")
     d = diagram(fmus.fmi2, extra=extra, wires="  - f.y -> g.u\n  - g.y -> h.u", log="[f.y, g.y, h.y]")
-    source = d.blocks["src"].block
-    d.blocks["h"].block.kernel = lambda: None                       # h runs in Python
-    monkeypatch.setattr(source, "kernel", lambda: None)               # and so does the FMU's source
+    in_python = (d.blocks["src"].block, d.blocks["h"].block)
+    usable = compiled.usable_kernel
+    ran_in_python: collections.Counter = collections.Counter()
+
+    def no_kernel_for_python_blocks(block, *args):
+        if any(block is b for b in in_python):
+            ran_in_python[type(block).__name__] += 1
+            return None
+        return usable(block, *args)
+
+    monkeypatch.setattr(compiled, "usable_kernel", no_kernel_for_python_blocks)
     reference = python(monkeypatch, d)
     counts = slow_calls(monkeypatch)
-    assert_same(simulate(d), reference)
+    result = simulate(d)
+    assert result.complete, result.status
+    assert_same(result, reference)
     assert counts == {"output": 1}
+    assert set(ran_in_python) == {"Ramp", "Gain"}
 
 
 def handed(kind: str, isolation: str) -> str:

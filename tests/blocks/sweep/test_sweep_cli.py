@@ -150,9 +150,11 @@ def test_a_point_that_kills_its_worker_fails_alone(tmp_path, monkeypatch, capfd)
     monkeypatch.syspath_prepend(str(tmp_path))
     out = tmp_path / "sweep"
     values = ",".join(str(v) for v in range(1, 17))
-    # After the first single-point tasks, the 16 points go in chunks of 3, one of them holding
-    # the point that kills its worker: that chunk is lost whole and its points run again alone.
-    with dask.config.set({"distributed.scheduler.allowed-failures": 1}):
+    # After the first single-point tasks, the 16 points go in chunks, one of them holding the
+    # point that kills its worker: that chunk is lost whole and its points run again alone.
+    # A lost-worker timeout of 0 s stands for a restart slower than any timeout (a busy
+    # machine): the sweep's cluster still waits for its nannies to restart their workers.
+    with dask.config.set({"distributed.scheduler.allowed-failures": 1, "distributed.deploy.lost-worker-timeout": "0 s"}):
         code = main(["sweep", str(tmp_path / "crash.yaml"), "-o", str(out), "--grid", f"src.value={values}",
                      "--metric", "y=final(crash.y)", "--trust", "--workers", "2", "-q"])
     got = {float(r["src.value"]): r for r in rows(out)}
