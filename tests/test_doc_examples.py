@@ -33,6 +33,9 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
 SHELL = {"bash", "sh", "console", "shell"}
 NOT_COMMANDS = {"text", "yaml", "toml", ""}
+LISTINGS = {"c", "py"}
+"""Blocks that show a file of the project (a tutorial's real code): not run, but each must be
+found in a file of the packages, so that the page cannot drift from the code."""
 COPIED = ("diagrams", "docs", "fmu", "benchmarks")
 
 # The quick start's installs are dropped and the rest of the line runs: there is no network
@@ -103,7 +106,7 @@ TEXT = "\n".join(page.read_text(encoding="utf-8") for page in PAGES)
 
 
 def test_every_block_is_a_known_kind():
-    unknown = [(lang, place) for lang, _, place in BLOCKS if lang not in SHELL | NOT_COMMANDS | {"python"}]
+    unknown = [(lang, place) for lang, _, place in BLOCKS if lang not in SHELL | NOT_COMMANDS | LISTINGS | {"python"}]
     assert not unknown, f"blocks of a language this test does not handle: {unknown}"
     assert len(SHELL_BLOCKS) >= 5 and len(PYTHON_BLOCKS) >= 5
 
@@ -193,3 +196,24 @@ def test_inline_set_example_is_accepted(path: str, value: str, workdir, tmp_path
                            "--t-end", "10 ms", "-q", "--set", f"{path}={value}"],
                           cwd=work, env=env, capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stderr
+
+
+SOURCES = [p for package in ("blocks", "hierhand") for p in sorted((ROOT / package).rglob("*"))
+           if p.suffix in (".py", ".c", ".h") and p.is_file()]
+
+
+def listing_lines(text: str) -> list[str]:
+    """A text's non-blank lines, spaces collapsed and a C line continuation dropped."""
+    return [" ".join(line.rstrip().rstrip("\\").split()) for line in text.splitlines() if line.strip()]
+
+
+@pytest.mark.parametrize("body, place", first_places(BLOCKS, LISTINGS), ids=lambda v: v if ":" in str(v) else "")
+def test_a_listing_shows_a_file_of_the_project_as_it_is(body, place):
+    """A listing's lines are lines of one source file, in the file's order (an excerpt may
+    leave lines out between them), as written there."""
+    shown = listing_lines(body)
+    for path in SOURCES:
+        lines = iter(listing_lines(path.read_text(encoding="utf-8")))
+        if all(any(line == want for line in lines) for want in shown):
+            return
+    pytest.fail(f"{place}: this listing is not (or no longer) the text of any file of blocks/ or hierhand/")

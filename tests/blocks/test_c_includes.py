@@ -73,7 +73,7 @@ def test_the_include_reader_finds_includes_beside_the_file_upwards_and_in_the_in
     blocks, hand = FOLDERS
     assert graph.has_edge(blocks / "fmu_block_step", blocks / "fmu_channel")  # beside the file
     assert graph.has_edge(hand / "python" / "py_kernel_types", hand / "kernel_types")  # "../kernel_types.h"
-    assert graph.has_edge(hand / "kernels", blocks / "blocks_kernel")  # an include folder
+    assert graph.has_edge(hand / "kernel_types", blocks / "blocks_kernel")  # an include folder
     assert not graph.has_edge(blocks / "fmu_channel", blocks / "fmu_channel")  # x.c with x.h: one unit
 
 
