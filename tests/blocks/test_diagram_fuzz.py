@@ -25,7 +25,7 @@ from blocks.library import LIBRARY
 FILENAME = "fuzz.yaml"
 TOY_TEXT = (Path(__file__).resolve().parents[2] / "diagrams" / "toy.yaml").read_text(encoding="utf-8")
 
-FUZZ_SETTINGS = dict(deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture,
+FUZZ_SETTINGS = dict(derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture,
                                                            HealthCheck.too_slow,
                                                            HealthCheck.filter_too_much])
 

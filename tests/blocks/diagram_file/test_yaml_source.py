@@ -359,7 +359,7 @@ yaml_values = st.recursive(
     max_leaves=20)
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200)
 @given(yaml_values, st.sampled_from([False, True]))
 def test_load_yaml_agrees_with_safe_load(value, flow):
     text = yaml.safe_dump(value, default_flow_style=flow)

@@ -152,7 +152,7 @@ def test_the_random_diagrams_include_runs_that_end_early_fail_and_advance(kind):
     """The comparison above is only as good as its diagrams: they must end runs early,
     fail part-way and advance blocks over spans."""
     find(st.tuples(mixed_document(), st.integers(min_value=1, max_value=150)), lambda ex: kind in kinds_of_run(ex),
-         settings=settings(max_examples=2000, database=None, deadline=None, phases=[Phase.generate]))
+         settings=settings(max_examples=2000, database=None, phases=[Phase.generate]))
 
 
 RUNNABLE = sorted(p.stem for p in (ROOT / "diagrams").glob("*.yaml")

@@ -34,7 +34,7 @@ def test_toy_plan():
     assert "plant" not in outputs  # its output at an event comes from the previous advance
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60)
 @given(st.lists(st.tuples(st.integers(1, 12), st.integers(0, 11)), min_size=1, max_size=4),
        st.integers(1, 400))
 def test_hits_in_closed_form_match_the_firing_masks(rates, n_ticks):
@@ -120,7 +120,7 @@ def test_huge_logs_are_refused_before_the_run():
         blocks.simulate(toy(), t_end="1e6 s")
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=200)
 @given(st.integers(1, 12).flatmap(lambda n: st.tuples(
     st.just(n), st.permutations(range(n)), st.sets(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1))))))
 def test_output_order_is_networkx_lexicographic_order(case):

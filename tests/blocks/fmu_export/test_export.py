@@ -88,7 +88,7 @@ def test_every_signal_block_of_the_library_leaves_with_the_native_samples(tmp_pa
 
 @settings(max_examples=120, suppress_health_check=[*FUZZ_SETTINGS.get("suppress_health_check", ()),
                                                    HealthCheck.function_scoped_fixture],
-          deadline=None, derandomize=True)
+          derandomize=True)
 @given(doc=wired_document(), ticks=st.integers(min_value=5, max_value=60))
 def test_random_library_diagrams_leave_with_the_native_samples(doc, ticks, tmp_path):
     try:

@@ -161,7 +161,7 @@ class TestAdvance:
 
     @given(st.integers(1, 4), st.integers(1, 3), st.integers(1, 3), st.integers(1, 300),
            st.integers(0, 2**32 - 1))
-    @settings(max_examples=40, deadline=None)
+    @settings(max_examples=40)
     def test_matches_reference_loop_property(self, n_states, m, p, steps, seed):
         rng = np.random.default_rng(seed)
         A, B, C, _ = random_stable(rng, n_states, m, p, with_d=False)

@@ -97,7 +97,7 @@ class TestSum:
 
     @given(st.text(alphabet="+-", min_size=1, max_size=8),
            st.lists(st.floats(-1e6, 1e6), min_size=8, max_size=8))
-    @settings(max_examples=60, deadline=None)
+    @settings(max_examples=60)
     def test_signed_sum_property(self, signs, values):
         inputs = {f"u{j}": np.array([values[j]]) for j in range(len(signs))}
         y = sized(Sum(signs), 1).output(0.0, None, inputs)["y"]

@@ -155,7 +155,7 @@ def test_finger_ik_rejects_bad_arguments(kwargs, message):
 hand_q = st.lists(st.floats(-1.3, 1.3), min_size=9, max_size=9).map(np.array)
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=100)
 @given(hand_q, st.lists(st.floats(-0.02, 0.02), min_size=9, max_size=9))
 def test_hand_ik_reproduces_the_models_tip_positions(hand, q, noise):
     q[1::3] = np.where(np.abs(q[1::3]) < 0.1, 0.1, q[1::3])
@@ -165,7 +165,7 @@ def test_hand_ik_reproduces_the_models_tip_positions(hand, q, noise):
     np.testing.assert_allclose(sol, q, atol=1e-7)
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(hand_q)
 def test_hand_ik_picks_the_branch_nearest_the_reference(hand, q):
     q[1::3] = np.where(np.abs(q[1::3]) < 0.1, 0.1, q[1::3])

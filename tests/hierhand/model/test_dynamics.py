@@ -59,7 +59,7 @@ def potential(hand, q):
     return -sum(mass * g @ pc for mass, _, pc, _, _ in com_positions_and_jacobians(hand, q))
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(q=angles)
 def test_mass_matrix_is_symmetric_positive_definite(q):
     m = Hand.default().mass_matrix(q)
@@ -67,7 +67,7 @@ def test_mass_matrix_is_symmetric_positive_definite(q):
     assert np.linalg.eigvalsh(0.5 * (m + m.T)).min() > 0.9e-4  # at least the armature
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(q=angles)
 def test_mass_matrix_equals_sum_of_link_kinetic_energies(q):
     hand = hand_with_offsets()
@@ -75,7 +75,7 @@ def test_mass_matrix_equals_sum_of_link_kinetic_energies(q):
     assert np.allclose(hand.mass_matrix(q), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(q=angles, qd=rates)
 def test_bias_is_coriolis_plus_gravity_plus_damping(q, qd):
     """h = Mdot qd - 1/2 d(qd' M qd)/dq + dV/dq + D qd, derivatives by central differences."""
@@ -127,7 +127,7 @@ def two_link_closed_form(finger, gravity, q1, q2, qd1, qd2):
     return np.array([[m11, m12], [m12, m22]]), cor + grav + damp
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=50)
 @given(q=angles, qd=rates)
 def test_two_link_finger_matches_closed_form(q, qd):
     hand = two_link_hand()
@@ -140,7 +140,7 @@ def test_two_link_finger_matches_closed_form(q, qd):
         assert np.allclose(h[3 * f : 3 * f + 2], ref_h, rtol=0, atol=1e-10 * np.abs(ref_h).max())
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(q=angles)
 def test_tip_jacobians_are_derivatives_of_tip_positions(q):
     hand = Hand.default()
