@@ -6,14 +6,25 @@ already has (no CMake, no code generator), and copies the shipped diagrams into 
 package (``hierhand/diagrams/``), which package data cannot reach from outside it. The framework's extension ``blocks._native``
 is the CPython module (``native_module.c``, ``native_run*.c``) of the op-table interpreter
 (``core.c``, plain C99 that needs no Python), with the library's and the FMU block's kernels (``blocks/csrc``); the
-hand's, ``hierhand._native``, binds its C core. Besides the extensions the build links
+hand's, ``hierhand._native``, binds its C core, with Python's stable ABI only (``Py_LIMITED_API``
+3.11: one ``_native.abi3.so`` for every Python >= 3.11). ``blocks._native`` cannot be: its
+run releases the GIL only while no other thread could take it, which it learns by walking the
+interpreter's thread states (``PyInterpreterState_ThreadHead``, ``PyThreadState_Next``) and
+``_PyOS_IsMainThread``, and it calls Python blocks by vectorcall (limited API from 3.12 only),
+so the wheel keeps its version tag. Besides the extensions the build links
 plain shared libraries that an FMU export copies into FMUs, so exporting needs no
 compiler: ``blocks/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the op-table core, the
 library's kernels and an FMI wrapper: any diagram of library blocks) and
 ``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the same with the hand's kernels). They
-link libc and libm only; their FMI headers come from fmpy (a build requirement), the
-headers an importer builds against too. The file lists are ``blocks/engine/native_sources.py``
+link libc and libm only; their FMI headers are the standard's, carried in ``blocks/csrc/fmi``
+(BSD-2-Clause, see LICENSE). The file lists are ``blocks/engine/native_sources.py``
 and ``hierhand/native_sources.py``, which the exporter reads for an FMU's ``sources/``.
+
+An editable install builds in fresh temporary folders, where distutils' up-to-date check
+never finds a previous build, so every reinstall (``pip install -e ".[test]"`` after
+``pip install -e .``) would compile everything again; ``BuildNative`` therefore reuses the
+extensions and FMU binaries that an editable or in-place build left in the tree when they
+are newer than every input of the build (``BUILD_INPUTS``), and compiles otherwise.
 """
 
 from __future__ import annotations
@@ -25,6 +36,7 @@ from pathlib import Path
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 from setuptools.command.build_py import build_py
+from setuptools.modified import newer_group
 
 ROOT = Path(__file__).resolve().parent
 
@@ -49,24 +61,71 @@ FMU_BINARIES = {
 """Per package and FMI version, every file of its FMU binary (C files and headers)."""
 
 
+BUILD_INPUTS = sorted(str(path) for folder in (framework.CSRC, hand.CSRC) for path in (ROOT / folder).rglob("*")
+                      if path.suffix in (".c", ".h")) + [__file__, framework.__file__, hand.__file__]
+"""Everything a compiled file of the build depends on: every C file and header of both C
+trees, this file (flags, macros) and the source lists."""
+
+
 class BuildNative(build_ext):
-    """build_ext that also links the FMU binaries next to the extensions."""
+    """build_ext that also links the FMU binaries next to the extensions, and reuses what an
+    earlier editable or in-place build left in the tree while it is current."""
 
     def run(self) -> None:
         super().run()
+        if self._in_tree():
+            self._remove_shadowing_builds()
         for package, versions in FMU_BINARIES.items():
             for fmi, files in versions.items():
                 self._link_fmu_binary(package, fmi, files)
 
+    def _remove_shadowing_builds(self) -> None:
+        """Remove the tree's other builds of each extension (``_native.cpython-311-...so`` beside
+        ``_native.abi3.so``): Python would import a version-specific one first, however old."""
+        build_py = self.get_finalized_command("build_py")
+        for ext in self.extensions:
+            current = ROOT / self._get_inplace_equivalent(build_py, ext)[0]
+            for other in current.parent.glob(ext.name.rpartition(".")[2] + ".*.so"):
+                if other != current:
+                    other.unlink()
+
+    def get_ext_fullpath(self, ext_name: str) -> str:
+        """distutils names the file by the extension's last name part only, which setuptools
+        maps to the last extension of that short name (both are ``_native``, only one abi3):
+        the file name here comes from the full name."""
+        path = super().get_ext_fullpath(ext_name)
+        return os.path.join(os.path.dirname(path), os.path.basename(self.get_ext_filename(self.get_ext_fullname(ext_name))))
+
+    def _in_tree(self) -> bool:
+        return self.inplace or getattr(self, "editable_mode", False)
+
+    def _current(self, in_tree: Path) -> bool:
+        """Whether ``in_tree``, left by an earlier editable or in-place build, is newer than
+        every input of the build, so that copying it is the same as compiling it again."""
+        return self._in_tree() and not self.force and in_tree.is_file() and not newer_group(BUILD_INPUTS, str(in_tree))
+
+    def build_extension(self, ext: Extension) -> None:
+        in_tree = ROOT / self._get_inplace_equivalent(self.get_finalized_command("build_py"), ext)[0]
+        if not self._current(in_tree):
+            super().build_extension(ext)
+            return
+        target = self.get_ext_fullpath(ext.name)
+        self.mkpath(os.path.dirname(target))
+        self.copy_file(str(in_tree), target)
+
     def _link_fmu_binary(self, package: str, fmi: int, files: list[str]) -> None:
         relative = Path(package, "fmu_binaries", f"fmi{fmi}.so")
         targets = [Path(self.build_lib) / relative]
-        if self.inplace or getattr(self, "editable_mode", False):
+        if self._in_tree():
+            if self._current(ROOT / relative):
+                self.mkpath(str(targets[0].parent))
+                self.copy_file(str(ROOT / relative), str(targets[0]))
+                return
             targets.append(ROOT / relative)
         objects = self.compiler.compile(
             [f for f in files if f.endswith(".c")],
             output_dir=os.path.join(self.build_temp, package, f"fmi{fmi}"),
-            include_dirs=[framework.fmi_headers(), framework.CSRC, hand.CSRC],
+            include_dirs=[framework.FMI_HEADERS, framework.CSRC, hand.CSRC],
             depends=[f for f in files if f.endswith(".h")],
             extra_postargs=framework.CFLAGS + ["-std=c99", "-g0"],  # no debug info in what FMUs carry
         )
@@ -118,11 +177,12 @@ setup(
             extra_compile_args=framework.CFLAGS + ["-std=c11"],
             libraries=["m"],
         ),
-        Extension(
+        Extension(  # the stable ABI of Python 3.11 (hierhand/csrc/python/py_common.h): one build for every Python >= 3.11
             "hierhand._native",
             sources=hand.EXTENSION_SOURCES,
             depends=hand.EXTENSION_DEPENDS,
-            define_macros=[("HH_SOURCES_DIGEST", f'"{hand.sources_digest(ROOT)}"')],
+            py_limited_api=True,
+            define_macros=[("Py_LIMITED_API", "0x030B0000"), ("HH_SOURCES_DIGEST", f'"{hand.sources_digest(ROOT)}"')],
             include_dirs=[framework.CSRC],
             extra_compile_args=framework.CFLAGS + ["-std=c11"],
             libraries=["m"],

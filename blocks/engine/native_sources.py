@@ -12,9 +12,6 @@ and one FMI wrapper, plus a kernel-set file that lists the kernel types the bina
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 CSRC = "blocks/csrc"
 
 CORE = ["core.c"]
@@ -35,6 +32,10 @@ FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
 KERNEL_SET = "library_kernel_set.c"
 """The kernel-set file of a binary holding the library's kernel types only."""
 
+FMI_HEADERS = f"{CSRC}/fmi"
+"""The FMI 2.0 and 3.0 standard's headers, unmodified (BSD-2-Clause, see LICENSE), which the FMU
+binaries and the tests' FMUs and C hosts are built against."""
+
 CFLAGS = ["-O2", "-fvisibility=hidden", "-fno-math-errno", "-ffp-contract=off", "-Wall"]
 """-ffp-contract=off: no fused multiply-adds, so every build rounds as the reference does."""
 
@@ -51,14 +52,3 @@ def fmu_sources(fmi: int) -> list[str]:
     """The framework's files (repository paths) in every exported FMU of FMI ``fmi``, its
     kernel-set file excepted: C files first, then headers."""
     return paths(CORE + LIBRARY + EXPORT + [FMI_WRAPPERS[fmi]] + CORE_HEADERS + LIBRARY_HEADERS + EXPORT_HEADERS)
-
-
-def fmi_headers() -> str:
-    """The folder of the FMI 2 / 3 headers the libraries are built against (fmpy's copy)."""
-    spec = importlib.util.find_spec("fmpy")
-    if spec is None or not spec.submodule_search_locations:
-        raise RuntimeError("building the FMU binaries needs fmpy (for the FMI headers); pip installs it as a build requirement")
-    folder = Path(list(spec.submodule_search_locations)[0]) / "c-code"
-    if not (folder / "fmi2Functions.h").is_file() or not (folder / "fmi3Functions.h").is_file():
-        raise RuntimeError(f"fmpy's FMI headers are missing from {folder}")
-    return str(folder)

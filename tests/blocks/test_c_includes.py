@@ -7,7 +7,8 @@ A ``.c`` file and the ``.h`` of the same name are one unit (the header is the fi
 interface): ``fmu_channel.c`` including ``fmu_channel.h`` is no circle, but
 ``fmu_block_step.c`` including ``fmu_channel.h`` while ``fmu_channel.c`` includes
 ``fmu_block_step.h`` is one. Only quoted includes count; a header that is not in the
-tree (Python's, the FMI headers of fmpy, libc's) is no unit of ours.
+tree (Python's, libc's, the FMI standard's in ``blocks/csrc/fmi``, which the build passes
+as an include folder of its own) is no unit of ours.
 """
 
 from __future__ import annotations

@@ -8,6 +8,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = [ROOT / "blocks", ROOT / "hierhand"]
 LIMIT = 600
+VENDORED = ROOT / "blocks" / "csrc" / "fmi"
+"""The FMI standard's headers, kept as the standard writes them (LICENSE): not modules of ours."""
 
 KNOWN_OVER: set[str] = set()
 """Files allowed over the limit for now, each with the reason; none today."""
@@ -17,7 +19,7 @@ def line_counts() -> dict[str, int]:
     """Lines of every .py, .c and .h file under the packages, by repository path."""
     return {path.relative_to(ROOT).as_posix(): len(path.read_bytes().splitlines())
             for package in PACKAGES for path in sorted(package.rglob("*"))
-            if path.suffix in (".py", ".c", ".h") and path.is_file()}
+            if path.suffix in (".py", ".c", ".h") and path.is_file() and not path.is_relative_to(VENDORED)}
 
 
 def test_no_module_is_over_the_limit():

@@ -9,8 +9,9 @@ from pathlib import Path
 
 import pytest
 
+from blocks.engine.native_sources import FMI_HEADERS
+
 REPO = Path(__file__).resolve().parents[2]
-FMI_HEADERS = Path(__import__("fmpy").__file__).parent / "c-code"
 
 
 @pytest.fixture(scope="session")
@@ -28,6 +29,6 @@ def c_host(tmp_path_factory):
     if compiler is None:
         pytest.skip("no C compiler")
     exe = tmp_path_factory.mktemp("host") / "fmi2_host"
-    subprocess.run([compiler, "-std=c99", "-O1", "-I", str(FMI_HEADERS), "-o", str(exe),
+    subprocess.run([compiler, "-std=c99", "-O1", "-I", str(REPO / FMI_HEADERS), "-o", str(exe),
                     str(Path(__file__).with_name("fmu_host") / "fmi2_host.c"), "-ldl"], check=True)
     return exe

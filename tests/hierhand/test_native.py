@@ -17,7 +17,6 @@ from hierhand.model import Hand, HandPlant
 from hierhand.layouts import OUTPUT, STATE
 
 REPO = Path(__file__).resolve().parents[2]
-FMI_HEADERS = Path(__import__("fmpy").__file__).parent / "c-code"
 
 
 FMU_C_FILES = sorted({p for fmi in framework_sources.FMI_WRAPPERS
@@ -31,7 +30,7 @@ def test_core_and_fmu_sources_are_strict_c99(path, tmp_path):
     if compiler is None:
         pytest.skip("gcc is not installed")
     done = subprocess.run([compiler, "-std=c99", "-pedantic-errors", "-Wall", "-Wextra", "-Werror", "-fPIC",
-                           "-I", str(FMI_HEADERS), "-I", str(REPO / framework_sources.CSRC),
+                           "-I", str(REPO / framework_sources.FMI_HEADERS), "-I", str(REPO / framework_sources.CSRC),
                            "-I", str(REPO / native_sources.CSRC), "-c", str(REPO / path),
                            "-o", str(tmp_path / "x.o")], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr

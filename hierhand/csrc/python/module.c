@@ -42,18 +42,22 @@ PyMODINIT_FUNC PyInit__native(void)
         PyErr_SetString(PyExc_SystemError, "hierhand._native: method table too small");
         return NULL;
     }
-    if (PyType_Ready(&hh_py_model_type) < 0 || PyType_Ready(&hh_py_context_type) < 0)
-        return NULL;
     PyObject *module = PyModule_Create(&module_def);
     if (module == NULL)
         return NULL;
-    if (hh_py_add_layouts(module) != 0 ||
-        PyModule_AddStringConstant(module, "SOURCES_DIGEST", HH_SOURCES_DIGEST) != 0) {
+    PyObject *model = PyType_FromSpec(&hh_py_model_spec);
+    PyObject *context = PyType_FromSpec(&hh_py_context_spec);
+    int added = model != NULL && context != NULL && PyModule_AddObjectRef(module, "Model", model) == 0 &&
+                PyModule_AddObjectRef(module, "Context", context) == 0;
+    Py_XDECREF(context);
+    if (!added) {
+        Py_XDECREF(model);
         Py_DECREF(module);
         return NULL;
     }
-    if (PyModule_AddObjectRef(module, "Model", (PyObject *)&hh_py_model_type) != 0 ||
-        PyModule_AddObjectRef(module, "Context", (PyObject *)&hh_py_context_type) != 0) {
+    hh_py_model_type = (PyTypeObject *)model; /* kept for the life of the process, as a static type would be */
+    if (hh_py_add_layouts(module) != 0 ||
+        PyModule_AddStringConstant(module, "SOURCES_DIGEST", HH_SOURCES_DIGEST) != 0) {
         Py_DECREF(module);
         return NULL;
     }

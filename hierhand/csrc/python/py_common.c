@@ -3,10 +3,49 @@
 
 #include <string.h>
 
+PyTypeObject *hh_py_model_type;
+
+PyObject *hh_py_alloc(PyTypeObject *type)
+{
+    return PyType_GenericAlloc(type, 0);
+}
+
+void hh_py_free(PyObject *self)
+{
+    PyTypeObject *type = Py_TYPE(self);
+    PyObject_Free(self);
+    Py_DECREF(type);
+}
+
+PyObject *hh_py_type_name(PyObject *obj)
+{
+    PyObject *type = (PyObject *)Py_TYPE(obj);
+    PyObject *module = PyObject_GetAttrString(type, "__module__");
+    PyObject *name = PyObject_GetAttrString(type, "__qualname__");
+    PyObject *full = NULL;
+    if (module != NULL && name != NULL)
+        full = PyUnicode_Check(module) && PyUnicode_CompareWithASCIIString(module, "builtins") != 0
+                   ? PyUnicode_FromFormat("%U.%U", module, name)
+                   : Py_NewRef(name);
+    Py_XDECREF(module);
+    Py_XDECREF(name);
+    return full;
+}
+
+/* TypeError: "<what> <text>, got <obj's type>". */
+static void type_error(const char *what, const char *text, PyObject *obj)
+{
+    PyObject *name = hh_py_type_name(obj);
+    if (name != NULL) {
+        PyErr_Format(PyExc_TypeError, "%s %s, got %.100U", what, text, name);
+        Py_DECREF(name);
+    }
+}
+
 ModelObject *hh_py_model(PyObject *obj, const char *what)
 {
-    if (!PyObject_TypeCheck(obj, &hh_py_model_type)) {
-        PyErr_Format(PyExc_TypeError, "%s must be a hierhand._native.Model, got %.100s", what, Py_TYPE(obj)->tp_name);
+    if (!PyObject_TypeCheck(obj, hh_py_model_type)) {
+        type_error(what, "must be a hierhand._native.Model", obj);
         return NULL;
     }
     return (ModelObject *)obj;
@@ -17,8 +56,8 @@ int hh_py_doubles(PyObject *obj, Py_buffer *view, Py_ssize_t n, int writable, co
     int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
     if (PyObject_GetBuffer(obj, view, flags) != 0) {
         PyErr_Clear();
-        PyErr_Format(PyExc_TypeError, "%s must be a C-contiguous%s float64 array, got %.100s", what,
-                     writable ? " writable" : "", Py_TYPE(obj)->tp_name);
+        type_error(what, writable ? "must be a C-contiguous writable float64 array" : "must be a C-contiguous float64 array",
+                   obj);
         return -1;
     }
     const char *format = view->format;
@@ -43,7 +82,7 @@ int hh_py_double(PyObject *obj, double *out, const char *what)
     double x = PyFloat_AsDouble(obj);
     if (x == -1.0 && PyErr_Occurred()) {
         PyErr_Clear();
-        PyErr_Format(PyExc_TypeError, "%s must be a number, got %.100s", what, Py_TYPE(obj)->tp_name);
+        type_error(what, "must be a number", obj);
         return -1;
     }
     *out = x;

@@ -1,4 +1,8 @@
-/* Shared pieces of the Python binding (the extension module hierhand._native). */
+/* Shared pieces of the Python binding (the extension module hierhand._native).
+ *
+ * The binding uses only the stable ABI of Python 3.11 (Py_LIMITED_API, set by setup.py): its
+ * types are heap types made from specs, objects are reached through functions, never their
+ * structs, and arrays through the buffer protocol. One build serves every Python >= 3.11. */
 #ifndef HIERHAND_PY_COMMON_H
 #define HIERHAND_PY_COMMON_H
 
@@ -17,10 +21,20 @@ typedef struct {
     hh_work work;
 } ModelObject;
 
-extern PyTypeObject hh_py_model_type;
+extern PyType_Spec hh_py_model_spec;
+extern PyTypeObject *hh_py_model_type; /* made from hh_py_model_spec when the module loads */
 
 /* A kernel's context built by its type's constructor from a record (py_kernel_types.c). */
-extern PyTypeObject hh_py_context_type;
+extern PyType_Spec hh_py_context_spec;
+
+/* A new object of the heap type ``type`` (zeroed); NULL with an exception. */
+PyObject *hh_py_alloc(PyTypeObject *type);
+
+/* Free ``self``, an object of a heap type, and the reference it held to its type. */
+void hh_py_free(PyObject *self);
+
+/* The name of ``obj``'s type as Python writes it ("numpy.ndarray", "list"): a new reference. */
+PyObject *hh_py_type_name(PyObject *obj);
 
 /* ``obj`` as a Model, or NULL with TypeError naming ``what``. */
 ModelObject *hh_py_model(PyObject *obj, const char *what);

@@ -47,7 +47,7 @@ static PyObject *context_new(PyTypeObject *type, PyObject *args, PyObject *kwarg
     Py_buffer view;
     if (hh_py_doubles(record, &view, -1, 0, "record") != 0)
         return NULL;
-    ContextObject *self = (ContextObject *)type->tp_alloc(type, 0);
+    ContextObject *self = (ContextObject *)hh_py_alloc(type);
     if (self == NULL) {
         PyBuffer_Release(&view);
         return NULL;
@@ -69,7 +69,7 @@ static void context_dealloc(ContextObject *self)
 {
     if (self->type != NULL && self->built.ctx != NULL)
         self->type->destroy(self->built.ctx);
-    Py_TYPE(self)->tp_free((PyObject *)self);
+    hh_py_free((PyObject *)self);
 }
 
 static PyObject *context_address(ContextObject *self, void *closure)
@@ -113,17 +113,22 @@ static PyMethodDef context_methods[] = {
     {NULL, NULL, 0, NULL},
 };
 
-PyTypeObject hh_py_context_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hierhand._native.Context",
-    .tp_basicsize = sizeof(ContextObject),
-    .tp_dealloc = (destructor)context_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Context(kind, record): the context the constructor of kernel type kind (kernel_types.h) builds from "
-              "record (float64), ValueError with the constructor's message when it refuses the record; freed "
-              "with the object.",
-    .tp_getset = context_getset,
-    .tp_methods = context_methods,
-    .tp_new = context_new,
+static PyType_Slot context_slots[] = {
+    {Py_tp_dealloc, (void *)context_dealloc},
+    {Py_tp_doc, "Context(kind, record): the context the constructor of kernel type kind (kernel_types.h) builds from "
+                "record (float64), ValueError with the constructor's message when it refuses the record; freed "
+                "with the object."},
+    {Py_tp_getset, context_getset},
+    {Py_tp_methods, context_methods},
+    {Py_tp_new, (void *)context_new},
+    {0, NULL},
+};
+
+PyType_Spec hh_py_context_spec = {
+    .name = "hierhand._native.Context",
+    .basicsize = sizeof(ContextObject),
+    .flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_IMMUTABLETYPE,
+    .slots = context_slots,
 };
 
 /* -- the adapters' addresses ------------------------------------------------------------------ */

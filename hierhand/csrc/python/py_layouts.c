@@ -52,7 +52,7 @@ static PyObject *layout_tuple(const layout_entry *layout)
         if (slot == NULL)
             Py_CLEAR(slots);
         else
-            PyTuple_SET_ITEM(slots, (Py_ssize_t)i, slot);
+            PyTuple_SetItem(slots, (Py_ssize_t)i, slot); /* steals slot */
     }
     if (slots == NULL)
         return NULL;
@@ -111,7 +111,7 @@ static int add_block_classes(PyObject *module)
         if (path == NULL)
             Py_CLEAR(classes);
         else
-            PyTuple_SET_ITEM(classes, (Py_ssize_t)i, path);
+            PyTuple_SetItem(classes, (Py_ssize_t)i, path); /* steals path */
     }
     return add_owned(module, "BLOCK_CLASSES", classes);
 }

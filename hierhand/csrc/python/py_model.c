@@ -43,7 +43,7 @@ static PyObject *model_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
     double dt = 0.0;
     if (!PyArg_ParseTupleAndKeywords(args, kwargs, "O|d:Model", keywords, &hand, &dt))
         return NULL;
-    ModelObject *self = (ModelObject *)type->tp_alloc(type, 0);
+    ModelObject *self = (ModelObject *)hh_py_alloc(type);
     if (self == NULL)
         return NULL;
     PyObject *problems = pack_hand(hand, dt, &self->model);
@@ -51,12 +51,12 @@ static PyObject *model_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
         Py_DECREF(self);
         return NULL;
     }
-    Py_ssize_t count = PyList_GET_SIZE(problems);
+    Py_ssize_t count = PyList_Size(problems);
     if (count != 0) {
-        PyObject *first = PyList_GET_ITEM(problems, 0);
-        int param = (int)PyLong_AsLong(PyTuple_GET_ITEM(first, 0));
+        PyObject *first = PyList_GetItem(problems, 0);
+        int param = (int)PyLong_AsLong(PyTuple_GetItem(first, 0));
         PyErr_Format(PyExc_ValueError, "invalid hand: %s %U (%zd problem%s; check_hand lists them)",
-                     hh_hand_param_name(param), PyTuple_GET_ITEM(first, 1), count, count == 1 ? "" : "s");
+                     hh_hand_param_name(param), PyTuple_GetItem(first, 1), count, count == 1 ? "" : "s");
         Py_DECREF(problems);
         Py_DECREF(self);
         return NULL;
@@ -72,7 +72,7 @@ static PyObject *model_new(PyTypeObject *type, PyObject *args, PyObject *kwargs)
 static void model_dealloc(ModelObject *self)
 {
     hh_work_free(&self->work);
-    Py_TYPE(self)->tp_free((PyObject *)self);
+    hh_py_free((PyObject *)self);
 }
 
 static PyObject *model_with_dt(ModelObject *self, PyObject *arg)
@@ -84,7 +84,7 @@ static PyObject *model_with_dt(ModelObject *self, PyObject *arg)
         PyErr_Format(PyExc_ValueError, "dt must be a positive finite number of seconds, got %g", dt);
         return NULL;
     }
-    ModelObject *copy = (ModelObject *)Py_TYPE(self)->tp_alloc(Py_TYPE(self), 0);
+    ModelObject *copy = (ModelObject *)hh_py_alloc(Py_TYPE((PyObject *)self));
     if (copy == NULL)
         return NULL;
     copy->model = self->model;
@@ -153,16 +153,21 @@ static PyGetSetDef model_getset[] = {
     {NULL, NULL, NULL, NULL, NULL},
 };
 
-PyTypeObject hh_py_model_type = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "hierhand._native.Model",
-    .tp_basicsize = sizeof(ModelObject),
-    .tp_dealloc = (destructor)model_dealloc,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Model(hand, dt=0): a hand vector (HH_HAND_PARAMS float64 values) checked and packed "
-              "for the plant's C core; raises ValueError for an invalid hand.",
-    .tp_methods = model_methods,
-    .tp_getset = model_getset,
-    .tp_new = model_new,
+static PyType_Slot model_slots[] = {
+    {Py_tp_dealloc, (void *)model_dealloc},
+    {Py_tp_doc, "Model(hand, dt=0): a hand vector (HH_HAND_PARAMS float64 values) checked and packed "
+                "for the plant's C core; raises ValueError for an invalid hand."},
+    {Py_tp_methods, model_methods},
+    {Py_tp_getset, model_getset},
+    {Py_tp_new, (void *)model_new},
+    {0, NULL},
+};
+
+PyType_Spec hh_py_model_spec = {
+    .name = "hierhand._native.Model",
+    .basicsize = sizeof(ModelObject),
+    .flags = Py_TPFLAGS_DEFAULT | Py_TPFLAGS_IMMUTABLETYPE,
+    .slots = model_slots,
 };
 
 /* -- module functions ------------------------------------------------------------------------ */
@@ -187,7 +192,7 @@ static PyObject *py_hand_parameters(PyObject *module, PyObject *unused)
             Py_DECREF(list);
             return NULL;
         }
-        PyList_SET_ITEM(list, i, item);
+        PyList_SetItem(list, i, item); /* steals item; cannot fail on a new list */
     }
     return list;
 }

@@ -1,9 +1,10 @@
 """Builds the test FMUs of ``sources/`` at test time, for the FMU block tests and the
 hostile-input corpus.
 
-The shared libraries are compiled with the system C compiler against fmpy's FMI headers;
-``build_error()`` says why that cannot be done here (no compiler, Windows, no headers), and
-the tests that need a library skip with that reason.
+The shared libraries are compiled with the system C compiler against the FMI headers
+that the repository carries (``blocks/csrc/fmi``); ``build_error()`` says why that cannot
+be done here (no compiler, Windows, no headers), and the tests that need a library skip
+with that reason.
 """
 
 from __future__ import annotations
@@ -19,8 +20,10 @@ from pathlib import Path
 
 import fmpy
 
+from blocks.engine.native_sources import FMI_HEADERS
+
 SOURCES = Path(__file__).parent / "sources"
-HEADERS = Path(fmpy.__file__).parent / "c-code"
+HEADERS = Path(__file__).resolve().parents[3] / FMI_HEADERS
 EXT = fmpy.sharedLibraryExtension
 
 
@@ -39,7 +42,7 @@ def build_error() -> str | None:
     if compiler() is None:
         return "no C compiler (cc, gcc or clang) on PATH to build the test FMUs"
     if not (HEADERS / "fmi2Functions.h").is_file() or not (HEADERS / "fmi3Functions.h").is_file():
-        return f"fmpy's FMI headers are missing (looked in {HEADERS})"
+        return f"the FMI headers are missing (looked in {HEADERS})"
     return None
 
 
