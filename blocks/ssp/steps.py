@@ -15,8 +15,9 @@ outputs at a communication point after setting that point's inputs (the FMU bloc
 ``feedthrough``), as the diagram it was exported from evaluates it; other tools step it
 as they do every FMU (libcosim: on the inputs of the previous communication point).
 OMSimulator refuses any ``ssd:Annotations`` inside an ``ssd:Component`` (the schema allows
-them), so the writer can put blocks' stepping on the system instead, one
-``<blocks:Stepping component="name" stepSize="..." feedthrough="..."/>`` per component
+them), so the writer can put blocks' stepping on the system instead: in a
+``<blocks:Components>`` (an annotation holds one element), one ``<blocks:Stepping
+component="name" stepSize="..." feedthrough="true"/>`` per component
 (``add_system_stepping``), which ``step_hint`` and ``feedthrough`` read as the component's own.
 """
 
@@ -84,8 +85,9 @@ def _system_stepping(component: Any) -> Any:
     if system is None:
         return None
     for content in annotations(system, BLOCKS_ANNOTATION):
-        if content.tag == q("blocks", "Stepping") and content.get("component") == component.get("name"):
-            return content
+        for stepping in children(content, "blocks", "Stepping") if content.tag == q("blocks", "Components") else ():
+            if stepping.get("component") == component.get("name"):
+                return stepping
     return None
 
 
@@ -115,7 +117,10 @@ def add_system_stepping(system: Any, name: str, period: Fraction, feedthrough_: 
     attributes = {"component": name, "stepSize": number(period)}
     if feedthrough_:
         attributes["feedthrough"] = "true"
-    _annotation(system, BLOCKS_ANNOTATION, reuse=True).append(_make("blocks", "Stepping", **attributes))
+    annotation = _annotation(system, BLOCKS_ANNOTATION, reuse=True)
+    if not len(annotation):
+        annotation.append(_make("blocks", "Components"))
+    annotation[0].append(_make("blocks", "Stepping", **attributes))
 
 
 def add_base_step(experiment: Any, step: Fraction) -> None:
