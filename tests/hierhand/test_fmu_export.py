@@ -110,6 +110,9 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
         assert name in params
     mass = next(v for v in md.modelVariables if v.name == "object.mass")
     assert float(mass.start) == 0.3 and mass.variability == "fixed"
+    declared = {v.name: v for v in md.modelVariables}
+    assert (mass.min, mass.max) == ("0.0", None)  # the hand file's check: > 0
+    assert declared["contact.mu_s"].min == "0.0" and declared["gravity[2]"].min is None  # >= 0; any number
     units = {v.name: v.unit for v in md.modelVariables}
     assert (units["tau[1]"], units["q[1]"], units["qd[1]"], units["fn[1]"], units["object.mass"]) == (
         "N m", "rad", "rad/s", "N", "kg")
@@ -118,6 +121,7 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
     assert (newton.kg, newton.m, newton.s) == (1, 1, -2)
     outputs = [v for v in md.modelVariables if v.causality == "output"]
     assert all(v.initial == "calculated" for v in outputs)
+    assert {v.variability for v in outputs} == {"continuous"}  # samples of the integrated plant
     assert all(u.dependencies == [] for u in md.outputs)  # no direct feedthrough
     # initial outputs depend on parameters only: an importer need not compute inputs first
     assert {u.variable.name for u in md.initialUnknowns} == {v.name for v in outputs}

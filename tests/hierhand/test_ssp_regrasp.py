@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy import read_model_description
+from fmpy.validation import validate_fmu
 
 import blocks
 from blocks.ssp import export_ssp
@@ -75,6 +76,13 @@ def test_the_regrasp_leaves_as_three_components_with_units_and_a_valid_ssd(regra
     assert '<ssc:Unit name="N m">' in ssd and 'kg="1" m="2" s="-2"' in ssd
     ctrl = read_model_description(str(unpacked / "resources" / "ctrl.fmu"))
     assert {"reflex.ki", "suppress.S_b[4]", "suppress.time_constant"} <= {v.name for v in ctrl.modelVariables if v.causality == "parameter"}
+    declared = {v.name: v for v in ctrl.modelVariables}
+    assert {v.variability for v in ctrl.modelVariables if v.causality == "output"} == {"discrete"}  # sampled torques
+    assert (declared["reflex.margin"].min, declared["reflex.margin"].max) == ("0.0", "1.0")  # the reflex's range
+    assert (declared["suppress.S_b[4]"].min, declared["suppress.S_b[4]"].max) == (None, None)  # any number
+    plant = read_model_description(str(unpacked / "resources" / "plant.fmu"))
+    assert {v.variability for v in plant.modelVariables if v.causality == "output"} == {"continuous"}
+    assert validate_fmu(str(unpacked / "resources" / "ctrl.fmu")) == []
 
 
 def test_the_regrasp_ssp_run_back_is_the_native_regrasp(regrasp_ssp, native_regrasp):
