@@ -172,9 +172,11 @@ def test_the_command_line_exports_and_refuses_with_exit_code_2(first_order, tmp_
     (tmp_path / "d.yaml").write_text((tmp_path / "d.yaml").read_text().replace(", a.y -> g.u", "")
                                      .replace("  g: {type: FMU, period: 100 ms, offset: 50 ms, params: {path: fo.fmu}}\n", ""))
     good = subprocess.run([sys.executable, "-m", "blocks", "ssp", "export", str(tmp_path / "d.yaml"), "-o", str(out),
-                           "--set", "a.x0=3"], capture_output=True, text=True, timeout=120)
+                           "--set", "a.x0=3", "--annotations", "none"], capture_output=True, text=True, timeout=120)
     assert good.returncode == 0, good.stderr
-    assert load_diagram(out).blocks["a"].params["start_values"] == {"x0": 3}
+    assert load_diagram(out, step="100 ms").blocks["a"].params["start_values"] == {"x0": 3}
+    with zipfile.ZipFile(out) as zf:
+        assert b"<ssd:Annotations" not in zf.read("SystemStructure.ssd")  # left out on request
 
 
 def test_a_subsystem_the_fmu_exporter_refuses_is_one_error_at_its_block(first_order, tmp_path):
