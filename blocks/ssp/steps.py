@@ -30,9 +30,9 @@ from typing import Any
 from .xml import BLOCKS_ANNOTATION, OMS_ANNOTATION, OSP_ANNOTATION, annotations, child, children, local, q
 
 ANNOTATIONS = {
-    "system": "each component's step and feedthrough as blocks:Stepping on the system (OMSimulator loads it)",
+    "system": "each component's step and feedthrough as blocks:Stepping on the system, where OMSimulator takes them",
     "components": "libcosim's osp:StepSizeHint and blocks:Stepping in each component (OMSimulator refuses them)",
-    "none": "no tool-specific annotations (every tool steps every component at the SSD's base step)",
+    "none": "no tool-specific annotations (every tool steps every component at the step it is given)",
 }
 """Where the tool-specific annotations go (``export_ssp``'s ``annotations``)."""
 
