@@ -16,8 +16,10 @@ plain shared libraries that an FMU export copies into FMUs, so exporting needs n
 compiler: ``blocks/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the op-table core, the
 library's kernels and an FMI wrapper: any diagram of library blocks) and
 ``hierhand/fmu_binaries/fmi2.so`` and ``fmi3.so`` (the same with the hand's kernels). They
-link libc and libm only; their FMI headers are the standard's, carried in ``blocks/csrc/fmi``
-(BSD-2-Clause, see LICENSE). The file lists are ``blocks/engine/native_sources.py``
+link libc and libm only, with no RUNPATH and the maths symbols at the oldest glibc
+versions (``blocks/csrc/glibc_compat.h``: portable across Linux distributions); their FMI
+headers are the standard's, carried in ``blocks/csrc/fmi`` (BSD-2-Clause, see LICENSE). The
+file lists are ``blocks/engine/native_sources.py``
 and ``hierhand/native_sources.py``, which the exporter reads for an FMU's ``sources/``.
 
 An editable install builds in fresh temporary folders, where distutils' up-to-date check
@@ -127,11 +129,19 @@ class BuildNative(build_ext):
             output_dir=os.path.join(self.build_temp, package, f"fmi{fmi}"),
             include_dirs=[framework.FMI_HEADERS, framework.CSRC, hand.CSRC],
             depends=[f for f in files if f.endswith(".h")],
-            extra_postargs=framework.CFLAGS + ["-std=c99", "-g0"],  # no debug info in what FMUs carry
+            # no debug info in what FMUs carry; the maths bound to the oldest glibc that has it
+            extra_postargs=framework.CFLAGS + ["-std=c99", "-g0", "-include", str(ROOT / framework.CSRC / "glibc_compat.h")],
         )
-        for target in targets:
-            target.parent.mkdir(parents=True, exist_ok=True)
-            self.compiler.link_shared_object(objects, str(target), libraries=["m"], extra_postargs=["-s"])
+        linker = self.compiler.linker_so
+        # no RUNPATH: Python's link flags name its own library folder, which an FMU neither
+        # needs (it links libc and libm only) nor should carry to another machine
+        self.compiler.linker_so = [a for a in linker if not a.startswith(("-Wl,-rpath", "-Wl,-R"))]
+        try:
+            for target in targets:
+                target.parent.mkdir(parents=True, exist_ok=True)
+                self.compiler.link_shared_object(objects, str(target), libraries=["m"], extra_postargs=["-s"])
+        finally:
+            self.compiler.linker_so = linker
 
     def get_outputs(self) -> list[str]:
         outputs = super().get_outputs()

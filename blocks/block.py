@@ -127,6 +127,10 @@ class Block:
     """Parameters whose diagram value is the name of another block of the diagram; the
     constructor receives that block (built and bound before this one)."""
     time_varying: ClassVar[bool] = False
+    samples_continuous_time: ClassVar[bool] = False
+    """The block's outputs are samples of a continuous-time model (a plant integrated at
+    its period), not values held between hits (a controller's): an exported FMU declares
+    them ``continuous``, the others ``discrete``."""
     name: str | None = None
     """The block's name in its diagram, set by the loader once the block is built (None
     for a block made from Python); for messages of blocks that refer to it."""

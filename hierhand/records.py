@@ -56,9 +56,10 @@ def hand_tunables(at: int) -> tuple[Tunable, ...]:
     """The hand's numbers as tunables, named as the C core names them, for a segment at
     ``at``: their hand-file description and its unit."""
     out = []
-    for i, (name, doc) in enumerate(_native.hand_parameters()):
+    for i, (name, doc, at_least_zero) in enumerate(_native.hand_parameters()):
         unit = _UNIT.search(doc)
-        out.append(Tunable(name, at + SEGMENT.HAND + i, doc, unit.group(1) if unit else "1"))
+        out.append(Tunable(name, at + SEGMENT.HAND + i, doc, unit.group(1) if unit else "1",
+                           minimum=0.0 if at_least_zero else None))
     return tuple(out)
 
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..ssp.steps import ANNOTATIONS
 from .options import load, parse_overrides, trust_arg
 from .program import EXIT_OK
 
@@ -23,6 +24,9 @@ def add(sub, program) -> argparse.ArgumentParser:
     export.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
                         help="override a parameter before exporting (repeatable)")
     export.add_argument("--step", metavar="T", help="SSP input only: the step of components that give none")
+    export.add_argument("--annotations", choices=sorted(ANNOTATIONS), default="system",
+                        help="where the tool-specific annotations go: "
+                             + "; ".join(f"{k}: {v}" for k, v in ANNOTATIONS.items()) + " (default: system)")
     trust_arg(export)
     export.set_defaults(handler=cmd_ssp_export)
     return ssp
@@ -33,6 +37,6 @@ def cmd_ssp_export(args: argparse.Namespace) -> int:
     from blocks.ssp import export_ssp
 
     parse_overrides(args.overrides)
-    written = export_ssp(load(args), args.output)
+    written = export_ssp(load(args), args.output, annotations=args.annotations)
     print(f"wrote {written}")
     return EXIT_OK

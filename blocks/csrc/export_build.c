@@ -30,6 +30,7 @@ void ex_release_build(blk_instance *inst)
     free(b->states);
     free(b->state_sizes);
     free(b->arena);
+    free(b->held_outputs);
     free(b);
     inst->build = NULL;
     inst->outputs_fresh = 0;
@@ -140,8 +141,9 @@ int ex_build_kernels(blk_instance *inst)
     b->states = calloc(n, sizeof *b->states);
     b->state_sizes = calloc(n, sizeof *b->state_sizes);
     b->arena = malloc((size_t)(x->table.header[BLK_H_ARENA] + 1) * sizeof(double));
+    b->held_outputs = calloc((size_t)x->n_outputs + 1, sizeof *b->held_outputs);
     int written = b->records == NULL || b->built == NULL || b->kernels == NULL || b->states == NULL ||
-                          b->state_sizes == NULL || b->arena == NULL
+                          b->state_sizes == NULL || b->arena == NULL || b->held_outputs == NULL
                       ? -1
                       : write_records(inst, b);
     if (written != 0) {

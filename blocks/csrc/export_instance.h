@@ -9,13 +9,14 @@
  * resources (BLK_EXPORT_RESOURCE, written by blocks/fmu_export), so one binary serves
  * every diagram whose kernel types it holds.
  *
- * Time. The internal step is the diagram's base tick; a communication step must be a
- * whole number of grid ticks (the base tick, or the period of the blocks the table
- * advances in one call, whose hits every communication point must be), counted in
- * integers from t = 0, so time never drifts. The FMU's outputs at a communication point
- * are the diagram's outputs there, computed from the inputs set there (an output the
- * inputs feed through blocks with feedthrough changes when they are set); a step runs the
- * updates of that point and every tick up to the next one.
+ * Time. The internal step is the diagram's base tick; the grid is the base tick, or the
+ * period of the blocks the table advances in one call, counted in integers from t = 0 so
+ * time never drifts. A communication step may be any length (importers such as
+ * OMSimulator step every FMU at the smallest step of all): it runs every grid point up to
+ * its end with the inputs set at its start. The FMU's outputs at a communication point on
+ * the grid are the diagram's outputs there, computed from the inputs set there (an output
+ * the inputs feed through blocks with feedthrough changes when they are set); between grid
+ * points they hold the last grid point's, as the diagram's samples hold between hits.
  *
  * Variables, by value reference: 0 the time (FMI 3's independent variable), then the
  * inputs, the outputs and the parameters, each a range that starts where the resources
@@ -117,7 +118,7 @@ blk_status blk_instance_enter_initialization(blk_instance *inst);
 blk_status blk_instance_exit_initialization(blk_instance *inst);
 blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n, double *values);
 blk_status blk_instance_set(blk_instance *inst, const unsigned int *vr, size_t n, const double *values);
-/* A step; *terminated: the diagram ended (a block asked to end the run), at time
+/* A step of any length; *terminated: the diagram ended (a block asked to end the run), at time
    blk_instance_time, which a step then no longer passes. */
 blk_status blk_instance_do_step(blk_instance *inst, double current_time, double step, int *terminated);
 double blk_instance_time(const blk_instance *inst);

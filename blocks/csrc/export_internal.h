@@ -82,6 +82,13 @@ typedef struct {
     int64_t *state_sizes;
     double *arena;
     blk_run run;
+    /* Between grid points (a communication step that ended off the grid): the outputs of
+       held_tick, the last grid point passed, held until the next one; the run is past
+       held_tick's ops and the instance's time is held_time. */
+    int held;
+    int64_t held_tick;
+    double held_time;
+    double *held_outputs;
 } ex_build;
 
 struct blk_instance {
@@ -131,7 +138,7 @@ void ex_free_export(blk_export *x);
 /* -- export_step.c ----------------------------------------------------------------------- */
 
 /* The outputs at the run's tick from the inputs now: 0; -1 after logging the failure (the
-   instance then failed); 1 in initialization mode, where a failure is a warning. */
+   instance then failed); 1 in initialization mode, where a failure waits for the inputs. */
 int ex_refresh_outputs(blk_instance *inst);
 
 /* -- export_build.c ---------------------------------------------------------------------- */

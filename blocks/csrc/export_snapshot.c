@@ -6,15 +6,15 @@
 
 #include "export_internal.h"
 
-#define SNAPSHOT_MAGIC "BLKXST01"
+#define SNAPSHOT_MAGIC "BLKXST02"
 
 /* A snapshot: this header, then the parameters, their set flags (as doubles), the inputs,
-   and when built the arena, the state sizes (as doubles) and the states. */
+   and when built the arena, the state sizes (as doubles), the states and the held outputs. */
 struct blk_snapshot {
     char magic[8];
     int64_t words; /* the doubles after the header */
-    int64_t phase, built, fresh, stop_defined, stop_tick, outcome_status, end_op, end_asked;
-    double stop_time;
+    int64_t phase, built, fresh, stop_defined, stop_tick, outcome_status, end_op, end_asked, held, held_tick;
+    double stop_time, held_time;
     blk_position at;
     double values[];
 };
@@ -24,7 +24,7 @@ static int64_t snapshot_words(const blk_instance *inst)
     const blk_export *x = &inst->x;
     int64_t n = 2 * x->n_params + x->n_inputs;
     if (inst->build != NULL) {
-        n += x->table.header[BLK_H_ARENA] + x->n_blocks;
+        n += x->table.header[BLK_H_ARENA] + x->n_blocks + x->n_outputs;
         for (int64_t k = 0; k < x->n_blocks; k++)
             n += inst->build->state_sizes[k] > 0 ? inst->build->state_sizes[k] : 0;
     }
@@ -74,6 +74,9 @@ blk_status blk_instance_get_state(blk_instance *inst, blk_snapshot **snapshot)
         s->outcome_status = b->run.outcome.status;
         s->end_op = b->run.outcome.end_op;
         s->end_asked = b->run.outcome.end_asked;
+        s->held = b->held;
+        s->held_tick = b->held_tick;
+        s->held_time = b->held_time;
         memcpy(v, b->arena, (size_t)x->table.header[BLK_H_ARENA] * sizeof(double));
         v += x->table.header[BLK_H_ARENA];
         for (int64_t k = 0; k < x->n_blocks; k++)
@@ -83,6 +86,7 @@ blk_status blk_instance_get_state(blk_instance *inst, blk_snapshot **snapshot)
                 memcpy(v, b->states[k], (size_t)b->state_sizes[k] * sizeof(double));
                 v += b->state_sizes[k];
             }
+        memcpy(v, b->held_outputs, (size_t)x->n_outputs * sizeof(double));
     }
     *snapshot = s;
     return BLK_STATUS_OK;
@@ -123,6 +127,10 @@ blk_status blk_instance_set_state(blk_instance *inst, const blk_snapshot *s)
                 memcpy(b->states[k], v, (size_t)b->state_sizes[k] * sizeof(double));
                 v += b->state_sizes[k];
             }
+        memcpy(b->held_outputs, v, (size_t)x->n_outputs * sizeof(double));
+        b->held = (int)s->held;
+        b->held_tick = s->held_tick;
+        b->held_time = s->held_time;
         b->run.at = s->at;
         b->run.outcome.status = (int)s->outcome_status;
         b->run.outcome.end_op = s->end_op;

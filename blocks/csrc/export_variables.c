@@ -1,6 +1,7 @@
 /* The variables of an exported FMU's instance by value reference: 0 the time, then the
  * inputs, the outputs and the parameters, each a range that starts where the resources say
- * (export_instance.h). Reading an output computes the outputs first when an input changed;
+ * (export_instance.h). Reading an output computes the outputs first when an input changed
+ * (between grid points the outputs hold: export_step.c);
  * setting a parameter releases the kernels, which are built again with it. */
 
 #include "export_internal.h"
@@ -23,11 +24,11 @@ blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n
             LOG_ERROR(inst, "output %u is calculated: read it after entering initialization mode", vr[i]);
             return BLK_STATUS_ERROR;
         }
-        int refreshed = ex_build_kernels(inst) != 0 ? -1 : inst->outputs_fresh ? 0 : ex_refresh_outputs(inst);
+        int refreshed = ex_build_kernels(inst) != 0                         ? -1
+                        : inst->outputs_fresh || inst->build->held ? 0
+                                                                    : ex_refresh_outputs(inst);
         if (refreshed < 0)
             return BLK_STATUS_ERROR;
-        if (refreshed > 0)
-            status = BLK_STATUS_WARNING;
         break;
     }
     for (size_t i = 0; i < n; i++) {
@@ -37,7 +38,8 @@ blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n
         else if (in_range(r, x->vr_input, x->n_inputs))
             values[i] = inst->inputs[r - x->vr_input];
         else if (in_range(r, x->vr_output, x->n_outputs))
-            values[i] = inst->build->arena[x->outputs[r - x->vr_output]];
+            values[i] = inst->build->held ? inst->build->held_outputs[r - x->vr_output]
+                                          : inst->build->arena[x->outputs[r - x->vr_output]];
         else if (in_range(r, x->vr_param, x->n_params))
             values[i] = inst->params[r - x->vr_param];
         else {

@@ -66,6 +66,11 @@ class Tunable:
     finite: bool = False
     """The value must be finite, the block's one check of it (the kind's constructor
     checks the others)."""
+    minimum: float | None = None
+    maximum: float | None = None
+    """The closed range the kind's constructor holds the value to (a bound of a range
+    open at that end, ``> 0``, is given as the closed one, 0: FMI's ``min``/``max`` are
+    inclusive); None: unbounded that side."""
 
 
 @dataclass(frozen=True)

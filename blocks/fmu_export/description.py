@@ -1,12 +1,14 @@
 """modelDescription.xml and sources/buildDescription.xml of an exported diagram FMU.
 
 Co-simulation only, FMI 2.0 or 3.0, every variable a Float64 (FMI 2 Real) scalar:
-inputs (continuous, a start value), outputs (``initial="calculated"``), parameters
-(``variability="fixed"``, settable until initialization ends). Units are declared once in
+inputs (continuous, a start value), outputs (``initial="calculated"``; ``discrete`` where
+a sampled block holds them between its hits), parameters (``variability="fixed"``,
+settable until initialization ends; ``min``/``max`` where the block holds them to a range). Units are declared once in
 ``UnitDefinitions`` (with their SI base units where pint reads the unit: ``blocks.units``)
 and named by every variable that has one. The step rules say what the binary does: the
 internal step is the communication grid (``fixedInternalStepSize``, FMI 2: in a vendor
-annotation), any whole multiple of it is taken (``canHandleVariableCommunicationStepSize``),
+annotation), any communication step is taken (``canHandleVariableCommunicationStepSize``;
+between grid points the outputs hold),
 FMU states can be got, set and serialized.
 """
 
@@ -79,7 +81,7 @@ def _model_variables(parent: ET.Element, fmi: int, everything: list[Variable]) -
         if v.causality == "parameter":
             attrs.update(variability="fixed", initial="exact")
         elif v.causality == "output":
-            attrs.update(variability="continuous", initial="calculated")
+            attrs.update(variability="discrete" if v.discrete else "continuous", initial="calculated")
         else:
             attrs.update(variability="continuous")
         typed = {}
@@ -87,6 +89,10 @@ def _model_variables(parent: ET.Element, fmi: int, everything: list[Variable]) -
             typed["unit"] = v.unit
         if v.start is not None:
             typed["start"] = repr(v.start)
+        if v.minimum is not None:
+            typed["min"] = repr(v.minimum)
+        if v.maximum is not None:
+            typed["max"] = repr(v.maximum)
         if fmi == 2:
             ET.SubElement(ET.SubElement(parent, "ScalarVariable", **attrs), "Real", **typed)
         else:

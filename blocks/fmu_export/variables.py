@@ -44,7 +44,13 @@ class Variable:
     block: int = -1
     slot: int = -1
     finite: bool = False
-    """Parameter: its block and record slot, and whether the FMU checks that it is finite."""
+    minimum: float | None = None
+    maximum: float | None = None
+    """Parameter: its block and record slot, whether the FMU checks that it is finite,
+    and the range its block holds it to (``Tunable``)."""
+    discrete: bool = False
+    """Output: it changes only at its block's hits (a sampled block's, such as a
+    controller's torques), held in between (variability ``discrete``)."""
     depends: tuple[int, ...] = ()
     initial_depends: tuple[int, ...] = ()
     """Output: the input variables (their positions among the inputs) it depends on, at a
@@ -129,7 +135,7 @@ def fmu_variables(plan: Plan) -> Variables:
         for i in range(width):
             v.outputs.append(Variable(
                 _element(name, i, width), 0, "output", _describe(f"output {signal}", labels, i, ()),
-                _unit(units, i), offsets=(base + i,),
+                _unit(units, i), offsets=(base + i,), discrete=_sampled(d, block, input_of, set()),
                 depends=tuple(j for k in sorted(depends) for j in input_vars[k]),
                 initial_depends=tuple(j for k in sorted(initial) for j in input_vars[k])))
     v.outputs = [Variable(**{**o.__dict__, "vr": v.vr_output + i}) for i, o in enumerate(v.outputs)]
@@ -150,7 +156,7 @@ def _parameters(plan: Plan, v: Variables, index: dict[str, int]) -> None:
             v.parameters.append(Variable(name, v.vr_param + len(v.parameters), "parameter",
                                          tunable.description or f"parameter {tunable.name} of block '{eb.name}'",
                                          tunable.unit, float(rec.values[tunable.slot]), block=b, slot=tunable.slot,
-                                         finite=tunable.finite))
+                                         finite=tunable.finite, minimum=tunable.minimum, maximum=tunable.maximum))
         for rule in rec.follows:
             when = tuple(mine[n] for n in rule.when_set if n in mine)
             if when:
@@ -161,6 +167,22 @@ def _parameters(plan: Plan, v: Variables, index: dict[str, int]) -> None:
                 v.links.append(LinkRule(b, link.slot, source, link.source_slot, link.length))
     if len({p.name for p in v.parameters}) != len(v.parameters):
         raise DiagramError([d.issue(None, "two tunable parameters of the exported diagram have the same name")])
+
+
+def _sampled(d: Diagram, block: str, input_of: dict[tuple[str, str], int], seen: set[str]) -> bool:
+    """Whether ``block``'s outputs change only at the hits of sampled blocks: it is no
+    sampled continuous-time model (``Block.samples_continuous_time``) and has a period of
+    its own, or inherits one from blocks that are sampled alone (not from the diagram's
+    inputs, which may change at every communication step)."""
+    spec = d.blocks[block]
+    if spec.block.samples_continuous_time:
+        return False
+    if spec.period is not None or block in seen:
+        return True
+    seen.add(block)
+    if any((block, port) in input_of for port in spec.block.inputs):
+        return False
+    return all(_sampled(d, c.src_block, input_of, seen) for c in d.connections if c.dst_block == block)
 
 
 def _first_variables(d: Diagram, inputs: list[Variable]) -> list[list[int]]:

@@ -6,12 +6,15 @@ own (``components``, exported by ``blocks.fmu_export``), stepped at the largest 
 of its internal step that its partners' steps allow. Its connectors are the FMU's input
 and output variables (element by element for a vector port, typed and with units as the
 FMU declares them; ``ssd:Units`` from the FMUs' definitions), its start values an inline
-``ssd:ParameterBindings``, its step a libcosim ``osp:StepSizeHint``, and an FMU whose
-outputs feed through a ``blocks:Stepping`` annotation (``steps``). The top level's
-connections become ``ssd:Connection``s between those variables. The end time is the
-``ssd:DefaultExperiment`` stopTime, whose libcosim ``osp:FixedStepAlgorithm``
-baseStepSize and the system's OMSimulator ``FixedStepMaster`` stepSize are the greatest
-common divisor of the components' steps. What cannot become a component (a block or
+``ssd:ParameterBindings``. The top level's connections become ``ssd:Connection``s between
+those variables. The end time is the ``ssd:DefaultExperiment`` stopTime, whose libcosim
+``osp:FixedStepAlgorithm`` baseStepSize and the system's OMSimulator ``FixedStepMaster``
+stepSize are the greatest common divisor of the components' steps (every exported FMU
+takes any step, holding its outputs between its hits). Where each component's own step
+and feedthrough go is ``annotations`` (``ANNOTATIONS``): by default on the system, as
+``blocks:Stepping`` entries (OMSimulator refuses annotations inside a component);
+``components``: a libcosim ``osp:StepSizeHint`` and a ``blocks:Stepping`` in each component;
+``none``: no tool annotations at all. What cannot become a component (a block or
 subsystem the FMU exporter refuses, a block whose inherited hits are uneven, a delayed
 connection, an offset, a port type SSP 1.0 has no connector type for) is one error
 naming it. The SSD validates against the SSP schemas (the tests check it).
@@ -36,7 +39,8 @@ from blocks.builder.diagram import Diagram
 from ..issues import DiagramError, Issue
 from ..timebase import format_duration
 from .names import SSD_NAME
-from .steps import add_base_step, add_feedthrough, add_step_hint, add_system_step, number
+from .steps import (ANNOTATIONS, add_base_step, add_feedthrough, add_step_hint, add_system_step, add_system_stepping,
+                    number)
 from .units import add_units, unit_definitions
 from .xml import PREFIXES, q
 
@@ -49,9 +53,12 @@ VALUE_TYPES = {"Real": "Real", "Float64": "Real", "Float32": "Real", "Integer": 
 """SSV 1.0 value types of the FMU variable types of start values."""
 
 
-def export_ssp(diagram: Diagram, out: str | Path) -> Path:
-    """Write ``diagram`` as the SSP archive ``out`` (a ``.ssp`` file); DiagramError naming
-    each block or connection that SSP cannot carry."""
+def export_ssp(diagram: Diagram, out: str | Path, annotations: str = "system") -> Path:
+    """Write ``diagram`` as the SSP archive ``out`` (a ``.ssp`` file), its tool-specific
+    annotations placed as ``annotations`` says (a key of ``ANNOTATIONS``); DiagramError
+    naming each block or connection that SSP cannot carry."""
+    if annotations not in ANNOTATIONS:
+        raise ValueError(f"annotations must be one of {', '.join(ANNOTATIONS)}, got {annotations!r}")
     with tempfile.TemporaryDirectory(prefix="blocks-ssp-") as scratch:
         problems: list[Issue] = []
         components = _components(diagram, Path(scratch), problems)
@@ -59,7 +66,7 @@ def export_ssp(diagram: Diagram, out: str | Path) -> Path:
         if problems:
             raise DiagramError(problems)
         files: dict[str, bytes] = {}
-        ssd = _description(diagram, components, wires, files)
+        ssd = _description(diagram, components, wires, files, annotations)
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as zf:
         zf.writestr(SSD_NAME, ssd)
@@ -71,7 +78,7 @@ def export_ssp(diagram: Diagram, out: str | Path) -> Path:
 
 
 def _description(diagram: Diagram, components: dict[str, "Component"], wires: list[tuple],
-                 files: dict[str, bytes]) -> bytes:
+                 files: dict[str, bytes], annotations: str) -> bytes:
     """The SSD's text; ``files`` gets the FMUs it names, by member name."""
     from lxml import etree
 
@@ -89,7 +96,7 @@ def _description(diagram: Diagram, components: dict[str, "Component"], wires: li
         path = str(component.block.path)
         files.setdefault(_resource(path, names, component.name if component.exported else None),
                          Path(path).read_bytes())
-        _component(holder, component, names[path], units)
+        _component(holder, component, names[path], units, annotations == "components")
     if wires:
         connections = etree.SubElement(system, q("ssd", "Connections"))
         for src, dst in wires:
@@ -99,14 +106,19 @@ def _description(diagram: Diagram, components: dict[str, "Component"], wires: li
             c.set("endElement", dst[0])
             c.set("endConnector", dst[1])
     base = _gcd([c.period for c in components.values()])
-    add_system_step(system, base)
+    if annotations != "none":
+        add_system_step(system, base)  # first: OMSimulator reads a system's first annotation only
+    if annotations == "system":
+        for component in components.values():
+            add_system_stepping(system, component.name, component.period, component.feedthrough)
     if units:
         add_units(root, units)
     experiment = etree.SubElement(root, q("ssd", "DefaultExperiment"))
     experiment.set("startTime", "0")
     if diagram.t_end is not None:
         experiment.set("stopTime", number(diagram.t_end))
-    add_base_step(experiment, base)
+    if annotations != "none":
+        add_base_step(experiment, base)
     return etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
 
 
@@ -250,8 +262,10 @@ def _connections(diagram: Diagram, components: dict[str, Component], problems: l
     return wires
 
 
-def _component(holder: Any, component: Component, resource: str, units: dict[str, dict[str, float]]) -> None:
-    """The component's ``ssd:Component``; ``units`` gets the definitions of its connectors' units."""
+def _component(holder: Any, component: Component, resource: str, units: dict[str, dict[str, float]],
+               annotated: bool) -> None:
+    """The component's ``ssd:Component`` (``annotated``: with its step and feedthrough
+    annotations); ``units`` gets the definitions of its connectors' units."""
     from lxml import etree
 
     block, name = component.block, component.name
@@ -289,9 +303,10 @@ def _component(holder: Any, component: Component, resource: str, units: dict[str
             parameter.set("name", variable)
             typed = etree.SubElement(parameter, q("ssv", VALUE_TYPES.get(kind, "String")))
             typed.set("value", _text(given[0]))
-    add_step_hint(element, component.period)
-    if component.feedthrough:
-        add_feedthrough(element)
+    if annotated:
+        add_step_hint(element, component.period)
+        if component.feedthrough:
+            add_feedthrough(element)
 
 
 def _text(value: Any) -> str:

@@ -233,17 +233,19 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                              inputs.get("share", WHOLE_SHARE))
 
 
-_TUNABLES = tuple(Tunable(name, REFLEX_RECORD.GIVEN + slot, text, unit) for name, slot, text, unit in (
-    ("ki", GIVEN.KI, "integral gain of the fingertip force loop", "1/s"),
-    ("safety_ratio", GIVEN.SAFETY_RATIO, "largest |f_t|/f_n the reflex allows", "1"),
-    ("margin", GIVEN.MARGIN, "the loop aims at safety_ratio / (1 + margin)", "1"),
-    ("min_force", GIVEN.MIN_FORCE, "smallest normal force per contact", "N"),
-    ("max_force", GIVEN.MAX_FORCE, "largest commanded force per fingertip", "N"),
-    ("approach_force", GIVEN.APPROACH, "force pushing a 'grasp' finger towards the others", "N"),
-    ("contact_threshold", GIVEN.THRESHOLD, "normal force above which a finger counts as in contact", "N"),
-    ("release_share", GIVEN.RELEASE_SHARE, "share at which a third touching finger is wholly handed over", "1"),
-    ("hold_share", GIVEN.HOLD_SHARE, "share down to which a third touching finger is held whole", "1")))
-"""GraspReflex's parameters an exported FMU lets an importer set."""
+_TUNABLES = tuple(Tunable(name, REFLEX_RECORD.GIVEN + slot, text, unit, minimum=0.0, maximum=top)
+                  for name, slot, text, unit, top in (
+    ("ki", GIVEN.KI, "integral gain of the fingertip force loop", "1/s", None),
+    ("safety_ratio", GIVEN.SAFETY_RATIO, "largest |f_t|/f_n the reflex allows", "1", None),
+    ("margin", GIVEN.MARGIN, "the loop aims at safety_ratio / (1 + margin)", "1", 1.0),
+    ("min_force", GIVEN.MIN_FORCE, "smallest normal force per contact", "N", None),
+    ("max_force", GIVEN.MAX_FORCE, "largest commanded force per fingertip", "N", None),
+    ("approach_force", GIVEN.APPROACH, "force pushing a 'grasp' finger towards the others", "N", None),
+    ("contact_threshold", GIVEN.THRESHOLD, "normal force above which a finger counts as in contact", "N", None),
+    ("release_share", GIVEN.RELEASE_SHARE, "share at which a third touching finger is wholly handed over", "1", 1.0),
+    ("hold_share", GIVEN.HOLD_SHARE, "share down to which a third touching finger is held whole", "1", 1.0)))
+"""GraspReflex's parameters an exported FMU lets an importer set, with the ranges its
+constructor (``hh_reflex_pack``) holds them to."""
 
 
 def _kernel_error(code: int, which: int, t: float, phase: str) -> BaseException:

@@ -95,5 +95,5 @@ class JointLowPass(Block):
         compiled.native().call(phase, getattr(kernel, phase), kernel.context, float(t), state, [u], out)
 
 
-_TUNABLES = (Tunable("time_constant", RECORD.TIME_CONSTANT, "time constant of the filter (> 0)", "s"),)
+_TUNABLES = (Tunable("time_constant", RECORD.TIME_CONSTANT, "time constant of the filter (> 0)", "s", minimum=0.0),)
 """JointLowPass's parameter an exported FMU lets an importer set."""

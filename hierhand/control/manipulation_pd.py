@@ -231,8 +231,10 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
 
 _GIVEN_AT = MANIP_RECORD.GIVEN
 _TUNABLES = (
-    *(Tunable(f"kp[{j + 1}]", _GIVEN_AT + GIVEN.KP + j, f"joint {j + 1} stiffness", "N m/rad") for j in range(9)),
-    *(Tunable(f"kd[{j + 1}]", _GIVEN_AT + GIVEN.KD + j, f"joint {j + 1} damping", "N m s/rad") for j in range(9)),
+    *(Tunable(f"kp[{j + 1}]", _GIVEN_AT + GIVEN.KP + j, f"joint {j + 1} stiffness", "N m/rad", minimum=0.0)
+      for j in range(9)),
+    *(Tunable(f"kd[{j + 1}]", _GIVEN_AT + GIVEN.KD + j, f"joint {j + 1} damping", "N m s/rad", minimum=0.0)
+      for j in range(9)),
     Tunable("contact_threshold", _GIVEN_AT + GIVEN.THRESHOLD, "normal force above which a finger carries the object",
             "N"),
 )

@@ -149,12 +149,12 @@ class Suppresser(DescribesHandPorts, Block):
 
 _GIVEN_AT = SUPPRESS_RECORD.GIVEN
 _TUNABLES = (
-    *(Tunable(f"S_a[{j + 1}]", _GIVEN_AT + GIVEN.S_A + j, f"joint {j + 1} sigmoid steepness", "1/(N m)")
-      for j in range(9)),
+    *(Tunable(f"S_a[{j + 1}]", _GIVEN_AT + GIVEN.S_A + j, f"joint {j + 1} sigmoid steepness", "1/(N m)",
+              minimum=0.0) for j in range(9)),
     *(Tunable(f"S_b[{j + 1}]", _GIVEN_AT + GIVEN.S_B + j, f"joint {j + 1} manipulation torque halving the grasping "
               "torque", "N m") for j in range(9)),
     Tunable("time_constant", _GIVEN_AT + GIVEN.TIME_CONSTANT, "time constant of the low-pass before the sigmoid (> 0)",
-            "s"),
+            "s", minimum=0.0),
 )
 """Suppresser's parameters an exported FMU lets an importer set (time_constant only when
 it filters: 0 would change the block's state and feedthrough)."""

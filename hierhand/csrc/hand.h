@@ -50,6 +50,7 @@ typedef void (*hh_report_fn)(void *context, int param, const char *text);
 /* -- the hand vector ------------------------------------------------------------------- */
 const char *hh_hand_param_name(int param); /* NULL outside 0 .. HH_HAND_PARAMS-1 */
 const char *hh_hand_param_doc(int param); /* what the number is, with its unit */
+int hh_hand_param_at_least_zero(int param); /* 1: the number must be >= 0 (or > 0) */
 /* Check and pack a hand; returns the number of problems (0: ``m`` is ready). */
 int hh_model_from_hand(hh_model *m, const double *hand, double dt, hh_report_fn report, void *context);
 /* The moment of inertia of a uniform plate of mass ``mass`` and sides a, b about its

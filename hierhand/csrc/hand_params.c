@@ -75,6 +75,11 @@ const char *hh_hand_param_doc(int param)
     return param >= 0 && param < HH_HAND_PARAMS ? PARAMS[param].doc : NULL;
 }
 
+int hh_hand_param_at_least_zero(int param)
+{
+    return param >= 0 && param < HH_HAND_PARAMS && PARAMS[param].check != ANY;
+}
+
 static void report_problem(hh_report_fn report, void *context, int param, const char *text)
 {
     if (report != NULL)

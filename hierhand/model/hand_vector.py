@@ -22,13 +22,13 @@ from .. import _native
 @functools.cache
 def parameter_names() -> tuple[str, ...]:
     """The C core's names of the hand vector's entries, in order."""
-    return tuple(name for name, _ in _native.hand_parameters())
+    return tuple(name for name, *_ in _native.hand_parameters())
 
 
 @functools.cache
 def parameter_docs() -> tuple[str, ...]:
     """What each entry of the hand vector is, with its unit."""
-    return tuple(doc for _, doc in _native.hand_parameters())
+    return tuple(doc for _, doc, _ in _native.hand_parameters())
 
 
 _INDEX = re.compile(r"\[(\d+)\]")

@@ -100,6 +100,8 @@ class HandPlant(DescribesHandPorts, Block):
         k_n, c_n, k_t, c_t, mu_s, mu_d (keys not given keep the default)
     """
 
+    samples_continuous_time = True
+
     type_name = "HandPlant"
     feedthrough = False
 

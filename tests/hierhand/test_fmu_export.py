@@ -110,6 +110,9 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
         assert name in params
     mass = next(v for v in md.modelVariables if v.name == "object.mass")
     assert float(mass.start) == 0.3 and mass.variability == "fixed"
+    declared = {v.name: v for v in md.modelVariables}
+    assert (mass.min, mass.max) == ("0.0", None)  # the hand file's check: > 0
+    assert declared["contact.mu_s"].min == "0.0" and declared["gravity[2]"].min is None  # >= 0; any number
     units = {v.name: v.unit for v in md.modelVariables}
     assert (units["tau[1]"], units["q[1]"], units["qd[1]"], units["fn[1]"], units["object.mass"]) == (
         "N m", "rad", "rad/s", "N", "kg")
@@ -118,6 +121,7 @@ def test_fmu_is_valid_and_declares_the_plant(fmus, fmi):
     assert (newton.kg, newton.m, newton.s) == (1, 1, -2)
     outputs = [v for v in md.modelVariables if v.causality == "output"]
     assert all(v.initial == "calculated" for v in outputs)
+    assert {v.variability for v in outputs} == {"continuous"}  # samples of the integrated plant
     assert all(u.dependencies == [] for u in md.outputs)  # no direct feedthrough
     # initial outputs depend on parameters only: an importer need not compute inputs first
     assert {u.variable.name for u in md.initialUnknowns} == {v.name for v in outputs}
@@ -247,40 +251,30 @@ def test_long_communication_steps_land_where_short_ones_do(fmus, fmi, tmp_path):
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
-def test_communication_step_must_be_a_multiple_of_the_internal_step(fmus, fmi, tmp_path):
+def test_a_step_off_the_internal_step_holds_the_last_internal_steps_outputs(fmus, fmi, tmp_path):
+    """The export declares its internal step (fixedInternalStepSize, informative), and takes
+    any communication step: 0.15 ms steps land on the plant's 0.1 ms samples at or before
+    each communication point (OMSimulator steps every FMU at the smallest step of all)."""
     short = simulate_in(tmp_path, fmus[fmi], stop_time=2 * STEP, output_interval=5e-4, output=["q[1]"])
     assert len(short) == 5  # 0.5 ms is 5 internal steps
     slave = Slave(fmus[fmi], tmp_path)
     try:
+        slave.set(**{"f_ext[1]": 0.5})
         slave.initialize()
-        with pytest.raises(Exception, match="DoStep"):
-            slave.step(0.0, 1.5e-4)
-        assert "not a whole multiple of the internal step" in slave.errors()[0]
-        slave.step(0.0, 2e-4)  # the instance is still usable after a refused step
+        rows = []
+        for k in range(4):
+            slave.step(k * 1.5e-4, 1.5e-4)
+            rows.append(slave.get(Q))
     finally:
         slave.close()
-
-
-@pytest.mark.parametrize("fmi", [2, 3])
-def test_the_plant_refuses_a_step_off_its_internal_step_when_the_run_gets_there(fmus, fmi):
-    """The export declares its internal step (fixedInternalStepSize), which the FMU block
-    shows and does not enforce (the standard makes it informative): the plant itself
-    refuses a step that is no multiple of it, and the run fails with its message."""
-    from blocks import loads_diagram, simulate
-
-    text = f"""
-time: {{t_end: 0.6 ms}}
-blocks:
-  plant: {{type: FMU, period: 0.15 ms, params: {{path: "{fmus[fmi]}"}}}}
-log: [plant.q]
-"""
-    d = loads_diagram(text, filename="d.yaml")
-    assert "(fixed internal step 100 us, informative)" in d.blocks["plant"].block.describe()
-    results = simulate(d)
-    assert results.status.startswith("failed at t=0 s: block 'plant' (FMU) update:"), results.status
-    assert f"fmi{fmi}DoStep at t=0 s (step 0.00015 s) returned status 'error'" in results.status
-    assert "not a whole multiple of the internal step" in results.status
-    assert simulate(loads_diagram(text.replace("0.15 ms", "0.2 ms"))).complete
+    plant = HandPlant()
+    plant.bind(Fraction(1, 10000))
+    state, inputs = plant.initial_state(), {"tau": np.zeros(9), "f_ext": np.array([0.5, 0.0, 0.0])}
+    samples = []
+    for k in range(6):
+        state, out = plant.advance(k * 1e-4, state, inputs, 1)
+        samples.append(out["q"][-1].copy())
+    np.testing.assert_array_equal(np.array(rows), np.array(samples)[[0, 2, 3, 5]])  # 0.1, 0.3, 0.4, 0.6 ms
 
 
 def test_several_instances_and_exports_run_side_by_side_in_one_process(fmus, tmp_path):

@@ -72,7 +72,7 @@ def test_the_core_refuses_arrays_it_cannot_take(mutate, error, match):
 
 def test_check_hand_names_each_problem_by_its_index():
     hand = Hand.default().vector.copy()
-    names = [name for name, _ in _native.hand_parameters()]
+    names = [name for name, *_ in _native.hand_parameters()]
     hand[names.index("object.mass")] = -1.0
     hand[names.index("fingers[2].damping[3]")] = -0.5
     hand[names.index("contact.k_t")] = np.nan
@@ -87,7 +87,7 @@ def test_check_hand_names_each_problem_by_its_index():
 
 def test_too_many_surface_points_are_refused_before_any_memory_is_taken():
     hand = Hand.default().vector.copy()
-    names = [name for name, _ in _native.hand_parameters()]
+    names = [name for name, *_ in _native.hand_parameters()]
     hand[names.index("object.surface_spacing")] = 1e-7
     [(index, text)] = _native.check_hand(hand)
     assert names[index] == "object.surface_spacing" and "2000000 surface points, more than the 100000" in text

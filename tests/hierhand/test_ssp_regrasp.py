@@ -2,12 +2,16 @@
 the controller subsystem and the object's support each a component whose FMU the
 diagram-FMU exporter writes. Run back by blocks it is the native re-grasp to the last bit
 (the controller's outputs read with feedthrough, as its blocks:Stepping annotation asks);
-libcosim, whose fixed-step algorithm steps every FMU on the others' outputs of the last
-communication point, runs it as blocks runs the same SSP without that annotation."""
+libcosim and ecos, whose fixed-step algorithms step every FMU on the others' outputs of the
+last communication point, run it as blocks runs the same SSP without that annotation (ecos
+with every component at the 1 ms base step: the support's 10 ms FMU holds between its hits)."""
 
 from __future__ import annotations
 
+import ctypes
+import os
 import shutil
+import sys
 import zipfile
 from fractions import Fraction
 from pathlib import Path
@@ -15,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from fmpy import read_model_description
+from fmpy.validation import validate_fmu
 
 import blocks
 from blocks.ssp import export_ssp
@@ -50,6 +55,14 @@ def jacobi_copy(unpacked: Path, folder: Path) -> Path:
     return target
 
 
+@pytest.fixture(scope="module")
+def jacobi_regrasp(regrasp_ssp, tmp_path_factory):
+    """blocks' run of the re-grasp SSP without the blocks:Stepping annotations."""
+    without = blocks.load_diagram(jacobi_copy(regrasp_ssp[1], tmp_path_factory.mktemp("jacobi")))
+    assert not any(s.params.get("feedthrough") for s in without.blocks.values())
+    return blocks.simulate(without)
+
+
 def test_the_regrasp_leaves_as_three_components_with_units_and_a_valid_ssd(regrasp_ssp):
     path, unpacked = regrasp_ssp
     assert schema_errors(unpacked / "SystemStructure.ssd") == []
@@ -63,6 +76,13 @@ def test_the_regrasp_leaves_as_three_components_with_units_and_a_valid_ssd(regra
     assert '<ssc:Unit name="N m">' in ssd and 'kg="1" m="2" s="-2"' in ssd
     ctrl = read_model_description(str(unpacked / "resources" / "ctrl.fmu"))
     assert {"reflex.ki", "suppress.S_b[4]", "suppress.time_constant"} <= {v.name for v in ctrl.modelVariables if v.causality == "parameter"}
+    declared = {v.name: v for v in ctrl.modelVariables}
+    assert {v.variability for v in ctrl.modelVariables if v.causality == "output"} == {"discrete"}  # sampled torques
+    assert (declared["reflex.margin"].min, declared["reflex.margin"].max) == ("0.0", "1.0")  # the reflex's range
+    assert (declared["suppress.S_b[4]"].min, declared["suppress.S_b[4]"].max) == (None, None)  # any number
+    plant = read_model_description(str(unpacked / "resources" / "plant.fmu"))
+    assert {v.variability for v in plant.modelVariables if v.causality == "output"} == {"continuous"}
+    assert validate_fmu(str(unpacked / "resources" / "ctrl.fmu")) == []
 
 
 def test_the_regrasp_ssp_run_back_is_the_native_regrasp(regrasp_ssp, native_regrasp):
@@ -82,7 +102,8 @@ def test_a_component_parameter_set_on_the_ssp_is_the_native_override(regrasp_ssp
                                                                  t_end=0.3)["plant.q"][1])
 
 
-def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regrasp_ssp, native_regrasp, tmp_path):
+def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regrasp_ssp, native_regrasp,
+                                                                          jacobi_regrasp):
     """libcosim's fixed-step algorithm steps every due FMU at once and only then hands the
     outputs over: the controller's torques reach the plant one step (1 ms) later than in
     the native diagram, where the controller reads the plant's outputs of the same tick."""
@@ -106,8 +127,42 @@ def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regras
     for _ in range(1000):
         assert execution.step()
         rows.append(observer.last_real_values(plant, q))
-    without = blocks.load_diagram(jacobi_copy(unpacked, tmp_path))
-    assert not any(s.params.get("feedthrough") for s in without.blocks.values())
-    jacobi = blocks.simulate(without)
-    np.testing.assert_allclose(np.array(rows), jacobi["plant.q"][1][1:], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(np.array(rows), jacobi_regrasp["plant.q"][1][1:], rtol=1e-9, atol=1e-12)
+    assert np.abs(np.array(rows) - native_regrasp["plant.q"][1][1:]).max() > 1e-4  # the lag shows
+
+
+def ecospy():
+    """The ecospy package (ecos, a co-simulation engine whose wheel bundles its binaries),
+    its TBB library loaded first: the engine needs libtbb.so.12, which the test extra's
+    ``tbb`` wheel puts in the environment's lib folder, where the loader does not look."""
+    for library in ("libtbb.so.12", os.path.join(sys.prefix, "lib", "libtbb.so.12")):
+        try:
+            ctypes.CDLL(library, mode=ctypes.RTLD_GLOBAL)
+            break
+        except OSError:
+            continue
+    try:
+        import ecospy as module
+    except (ImportError, OSError) as exc:
+        pytest.skip(f"ecospy (ecos's Python package) cannot be loaded ({exc}): the test extra installs it with "
+                    "tbb on Linux x86_64 (pip install -e '.[test]')")
+    return module
+
+
+def test_ecos_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regrasp_ssp, native_regrasp, jacobi_regrasp):
+    """ecos reads no step annotation of this SSP (the default export keeps them out of the
+    components, where OMSimulator refuses them) and steps every component at the 1 ms it
+    is given, Jacobi-fashion: the same run as blocks' without feedthrough, to the last bit."""
+    ecos = ecospy()
+    ecos.EcosLib.set_log_level("warn")
+    simulation = ecos.EcosSimulation(step_size=1e-3, ssp_path=str(regrasp_ssp[0]))
+    try:
+        simulation.init()
+        rows = []
+        for _ in range(1000):
+            simulation.step()
+            rows.append([simulation.get_real(f"plant::q[{i}]") for i in range(1, 10)])
+    finally:
+        simulation.terminate()
+    np.testing.assert_array_equal(np.array(rows), jacobi_regrasp["plant.q"][1][1:])
     assert np.abs(np.array(rows) - native_regrasp["plant.q"][1][1:]).max() > 1e-4  # the lag shows

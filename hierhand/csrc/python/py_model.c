@@ -187,7 +187,8 @@ static PyObject *py_hand_parameters(PyObject *module, PyObject *unused)
     if (list == NULL)
         return NULL;
     for (int i = 0; i < HH_HAND_PARAMS; i++) {
-        PyObject *item = Py_BuildValue("(ss)", hh_hand_param_name(i), hh_hand_param_doc(i));
+        PyObject *item = Py_BuildValue("(ssO)", hh_hand_param_name(i), hh_hand_param_doc(i),
+                                       hh_hand_param_at_least_zero(i) ? Py_True : Py_False);
         if (item == NULL) {
             Py_DECREF(list);
             return NULL;
@@ -283,7 +284,8 @@ PyMethodDef hh_py_model_methods[] = {
     {"check_hand", (PyCFunction)py_check_hand, METH_O,
      "check_hand(hand) -> [(index, text), ...]: the problems of a hand vector (empty if valid)."},
     {"hand_parameters", (PyCFunction)py_hand_parameters, METH_NOARGS,
-     "hand_parameters() -> [(name, doc), ...]: the hand vector's numbers in order."},
+     "hand_parameters() -> [(name, doc, at_least_zero), ...]: the hand vector's numbers in order, and "
+     "whether each must be >= 0."},
     {"initial_state", (PyCFunction)(void (*)(void))py_initial_state, METH_FASTCALL,
      "initial_state(model, state): write the model's initial state."},
     {"frames", (PyCFunction)(void (*)(void))py_frames, METH_FASTCALL,

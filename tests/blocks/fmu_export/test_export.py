@@ -257,7 +257,7 @@ def test_several_instances_of_several_diagrams_run_side_by_side(toy_fmus, tmp_pa
 
 
 @pytest.mark.parametrize("fmi", [2, 3])
-def test_steps_off_the_grid_are_refused_and_a_stop_block_ends_the_fmu(tmp_path, fmi):
+def test_a_stop_block_ends_the_fmu(tmp_path, fmi):
     (tmp_path / "stop.yaml").write_text(textwrap.dedent("""\
         name: stopping
         time: {t_end: 1 s}
@@ -272,9 +272,6 @@ def test_steps_off_the_grid_are_refused_and_a_stop_block_ends_the_fmu(tmp_path, 
     slave = Slave(path, tmp_path / "unzipped")
     try:
         slave.initialize()
-        with pytest.raises(Exception, match="DoStep"):
-            slave.step(0.0, 1.5e-3)
-        assert "not a whole multiple of the internal step 0.001 s" in slave.errors()[0]
         t = 0.0
         ended = None
         for _ in range(30):

@@ -39,16 +39,49 @@ def multirate(fmu, delay: int = 0, extra: bool = False):
     return b.build()
 
 
-@pytest.fixture
-def exported(first_order, tmp_path):
+def export_unpacked(first_order, tmp_path, annotations: str = "system"):
+    """The multirate diagram, its SSP (``annotations`` as export_ssp takes it) and the SSP's folder."""
     fmu = tmp_path / "fo.fmu"
     fmu.write_bytes(first_order)
     diagram = multirate(fmu)
-    path = export_ssp(diagram, tmp_path / "multirate.ssp")
-    folder = tmp_path / "unpacked"
+    path = export_ssp(diagram, tmp_path / f"multirate-{annotations}.ssp", annotations=annotations)
+    folder = tmp_path / f"unpacked-{annotations}"
     with zipfile.ZipFile(path) as zf:
         zf.extractall(folder)
     return diagram, path, folder
+
+
+@pytest.fixture
+def exported(first_order, tmp_path):
+    return export_unpacked(first_order, tmp_path)
+
+
+def test_tool_annotations_go_where_omsimulator_reads_them_or_nowhere(first_order, tmp_path):
+    """OMSimulator 3.0 refuses an ssd:Annotations inside an ssd:Component (the schema allows
+    one) and reads only the first ssc:Annotation of a system: by default the components
+    carry none, the system's first is OMSimulator's; each SSD validates and reads back with
+    the components' steps as the diagram's periods where blocks' annotations are written."""
+    from lxml import etree
+
+    from blocks.ssp.xml import q
+
+    periods = {}
+    for annotations in ("system", "components", "none"):
+        diagram, path, folder = export_unpacked(first_order, tmp_path, annotations)
+        assert schema_errors(folder / "SystemStructure.ssd") == []
+        root = etree.parse(str(folder / "SystemStructure.ssd")).getroot()
+        in_components = root.findall(f".//{q('ssd', 'Component')}/{q('ssd', 'Annotations')}")
+        kinds = [a.get("type") for a in root.iter(q("ssc", "Annotation"))]
+        if annotations == "system":
+            assert in_components == [] and kinds[0] == "org.openmodelica" and "org.hierhand.blocks" in kinds
+        elif annotations == "components":
+            assert len(in_components) == 2 and "com.opensimulationplatform" in kinds
+        else:
+            assert kinds == []
+        back = load_diagram(path, step="100 ms")
+        periods[annotations] = {n: b.period for n, b in back.blocks.items()}
+    assert periods["system"] == periods["components"] == {n: diagram.blocks[n].period for n in ("fast", "slow")}
+    assert periods["none"] == {"fast": Fraction(1, 10), "slow": Fraction(1, 10)}  # no step given but --step
 
 
 def test_the_exported_ssd_validates_and_runs_back_as_the_native_diagram(exported):
@@ -64,12 +97,13 @@ def test_the_exported_ssd_validates_and_runs_back_as_the_native_diagram(exported
         np.testing.assert_array_equal(native[signal][1], again[signal][1])
 
 
-def test_libcosim_runs_the_exported_ssp_as_the_native_diagram(exported):
+def test_libcosim_runs_the_exported_ssp_as_the_native_diagram(first_order, tmp_path):
+    """With the step hints libcosim reads in each component (``annotations="components"``)."""
     cosim = pytest.importorskip("libcosimpy.CosimExecution", reason="libcosimpy (the test extra's libcosim) is not "
                                 "installed; it has wheels for Linux x86-64 only")
     from libcosimpy.CosimObserver import CosimObserver
 
-    diagram, path, _ = exported
+    diagram, path, _ = export_unpacked(first_order, tmp_path, "components")
     execution = cosim.CosimExecution.from_ssp_file(str(path))
     observer = CosimObserver.create_last_value()
     execution.add_observer(observer)
@@ -138,9 +172,11 @@ def test_the_command_line_exports_and_refuses_with_exit_code_2(first_order, tmp_
     (tmp_path / "d.yaml").write_text((tmp_path / "d.yaml").read_text().replace(", a.y -> g.u", "")
                                      .replace("  g: {type: FMU, period: 100 ms, offset: 50 ms, params: {path: fo.fmu}}\n", ""))
     good = subprocess.run([sys.executable, "-m", "blocks", "ssp", "export", str(tmp_path / "d.yaml"), "-o", str(out),
-                           "--set", "a.x0=3"], capture_output=True, text=True, timeout=120)
+                           "--set", "a.x0=3", "--annotations", "none"], capture_output=True, text=True, timeout=120)
     assert good.returncode == 0, good.stderr
-    assert load_diagram(out).blocks["a"].params["start_values"] == {"x0": 3}
+    assert load_diagram(out, step="100 ms").blocks["a"].params["start_values"] == {"x0": 3}
+    with zipfile.ZipFile(out) as zf:
+        assert b"<ssd:Annotations" not in zf.read("SystemStructure.ssd")  # left out on request
 
 
 def test_a_subsystem_the_fmu_exporter_refuses_is_one_error_at_its_block(first_order, tmp_path):
