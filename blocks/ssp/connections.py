@@ -11,7 +11,12 @@ Units convert as ``ssd:Units`` define them, else as pint knows them; an unknown 
 left to the builder, which compares the units it knows.
 
 A connection at a nested system's own connector is one of the subsystem's inputs or
-outputs. An input connector of the top-level system has nothing outside to feed it, so it
+outputs. A connection from a system's ``kind="parameter"`` connector to an element's
+parameter (a component's, or a nested system's parameter connector) passes the value the
+system's bindings give its connector on to that parameter, converted and transformed as a
+signal is, after every binding of the file is read (``Element.links``; OMSimulator exports
+system parameters so), and wins over the element's own bindings. A system or element
+named ``""`` is the system itself, as OMSimulator writes it. An input connector of the top-level system has nothing outside to feed it, so it
 becomes a ``Constant`` block of its name, holding the value a binding of the top-level
 system gives the connector (converted into its unit), else 0: ``--set NAME.value=...``
 sets it, as OMSimulator's ``setReal`` sets a top-level input.
@@ -48,6 +53,8 @@ class End:
     unit: str | None
     system: bool
     shown: str
+    element: str | None = None
+    connector: str = ""
 
     @property
     def source(self) -> bool:
@@ -100,6 +107,9 @@ class Wiring:
             if converted is None:
                 return
             factor, offset = factor * converted[0], factor * converted[1] + offset
+        if src.kind == "parameter":
+            self.me.links.append((src.connector, dst.element, dst.connector, (factor, offset), line))
+            return
         where = Site(self.reader.file, line)
         if factor == 1.0 and offset == 0.0:
             self.wire(src.text, dst.text, where)
@@ -141,6 +151,11 @@ class Wiring:
     def flow(self, a: End, b: End, line: int | None) -> tuple[End, End] | None:
         """The connection's ends as (source, destination), by their kinds; None (reported)
         for two sources, two destinations, or a parameter connector."""
+        for end in (a, b):
+            if end.kind not in (*SOURCES[True], *SOURCES[False]):
+                self.fail(line, f"ssd:Connection at {end.shown} of kind '{end.kind}' is not supported",
+                          "connectors of FMU components and systems are inputs, outputs and parameters")
+                return None
         if a.source == b.source:
             which = "sources" if a.source else "destinations"
             self.fail(line, f"ssd:Connection joins {a.shown} of kind '{a.kind}' and {b.shown} of kind '{b.kind}': "
@@ -148,6 +163,8 @@ class Wiring:
                       "to an element's input (or a system's output)")
             return None
         src, dst = (a, b) if a.source else (b, a)
+        if src.system and src.kind == "parameter" and not dst.system and dst.kind == "parameter":
+            return src, dst
         for end in (src, dst):
             if end.kind not in SIGNALS:
                 self.fail(line, f"ssd:Connection at {end.shown} of kind '{end.kind}' is not supported",
@@ -161,14 +178,14 @@ class Wiring:
         if not connector:
             self.fail(line, f"ssd:Connection needs a {which}Connector")
             return None
-        if element is None:
+        if not element:
             c = me.connectors.get(connector)
             if c is None:
                 self.fail(line, f"ssd:Connection {which}Connector {shown(connector)}: the system has no connector "
                           "of that name", suggest(connector, list(me.connectors)) or
                           f"its connectors: {known(list(me.connectors))}")
                 return None
-            return End(f":{connector}", c.kind, c.unit, True, f"the system's connector '{connector}'")
+            return End(f":{connector}", c.kind, c.unit, True, f"the system's connector '{connector}'", None, connector)
         found = me.elements.get(element)
         if found is None:
             names = list(me.elements)
@@ -182,11 +199,15 @@ class Wiring:
                       "connector of that name", suggest(connector, names) or f"its connectors: {known(names)}")
             return None
         if found.kind == "system":
+            if not found.elements and c.kind in SIGNALS:
+                self.fail(line, f"ssd:Connection at {element}.{connector}: the system '{element}' has no elements",
+                          "connect to a system of components")
+                return None
             text = f"{element}.{port_name(connector)}"
         else:
             port, label = port_of(connector)
             text = f"{element}.{port}" if label is None else f"{element}.{port}[{label}]"
-        return End(text, c.kind, c.unit, False, f"{element}.{connector}")
+        return End(text, c.kind, c.unit, False, f"{element}.{connector}", element, connector)
 
     def conversion(self, a: str | None, b: str | None, line: int | None) -> tuple[float, float] | None:
         """(factor, offset) from unit ``a`` to ``b``; (1, 0) when either is not given or

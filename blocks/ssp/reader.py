@@ -44,8 +44,9 @@ from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from blocks.builder.context import known, suggest
+from blocks.builder.context import known
 from blocks.builder.diagram_builder import DiagramBuilder
+from ..fmu.description import FMUInfoError, read_description, step_of, variable_unit
 from ..fmu.ports import port_name, port_of
 from ..issues import DiagramError, Issue
 from blocks.builder.records import Site
@@ -88,6 +89,9 @@ class Element:
     md: Any = None
     """The FMU's modelDescription (fmpy's), read when a value's unit needs it; False: unreadable."""
     values: dict[str, Value] = field(default_factory=dict)
+    links: list[tuple[str, str, str, tuple[float, float], int | None]] = field(default_factory=list)
+    """A system's parameter connections: (its connector, element, the element's parameter,
+    (factor, offset), line), applied once every binding is read (``parameters``)."""
 
 
 def read_ssp(path: str | Path, trust: bool = False, step: Any = None) -> DiagramBuilder:
@@ -151,7 +155,7 @@ class _Reader:
             self.units = read_definitions(child(root, "ssd", "Units"))
         except UnitError as exc:
             self.fail(exc.line, str(exc))
-        self.system(system, b, None, top=True)
+        self.parameters(self.system(system, b, None, top=True))
         b.log_all(where=self.site(system))
         b.texts.extend(self.texts)
         return b
@@ -215,7 +219,8 @@ class _Reader:
                                      where=self.site(item))
                 sub.label = f"system '{name}' ({self.file}:{item.sourceline})"
                 found = self.system(item, sub, step)
-                b.add_subsystem(name, sub, where=self.site(item))
+                if found.elements:  # a system of nothing but parameters (OMSimulator writes them) runs nothing
+                    b.add_subsystem(name, sub, where=self.site(item))
             else:
                 found = self.component(item, name, b, step)
             if found is not None:
@@ -313,8 +318,6 @@ class _Reader:
         """The modelDescription of component ``me``'s FMU, read once; False if it cannot be
         read (the FMU block says why)."""
         if me.md is None:
-            from ..fmu.description import FMUInfoError, read_description
-
             try:
                 me.md = read_description(me.fmu, self.package.where(me.fmu)).md
             except FMUInfoError:
@@ -331,8 +334,6 @@ class _Reader:
             if variable is None:  # an FMU that cannot be read, or no such variable: the FMU block says so
                 me.start_values[name] = v.value
                 return
-            from ..fmu.description import variable_unit
-
             connector = me.connectors.get(name)
             unit = variable_unit(variable) or (connector.unit if connector is not None else None)
             tables = (self.units, fmu_definitions(md))
@@ -359,11 +360,11 @@ class _Reader:
             self.fail(exc.line, str(exc), exc.hint, file=exc.file)
             return
         for v in values:
-            if top and v.name in me.connectors and me.connectors[v.name].kind == "input":
-                me.values[v.name] = v
-                continue
             target, rest = me, v.name
             while True:
+                if rest in target.connectors and target.connectors[rest].kind in ("input", "parameter"):
+                    target.values[rest] = v  # a value of a system's own connector (top-level inputs, parameters)
+                    break
                 head, dot, tail = rest.partition(".")
                 found = target.elements.get(head) if dot else None
                 if found is None:
@@ -378,6 +379,33 @@ class _Reader:
                     self.assign(found, tail, v, head)
                     break
                 target, rest = found, tail
+
+    def parameters(self, me: Element) -> None:
+        """Pass the values of system ``me``'s parameter connectors on along its parameter
+        connections, then those of its nested systems (a higher level's first: it wins)."""
+        for connector, name, parameter, (factor, offset), line in me.links:
+            v = me.values.get(connector)
+            target = me.elements[name]
+            if v is None:
+                continue  # an unbound system parameter leaves the element's own value
+            try:
+                value = v.value_in(me.connectors[connector].unit, self.units)
+            except BindingError as exc:
+                self.fail(exc.line, str(exc), exc.hint, file=exc.file)
+                continue
+            if (factor, offset) != (1.0, 0.0):
+                if not isinstance(value, float):
+                    self.fail(line, f"ssd:Connection from the system's parameter '{connector}': a unit conversion or "
+                              "linear transformation maps only Real values")
+                    continue
+                value = factor * value + offset
+            if target.kind == "component":
+                target.start_values[parameter] = value
+            else:
+                target.values[parameter] = Value(parameter, value, v.file, v.line, target.connectors[parameter].unit)
+        for element in me.elements.values():
+            if element.kind == "system":
+                self.parameters(element)
 
 
 def _port_units(connectors: Any) -> dict[str, tuple[str | list[str], int | None]]:
@@ -411,8 +439,6 @@ def _port_units(connectors: Any) -> dict[str, tuple[str | list[str], int | None]
 
 def _default_step(md: Any) -> bool:
     """Whether a modelDescription declares a usable DefaultExperiment stepSize."""
-    from ..fmu.description import step_of
-
     step = getattr(md.defaultExperiment, "stepSize", None) if md.defaultExperiment is not None else None
     try:
         return step is not None and step_of(step) > 0

@@ -194,3 +194,33 @@ def test_an_omsimulator_style_ssd_maps_its_values_converts_their_units_and_then_
     result = simulate(diagram)
     # -4.905 m/s2 is -4905 mm/s2, then + 5; the sink (x[k+1] = u[k], b = 1) holds it from its second step
     assert result["sink.y"][1][1, 0] == pytest.approx(-4900.0, rel=1e-15)
+
+
+def test_an_omsimulator_export_with_system_parameters_and_unnamed_system_ends_runs(first_order, tmp_path):
+    """As OMSimulator exports a system whose parameters and inputs are the system's own
+    connectors: ``startElement=""`` for the system, the values bound by bare name."""
+    ssv = ("<?xml version='1.0' encoding='utf-8'?>\n<ssv:ParameterSet xmlns:ssv=\"http://ssp-standard.org/SSP1/"
+           'SystemStructureParameterValues" version="1.0" name="parameters">'
+           + inline(("k_cref", "0.25", None), ("Input_cref", "-20", None), ("foo.F_cref", "40", None),
+                    ("p.b", "10", None), ("p.a", "0.5", None), whole=False) + "</ssv:ParameterSet>\n")
+    system = f"""<ssd:System name="co_sim">
+  {connectors(("Input_cref", "input", None), ("Output_cref", "output", None), ("k_cref", "parameter", None))}
+  <ssd:ParameterBindings><ssd:ParameterBinding source="resources/values.ssv"/></ssd:ParameterBindings>
+  <ssd:Elements>
+    <ssd:System name="foo">{connectors(("F_cref", "parameter", None))}</ssd:System>
+    <ssd:Component name="p" type="application/x-fmu-sharedlibrary" source="resources/fo.fmu">
+      {connectors(("u", "input", None), ("y", "output", None), ("a", "parameter", None), ("b", "parameter", None))}
+    </ssd:Component>
+  </ssd:Elements>
+  <ssd:Connections>
+    <ssd:Connection startElement="" startConnector="k_cref" endElement="p" endConnector="b"/>
+    <ssd:Connection startElement="" startConnector="Input_cref" endElement="p" endConnector="u"/>
+    <ssd:Connection startElement="p" startConnector="y" endElement="" endConnector="Output_cref"/>
+  </ssd:Connections>
+</ssd:System>"""
+    folder = write_ssp(tmp_path / "oms", root(system), first_order, {"resources/values.ssv": ssv})
+    assert schema_errors(folder / "SystemStructure.ssd") == []
+    diagram = load_diagram(folder)
+    assert diagram.blocks["p"].params["start_values"] == {"a": 0.5, "b": 0.25}  # the system's k_cref wins
+    y = simulate(diagram)["p.y"][1][:, 0]
+    assert y[1] == 0.25 * -20.0  # x[1] = a x0 + b u, x0 = 0, u the input held at its bound -20
