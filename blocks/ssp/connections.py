@@ -254,5 +254,7 @@ class Wiring:
                              file=bound.file)
             return
         self.b.add(block, "Constant", params={"value": float(value)}, where=where)
+        if connector.unit:
+            self.b.annotate(f"{block}.y", units=connector.unit, where=where)
         for target in targets:
             self.b.connect(f"{block}.y", target, where=where)

@@ -8,7 +8,7 @@ A binding (``ssd:ParameterBinding``) gives a parameter set (``ssv:ParameterSet``
 applies to the prefixed names: an entry maps the parameter ``source`` to the name
 ``target`` (one source may go to several targets, two sources never to one), and a
 parameter no entry names is not applied. Values are Real / Float as float, integers as
-int, Boolean as bool, String as str. A Real value may carry a unit (defined in the set's
+int, Boolean as bool, String as str, Enumeration as its item's name (``Value.enumeration``). A Real value may carry a unit (defined in the set's
 ``ssv:Units``, or by name); ``value`` converts it into the unit of the parameter it lands
 on and then applies the entry's ``ssc:LinearTransformation`` (SSP 1.0, 7.1.1: the
 transformation after the unit conversion, or instead of it with
@@ -47,6 +47,8 @@ class Value:
     """The (factor, offset) of its mapping entry's linear transformation, if any."""
     convert: bool = True
     """False where its mapping entry suppresses the unit conversion."""
+    enumeration: bool = False
+    """An ``ssv:Enumeration`` value: ``value`` the item's name, which its FMU variable's type numbers."""
 
     def value_in(self, unit: str | None, *tables: Definitions) -> Any:
         """The value for a parameter of unit ``unit`` (None: it declares none): converted
@@ -157,7 +159,7 @@ def _parameter_set(root: Any, file: str) -> list[Value]:
             raise BindingError(file, parameter.sourceline, "ssv:Parameter needs a name and a typed value",
                                "<ssv:Parameter name='k'><ssv:Real value='2'/></ssv:Parameter>")
         out.append(Value(name, _value(typed[0], name, file), file, parameter.sourceline, typed[0].get("unit") or None,
-                         units))
+                         units, enumeration=local(typed[0]) == "Enumeration"))
     return out
 
 
@@ -173,12 +175,12 @@ def _value(element: Any, name: str, file: str) -> Any:
             if text.strip() not in ("true", "false", "1", "0"):
                 raise ValueError(text)
             return text.strip() in ("true", "1")
-        if kind == "String" and text is not None:
+        if kind in ("String", "Enumeration") and text is not None:
             return text
     except ValueError:
         raise BindingError(file, line, f"parameter '{name}': {text!r} is not an ssv:{kind} value") from None
     raise BindingError(file, line, f"parameter '{name}': values of type ssv:{kind} are not supported",
-                       "Real, Float64, Float32, Integer and IntN, Boolean and String values are")
+                       "Real, Float64, Float32, Integer and IntN, Boolean, String and Enumeration values are")
 
 
 Entry = tuple[str, "tuple[float, float] | None", bool]

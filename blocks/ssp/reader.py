@@ -328,11 +328,14 @@ class _Reader:
         """Set parameter ``name`` of component ``me`` to the value ``v`` gives, converted into
         the parameter's unit (the FMU variable's, else its parameter connector's)."""
         unit, tables = None, (self.units,)
-        if v.unit:
+        if v.unit or v.enumeration:
             md = self.description(me)
             variable = next((x for x in md.modelVariables if x.name == name), None) if md else None
             if variable is None:  # an FMU that cannot be read, or no such variable: the FMU block says so
                 me.start_values[name] = v.value
+                return
+            if v.enumeration:
+                me.start_values[name] = self.enumeration_item(v, variable, component)
                 return
             connector = me.connectors.get(name)
             unit = variable_unit(variable) or (connector.unit if connector is not None else None)
@@ -379,6 +382,19 @@ class _Reader:
                     self.assign(found, tail, v, head)
                     break
                 target, rest = found, tail
+
+    def enumeration_item(self, v: Value, variable: Any, component: str) -> Any:
+        """The number of the item ``v`` names in its FMU variable's enumeration type (the name
+        as it is, reported, where the variable's type has no such item)."""
+        items = getattr(getattr(variable, "declaredType", None), "items", None) or []
+        for item in items:
+            if item.name == v.value:
+                return int(item.value)
+        names = [item.name for item in items]
+        self.fail(v.line, f"component '{component}': parameter '{v.name}' = '{v.value}' is no item of the FMU's "
+                  f"enumeration type of '{variable.name}'", f"its items: {known(names)}" if names else
+                  f"'{variable.name}' is not an Enumeration variable", name=component, file=v.file)
+        return v.value
 
     def parameters(self, me: Element) -> None:
         """Pass the values of system ``me``'s parameter connectors on along its parameter

@@ -295,7 +295,7 @@ BAD_ELEMENTS = {
                         'kind="output"><ssc:Real/><ssc:Dimension size="3"/></ssd:Connector></ssd:Connectors>'
                         f"{hint('0.1')}</ssd:Component>", "array connectors (ssc:Dimension) are not supported", "Dimension"),
     "bad name": ('<ssd:Component name="a b" source="resources/fo.fmu"/>', "is not usable as a block name", 'name="a b"'),
-    "value type": (component("a", values(("x0", "Enumeration", "1"))), "values of type ssv:Enumeration", "ssv:Enumeration"),
+    "value type": (component("a", values(("x0", "Binary", "00"))), "values of type ssv:Binary", "ssv:Binary"),
     "ssv missing": (component("a", '<ssd:ParameterBindings><ssd:ParameterBinding source="resources/none.ssv"/>'
                               "</ssd:ParameterBindings>"), "parameter source 'resources/none.ssv' is not in the SSP", "none.ssv"),
 }

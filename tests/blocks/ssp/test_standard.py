@@ -115,7 +115,7 @@ def test_set_on_the_command_line_sets_a_top_level_input(first_order_library, tmp
     out = tmp_path / "run"
     assert main(PROGRAM, ["run", str(folder), "-o", str(out), "--set", "push.value=-1000", "--quiet"]) == 0
     results = Results.load(out)
-    assert results["push.y"][1][0, 0] == -1000.0
+    assert results["push.y"][1][0, 0] == -1000.0 and results.unit("push.y") == "mm/s2"
     assert results["body.y"][1][1, 0] == pytest.approx(0.5 * -4.905 - 1.0, rel=1e-15)
 
 
@@ -224,3 +224,27 @@ def test_an_omsimulator_export_with_system_parameters_and_unnamed_system_ends_ru
     assert diagram.blocks["p"].params["start_values"] == {"a": 0.5, "b": 0.25}  # the system's k_cref wins
     y = simulate(diagram)["p.y"][1][:, 0]
     assert y[1] == 0.25 * -20.0  # x[1] = a x0 + b u, x0 = 0, u the input held at its bound -20
+
+
+def test_an_enumeration_value_is_the_number_of_its_item_in_the_fmus_type(first_order_library, tmp_path):
+    fmu = variant(first_order_library,
+                  ("<LogCategories>", '<TypeDefinitions><SimpleType name="Scale"><Enumeration><Item name="single" '
+                                      'value="1"/><Item name="triple" value="3"/></Enumeration></SimpleType>'
+                                      "</TypeDefinitions>\n  <LogCategories>"),
+                  ('<Integer start="1"/>', '<Enumeration declaredType="Scale" start="1"/>'))
+    values = ('<ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues><ssv:ParameterSet version="1.0" '
+              'name="values"><ssv:Parameters><ssv:Parameter name="scale"><ssv:Enumeration value="{}"/>'
+              '</ssv:Parameter><ssv:Parameter name="x0"><ssv:Real value="2"/></ssv:Parameter></ssv:Parameters>'
+              "</ssv:ParameterSet></ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>")
+    component = ('<ssd:Component name="c" source="resources/fo.fmu">'
+                 f'{connectors(("z[1]", "output", None))}{values}</ssd:Component>')
+    folder = write_ssp(tmp_path / "enum", root(f'<ssd:System name="s"><ssd:Elements>{component}</ssd:Elements>'
+                                               "</ssd:System>").replace("{}", "triple"), fmu)
+    assert schema_errors(folder / "SystemStructure.ssd") == []
+    diagram = load_diagram(folder)
+    assert diagram.blocks["c"].params["start_values"]["scale"] == 3
+    assert simulate(diagram)["c.z"][1][0, 0] == 3 * 2.0  # z[1] = scale x
+    folder = write_ssp(tmp_path / "bad", root(f'<ssd:System name="s"><ssd:Elements>{component}</ssd:Elements>'
+                                              "</ssd:System>").replace("{}", "double"), fmu)
+    with pytest.raises(DiagramError, match="'double' is no item of the FMU's enumeration type of 'scale'"):
+        load_diagram(folder)
