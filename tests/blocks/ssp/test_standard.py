@@ -152,7 +152,7 @@ OMS_SSV = ("<?xml version='1.0' encoding='utf-8'?>\n<ssv:ParameterSet xmlns:ssc=
 OMS_SSM = """<?xml version='1.0' encoding='utf-8'?>
 <ssm:ParameterMapping xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon"
     xmlns:ssm="http://ssp-standard.org/SSP1/SystemStructureParameterMapping" version="1.0">
-  <ssm:MappingEntry source="body.x0" target="body.x0"/>
+  <ssm:MappingEntry source="body.x0" target="body.x0"><ssc:LinearTransformation factor="2" offset="1"/></ssm:MappingEntry>
   <ssm:MappingEntry source="gain_pct" target="body.a"><ssc:LinearTransformation factor="0.01"/></ssm:MappingEntry>
   <ssm:MappingEntry source="sink.threshold" target="sink.threshold"/>
   <ssm:MappingEntry source="sink.a" target="sink.a"/>
@@ -189,11 +189,12 @@ def test_an_omsimulator_style_ssd_maps_its_values_converts_their_units_and_then_
     assert schema_errors(folder / "SystemStructure.ssd") == []
     diagram = load_diagram(folder)
     body, sink = diagram.blocks["body"].params["start_values"], diagram.blocks["sink"].params["start_values"]
-    assert body == pytest.approx({"x0": -4.905, "a": 0.5}, rel=1e-15)  # cm/s2 read by pint, Modelica's notation
+    # -490.5 cm/s2 (read by pint in Modelica's notation) is -4.905 m/s2, then 2 x + 1 (SSP 1.0, 7.1.1)
+    assert body == pytest.approx({"x0": 2 * -4.905 + 1, "a": 0.5}, rel=1e-15)
     assert sink == {"threshold": 1e9, "a": 0.0}  # sink.b is in no mapping entry: not applied
     result = simulate(diagram)
-    # -4.905 m/s2 is -4905 mm/s2, then + 5; the sink (x[k+1] = u[k], b = 1) holds it from its second step
-    assert result["sink.y"][1][1, 0] == pytest.approx(-4900.0, rel=1e-15)
+    # -8.81 m/s2 is -8810 mm/s2, then + 5; the sink (x[k+1] = u[k], b = 1) holds it from its second step
+    assert result["sink.y"][1][1, 0] == pytest.approx(-8805.0, rel=1e-15)
 
 
 def test_an_omsimulator_export_with_system_parameters_and_unnamed_system_ends_runs(first_order, tmp_path):
