@@ -39,7 +39,7 @@ than 0) is one error naming the element and its line.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
@@ -53,7 +53,7 @@ from blocks.builder.records import Site
 from blocks.builder.scopes import NAME
 from ..timebase import DurationError, parse_duration
 from .connections import Wiring
-from .conversion import UnitError, fmu_definitions, read_definitions
+from .conversion import Definitions, UnitError, fmu_definitions, read_definitions
 from .package import Package, PackageError, open_package
 from .parameters import BindingError, Value, binding_values
 from .steps import base_step, feedthrough, libcosim_period, step_hint, system_step
@@ -115,7 +115,7 @@ class _Reader:
         self.file = package.where(package.ssd)
         self.b: DiagramBuilder | None = None
         self.base: Fraction | None = None
-        self.units: dict = {}
+        self.units: Definitions = {}
         self.texts: list[str] = []
 
     # -- reporting ---------------------------------------------------------------------
@@ -225,7 +225,7 @@ class _Reader:
                 found = self.component(item, name, b, step)
             if found is not None:
                 me.elements[name] = found
-        self.system_bindings(element, me, top)
+        self.system_bindings(element, me)
         self.connections(element, b, me, top)
         return me
 
@@ -332,7 +332,7 @@ class _Reader:
             md = self.description(me)
             variable = next((x for x in md.modelVariables if x.name == name), None) if md else None
             if variable is None:  # an FMU that cannot be read, or no such variable: the FMU block says so
-                me.start_values[name] = v.value
+                me.start_values[name] = replace(v, unit=None).value_in(None)
                 return
             if v.enumeration:
                 me.start_values[name] = self.enumeration_item(v, variable, component)
@@ -353,9 +353,9 @@ class _Reader:
 
     # -- bindings of a system ----------------------------------------------------------
 
-    def system_bindings(self, element: Any, me: Element, top: bool) -> None:
+    def system_bindings(self, element: Any, me: Element) -> None:
         """A system's bindings: ``element.parameter`` (``sub.element.parameter``) a component's
-        parameter; a bare name one of the top-level system's input connectors."""
+        parameter; a system's own input or parameter connector by its name (``sub.k``, ``k``)."""
         try:
             values = binding_values(self.package, self.file, child(element, "ssd", "ParameterBindings"),
                                     self.read_xml)
@@ -371,12 +371,9 @@ class _Reader:
                 head, dot, tail = rest.partition(".")
                 found = target.elements.get(head) if dot else None
                 if found is None:
-                    names = list(target.elements)
-                    inputs = [c for c, x in me.connectors.items() if x.kind == "input"] if top else []
                     self.fail(v.line, f"parameter '{v.name}': no element '{head}' to bind it to",
-                              "a system's bindings name element.parameter" + (f", or one of its input connectors "
-                                                                               f"({known(inputs)})" if inputs else "")
-                              + "; elements: " + known(names), file=v.file)
+                              "a system's bindings name element.parameter or one of its input or parameter "
+                              f"connectors; elements: {known(list(target.elements))}", file=v.file)
                     break
                 if found.kind == "component":
                     self.assign(found, tail, v, head)
