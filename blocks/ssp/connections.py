@@ -18,8 +18,10 @@ signal is, after every binding of the file is read (``Element.links``; OMSimulat
 system parameters so), and wins over the element's own bindings. A system or element
 named ``""`` is the system itself, as OMSimulator writes it. An input connector of the top-level system has nothing outside to feed it, so it
 becomes a ``Constant`` block of its name, holding the value a binding of the top-level
-system gives the connector (converted into its unit), else 0: ``--set NAME.value=...``
-sets it, as OMSimulator's ``setReal`` sets a top-level input.
+system gives the connector (converted into its unit), else the start value of the FMU
+inputs it feeds (through the conversions on the way; SSP 2.0: an unconnected input keeps
+its default), else 0: ``--set NAME.value=...`` sets it, as OMSimulator's ``setReal`` sets
+a top-level input.
 """
 
 from __future__ import annotations
@@ -69,6 +71,9 @@ class Wiring:
         self.reader, self.b, self.me, self.top = reader, b, me, top
         self.inputs: dict[str, list[str]] = {}
         self.outputs: dict[str, str] = {}
+        self.fed: dict[str, list[tuple[End, float, float]]] = {}
+        """The element ends each of the system's input connectors feeds, with the (factor,
+        offset) on the way: where a top-level input's start value comes from."""
         self.count = 0
 
     def fail(self, line: int | None, message: str, hint: str = "") -> None:
@@ -110,6 +115,8 @@ class Wiring:
         if src.kind == "parameter":
             self.me.links.append((src.connector, dst.element, dst.connector, (factor, offset), line))
             return
+        if src.system:
+            self.fed.setdefault(src.connector, []).append((dst, factor, offset))
         where = Site(self.reader.file, line)
         if factor == 1.0 and offset == 0.0:
             self.wire(src.text, dst.text, where)
@@ -236,25 +243,40 @@ class Wiring:
             self.b.connect(src, dst, where=where)
 
     def held_input(self, name: str, targets: list[str], where: Site) -> None:
-        """A top-level input connector: a ``Constant`` of its name feeding ``targets``."""
+        """A top-level input connector: a ``Constant`` of its name feeding ``targets``, at
+        the value a binding gives the connector, else the start value of the FMU inputs it
+        feeds (SSP 2.0, 5.3.1: an unconnected input keeps its default value), else 0."""
         me = self.me
         block = port_name(name)
         while block in me.elements:
             block = "_" + block
         connector, bound = me.connectors[name], me.values.get(name)
-        value: Any = 0.0
         if bound is not None:
             try:
                 value = bound.value_in(connector.unit, self.reader.units)
             except BindingError as exc:
                 self.reader.fail(exc.line, str(exc), exc.hint, file=exc.file)
                 return
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            self.reader.fail(bound.line, f"the system's input connector '{name}' is bound to {value!r}, not a number",
-                             file=bound.file)
-            return
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                self.reader.fail(bound.line, f"the system's input connector '{name}' is bound to {value!r}, not a "
+                                 "number", file=bound.file)
+                return
+        else:
+            value = self.start_value(name)
         self.b.add(block, "Constant", params={"value": float(value)}, where=where)
         if connector.unit:
             self.b.annotate(f"{block}.y", units=connector.unit, where=where)
         for target in targets:
             self.b.connect(f"{block}.y", target, where=where)
+
+    def start_value(self, name: str) -> float:
+        """The value of the system's input ``name`` that gives the FMU inputs it feeds their
+        start values (through the conversions on the way), where they all declare one and
+        agree; else 0."""
+        found = set()
+        for end, factor, offset in self.fed.get(name, []):
+            start = self.reader.start_of(self.me.elements[end.element], end.connector)
+            if start is None or factor == 0.0:
+                return 0.0
+            found.add((start - offset) / factor)
+        return found.pop() if len(found) == 1 else 0.0

@@ -84,11 +84,15 @@ def fmu_definitions(md: Any) -> Definitions:
 
 def definition(name: str, *tables: Definitions) -> BaseUnit | None:
     """The definition of unit ``name``: the first of ``tables`` that defines it, else
-    pint's reading of it (as written, else in Modelica's notation); None if none knows it."""
+    pint's reading of it (as written, else in Modelica's notation); None if none knows it.
+    A name in brackets (``[m]``, as some tools write a value's unit) is the unit inside."""
     for table in tables:
         if name in table:
             return table[name]
-    return base_unit(name) or base_unit(pint_text(name))
+    found = base_unit(name) or base_unit(pint_text(name))
+    if found is None and len(name) > 2 and name[0] == "[" and name[-1] == "]":
+        return definition(name[1:-1], *tables)
+    return found
 
 
 def pint_text(name: str) -> str:

@@ -224,6 +224,8 @@ def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dic
                 raise BindingError(file, transformation.sourceline, "ssc:LinearTransformation: factor and offset "
                                    "must be numbers") from None
         source, target = entry.get("source"), entry.get("target")
+        if source == "" and target:
+            continue  # an entry of no source maps nothing (OMSimulator writes them for unmapped targets)
         if not source or not target:
             raise BindingError(file, entry.sourceline, "ssm:MappingEntry needs 'source' and 'target'")
         if target in targets:

@@ -27,7 +27,8 @@ builder's. The translation:
   with a unit is converted into its parameter's unit (the FMU variable's, else its
   ``kind="parameter"`` connector's; ``blocks.ssp.parameters``);
 - an input connector of the top-level system -> a ``Constant`` block of its name, holding
-  the value a top-level binding gives it (else 0): ``--set NAME.value=...`` sets it;
+  the value a top-level binding gives it, else the start of the FMU inputs it feeds, else
+  0 (``blocks.ssp.connections``): ``--set NAME.value=...`` sets it;
 - ``ssd:DefaultExperiment`` stopTime -> the end time; an input or output connector's
   ``unit`` -> the port's unit, checked against the FMU's own and the other end's by the
   builder.
@@ -379,6 +380,16 @@ class _Reader:
                     self.assign(found, tail, v, head)
                     break
                 target, rest = found, tail
+
+    def start_of(self, me: Element, name: str) -> float | None:
+        """The start value the FMU of component ``me`` declares for its Real variable
+        ``name``; None for a system, an FMU that cannot be read, a variable without one."""
+        md = self.description(me) if me.kind == "component" else False
+        variable = next((x for x in md.modelVariables if x.name == name), None) if md else None
+        try:
+            return float(variable.start) if variable is not None and variable.start is not None else None
+        except (TypeError, ValueError):
+            return None
 
     def enumeration_item(self, v: Value, variable: Any, component: str) -> Any:
         """The number of the item ``v`` names in its FMU variable's enumeration type (the name

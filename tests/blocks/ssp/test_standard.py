@@ -10,6 +10,9 @@ import pytest
 
 from blocks import DiagramError, Results, load_diagram, simulate
 
+from blocks.ssp.conversion import UnitError, conversion
+from blocks.units import BaseUnit
+
 from .conftest import NAMESPACES, schema_errors, variant, write_ssp
 
 UNITS_FMU = (
@@ -119,6 +122,16 @@ def test_set_on_the_command_line_sets_a_top_level_input(first_order_library, tmp
     assert results["body.y"][1][1, 0] == pytest.approx(0.5 * -4.905 - 1.0, rel=1e-15)
 
 
+def test_an_unbound_top_level_input_holds_the_start_value_of_the_fmu_input_it_feeds(first_order_library, tmp_path):
+    text = dymola_ssd().replace('<ssv:Parameter name="push"><ssv:Real value="2500" unit="mm/s2"/></ssv:Parameter>', "")
+    fmu = variant(first_order_library, *UNITS_FMU, ('<Real start="0.0"/>', '<Real start="2.0"/>'))  # u starts at 2
+    folder = write_ssp(tmp_path / "dymola", text, fmu)
+    assert schema_errors(folder / "SystemStructure.ssd") == []
+    result = simulate(load_diagram(folder))
+    assert result["push.y"][1][0, 0] == pytest.approx(2000.0, rel=1e-15)  # 2 m/s2 in the connector's mm/s2
+    assert result["body.y"][1][1, 0] == pytest.approx(0.5 * -4.905 + 2.0, rel=1e-15)
+
+
 @pytest.mark.parametrize("value, message", [
     ('<ssv:Real value="3" unit="s"/>', "'s' does not convert to unit 'm/s2'"),
     ('<ssv:Real value="3" unit="zorks"/>', "unit 'zorks' is defined nowhere"),
@@ -156,6 +169,7 @@ OMS_SSM = """<?xml version='1.0' encoding='utf-8'?>
   <ssm:MappingEntry source="gain_pct" target="body.a"><ssc:LinearTransformation factor="0.01"/></ssm:MappingEntry>
   <ssm:MappingEntry source="sink.threshold" target="sink.threshold"/>
   <ssm:MappingEntry source="sink.a" target="sink.a"/>
+  <ssm:MappingEntry source="" target="sink.b"/>
 </ssm:ParameterMapping>
 """
 
@@ -191,7 +205,7 @@ def test_an_omsimulator_style_ssd_maps_its_values_converts_their_units_and_then_
     body, sink = diagram.blocks["body"].params["start_values"], diagram.blocks["sink"].params["start_values"]
     # -490.5 cm/s2 (read by pint in Modelica's notation) is -4.905 m/s2, then 2 x + 1 (SSP 1.0, 7.1.1)
     assert body == pytest.approx({"x0": 2 * -4.905 + 1, "a": 0.5}, rel=1e-15)
-    assert sink == {"threshold": 1e9, "a": 0.0}  # sink.b is in no mapping entry: not applied
+    assert sink == {"threshold": 1e9, "a": 0.0}  # sink.b is the source of no mapping entry: not applied
     result = simulate(diagram)
     # -8.81 m/s2 is -8810 mm/s2, then + 5; the sink (x[k+1] = u[k], b = 1) holds it from its second step
     assert result["sink.y"][1][1, 0] == pytest.approx(-8805.0, rel=1e-15)
@@ -249,3 +263,25 @@ def test_an_enumeration_value_is_the_number_of_its_item_in_the_fmus_type(first_o
                                               "</ssd:System>").replace("{}", "double"), fmu)
     with pytest.raises(DiagramError, match="'double' is no item of the FMU's enumeration type of 'scale'"):
         load_diagram(folder)
+
+
+@pytest.mark.parametrize("source, target, tables, want", [
+    ("cm/s2", "m/s2", (), (0.01, 0.0)),  # Modelica's notation, read by pint
+    ("[cm/s2]", "m/s2", (), (0.01, 0.0)),  # a unit in brackets, as some tools write values' units
+    ("degC", "K", (), (1.0, 273.15)),
+    ("kg.m2", "g.cm2", (), (1e7, 0.0)),
+    ("a", "b", ({"a": BaseUnit((("m", 1),), 2.0, 1.0), "b": BaseUnit((("m", 1),), 4.0, 0.0)},), (0.5, 0.25)),
+    ("m", "m", (), (1.0, 0.0)),
+])
+def test_units_convert_as_their_definitions_or_pint_say(source, target, tables, want):
+    factor, offset = conversion(source, target, *tables)
+    assert factor == pytest.approx(want[0], rel=1e-12) and offset == pytest.approx(want[1], rel=1e-12, abs=1e-12)
+
+
+@pytest.mark.parametrize("source, target, message", [
+    ("m", "s", "measure different quantities"),
+    ("zorks", "m", "unit 'zorks' is defined nowhere"),
+])
+def test_units_that_do_not_convert_are_refused(source, target, message):
+    with pytest.raises(UnitError, match=message):
+        conversion(source, target)
