@@ -1,8 +1,11 @@
 """Exact time: durations as rationals parsed from decimal text, ticks as integers.
 
 Periods, offsets and end times are ``fractions.Fraction`` seconds, parsed from the
-decimal text the user wrote (``"0.1 ms"``, ``"100us"``, ``0.5``), never through a
-binary float, so that 0.1 ms is exactly 1/10000 s and rate coincidences are exact.
+decimal text the user wrote (``"0.1 ms"``, ``"100us"``, ``0.5``, ``"1 min"``), never
+through a binary float, so that 0.1 ms is exactly 1/10000 s and rate coincidences are
+exact. Any unit of time pint knows is read (``min``, ``h``, ``day``, ``hour``): its
+length in seconds as the shortest decimal of pint's factor, exact for every unit that is
+a decimal number of seconds.
 """
 
 from __future__ import annotations
@@ -14,8 +17,11 @@ from functools import reduce
 
 _UNITS = {"s": Fraction(1), "ms": Fraction(1, 1000), "us": Fraction(1, 10**6),
           "µs": Fraction(1, 10**6), "ns": Fraction(1, 10**9)}
+"""The units durations are written back in; read without pint, as are ``min`` and ``h``."""
+_READ_UNITS = {**_UNITS, "min": Fraction(60), "h": Fraction(3600)}
 _DURATION = re.compile(
-    r"^\s*(?P<num>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<unit>s|ms|us|µs|ns)?\s*$")
+    r"^\s*(?P<num>[+-]?(?:\d+(?:\.\d*)?|\.\d+)(?:[eE][+-]?\d+)?)\s*(?P<unit>[^\W\d][\w]*)?\s*$")
+UNITS_SHOWN = "s, ms, us, ns, min, h or any unit of time pint knows"
 
 
 MIN_DURATION = Fraction(1, 10**12)
@@ -56,10 +62,24 @@ def parse_duration(value: object) -> Fraction:
             mantissa, _, exponent = m["num"].lower().partition("e")
             if exponent and abs(int(exponent)) > 30:
                 raise DurationError(f"duration {value!r} is out of range (1e-12 s to 1e9 s)")
-            return _in_range(Fraction(m["num"]) * _UNITS[m["unit"] or "s"], value)
+            per = _seconds_per(m["unit"] or "s")
+            if per is not None:
+                return _in_range(Fraction(m["num"]) * per, value)
     raise DurationError(
         f"cannot read {value!r} as a duration; write a number of seconds or a number "
-        "with a unit: s, ms, us, ns (e.g. '0.1 ms')")
+        f"with a unit of time: {UNITS_SHOWN} (e.g. '0.1 ms', '2 min')")
+
+
+def _seconds_per(unit: str) -> Fraction | None:
+    """The seconds in one ``unit``: exact for s, ms, us, ns, min and h, else pint's factor
+    as its shortest decimal; None when pint does not know it as a unit of time."""
+    found = _READ_UNITS.get(unit)
+    if found is not None:
+        return found
+    from .units import seconds_in
+
+    seconds = seconds_in(unit)
+    return None if seconds is None else Fraction(repr(seconds))
 
 
 def positive_duration(value: object, what: str) -> Fraction:

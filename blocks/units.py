@@ -92,6 +92,21 @@ def base_unit(unit: str) -> BaseUnit | None:
 
 
 @functools.cache
+def seconds_in(unit: str) -> float | None:
+    """The seconds in one ``unit`` (``"day"``: 86400.0), or None when pint cannot read it
+    or it is not a unit of time (``"m"``, ``"s^2"``); finite and positive."""
+    registry = _registry()
+    try:
+        quantity = registry.Quantity(1.0, unit)
+        if quantity.dimensionality != registry.second.dimensionality:
+            return None
+        seconds = float(quantity.to(registry.second).magnitude)
+    except Exception:  # pint raises many kinds for a text it cannot read
+        return None
+    return seconds if math.isfinite(seconds) and seconds > 0 else None
+
+
+@functools.cache
 def _pint_same(a: str, b: str) -> bool:
     registry = _registry()
     try:

@@ -10,7 +10,8 @@ A signal is ``block.port``; some of its elements are written after it in bracket
 
 A label is matched before an index, so a block whose elements are labelled ``1``, ``2``
 (an FMU's ``y[1]``) is selected by those labels. Connections (``c.y[1] -> g.u``,
-``a.y -> g.u[0]``) and ``hierhand plot -s`` read elements through ``pick``.
+``a.y -> g.u[0]``), ``hierhand plot -s`` and a sweep's ``--metric final(plant.q[1])``
+read elements through ``pick``, so ``q[1]`` is one element in every command.
 """
 
 from __future__ import annotations
@@ -53,6 +54,19 @@ def split_signal(text: str) -> tuple[str, str | None] | None:
     if found is None:
         return None
     return found.group(1), None if found.group(2) is None else found.group(2).strip()
+
+
+def split_signals(text: str) -> list[str]:
+    """The comma-separated parts of a list of signals (``"plant.q[1,1], ref.y"``), commas
+    inside brackets kept: a plot's selection, a metric's arguments."""
+    found, depth, start = [], 0, 0
+    for i, ch in enumerate(text):
+        depth += (ch == "[") - (ch == "]")
+        if ch == "," and depth == 0:
+            found.append(text[start:i])
+            start = i + 1
+    found.append(text[start:])
+    return [p.strip() for p in found]
 
 
 def parts(spec: str) -> list[str]:

@@ -20,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from blocks.builder.elements import ElementError, pick, split_signal
+from blocks.builder.elements import ElementError, pick, split_signal, split_signals
 
 
 class SelectionError(ElementError):
@@ -40,18 +40,6 @@ class Trace:
     @property
     def whole(self) -> bool:
         return self.title == self.signal
-
-
-def split_signals(text: str) -> list[str]:
-    """The comma-separated parts of a selection, commas inside brackets kept."""
-    parts, depth, start = [], 0, 0
-    for i, ch in enumerate(text):
-        depth += (ch == "[") - (ch == "]")
-        if ch == "," and depth == 0:
-            parts.append(text[start:i])
-            start = i + 1
-    parts.append(text[start:])
-    return [p.strip() for p in parts]
 
 
 def select(results: Any, text: str) -> list[Trace]:

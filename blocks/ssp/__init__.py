@@ -5,9 +5,11 @@ of co-simulation (or model-exchange) FMUs into a ``DiagramBuilder`` (``reader``)
 ``blocks.load_diagram`` builds like any diagram; ``export_ssp`` writes a diagram as an SSP
 whose components are FMUs (``writer``; ``components``: a block or subsystem as the diagram
 its FMU is exported from). Modules: ``package`` (the archive or folder, its files), ``xml``
-(namespaces, safe parsing), ``parameters`` (bindings, ``.ssv``, ``.ssm``), ``steps`` (the
-step-size annotations of libcosim and OMSimulator, and blocks' own stepping one),
-``units`` (``ssd:Units`` from the FMUs).
+(namespaces, safe parsing), ``parameters`` (bindings, ``.ssv``, ``.ssm``), ``connections``
+(an SSD's connections as wires, conversions and held top-level inputs), ``conversion``
+(units read: their definitions and conversions), ``steps`` (the step-size annotations of
+libcosim and OMSimulator, and blocks' own stepping one), ``units`` (``ssd:Units`` from the
+FMUs, for export).
 """
 
 import importlib

@@ -3,18 +3,25 @@
 
 A binding (``ssd:ParameterBinding``) gives a parameter set (``ssv:ParameterSet``: inline in
 ``ssd:ParameterValues``, or the ``.ssv`` file its ``source`` names), optionally a mapping
-(inline ``ssm:ParameterMapping`` or an ``.ssm`` file) and a ``prefix`` put before every
-name. A mapping entry maps the set's parameter ``source`` to the name ``target``, through
-its ``ssc:LinearTransformation`` if it has one; parameters no entry names keep their
-names. Values are Real / Float as float, integers as int, Boolean as bool, String as str.
+(inline ``ssm:ParameterMapping`` or an ``.ssm`` file) and a ``prefix``. As SSP 1.0 says
+(5.2.3), the prefix is put before every name of the set first, and the mapping then
+applies to the prefixed names: an entry maps the parameter ``source`` to the name
+``target`` (one source may go to several targets, two sources never to one), and a
+parameter no entry names is not applied. Values are Real / Float as float, integers as
+int, Boolean as bool, String as str, Enumeration as its item's name (``Value.enumeration``). A Real value may carry a unit (defined in the set's
+``ssv:Units``, or by name); ``value`` converts it into the unit of the parameter it lands
+on and then applies the entry's ``ssc:LinearTransformation`` (SSP 1.0, 7.1.1: the
+transformation after the unit conversion, or instead of it with
+``suppressUnitConversion``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
+from .conversion import Definitions, UnitError, conversion, definition, read_definitions
 from .package import Package, PackageError
 from .xml import XmlError, child, children, elements, local, q
 
@@ -32,6 +39,43 @@ class Value:
     value: Any
     file: str
     line: int | None
+    unit: str | None = None
+    """The unit the value is written in (``ssv:Real unit``), if any."""
+    units: Definitions = field(default_factory=dict, compare=False)
+    """The unit definitions of the file it is written in (its set's ``ssv:Units``)."""
+    transform: tuple[float, float] | None = None
+    """The (factor, offset) of its mapping entry's linear transformation, if any."""
+    convert: bool = True
+    """False where its mapping entry suppresses the unit conversion."""
+    enumeration: bool = False
+    """An ``ssv:Enumeration`` value: ``value`` the item's name, which its FMU variable's type numbers."""
+
+    def value_in(self, unit: str | None, *tables: Definitions) -> Any:
+        """The value for a parameter of unit ``unit`` (None: it declares none): converted
+        from the unit it is written in (definitions: the set's, then ``tables``), then
+        transformed by its mapping entry; BindingError where it cannot be converted."""
+        value = self.value
+        if self.unit and self.convert and isinstance(value, float) and not self._dimensionless():
+            if not unit:
+                raise BindingError(self.file, self.line, f"parameter '{self.name}' is given in '{self.unit}', but "
+                                   "the parameter declares no unit to convert it into",
+                                   "leave out the value's unit to set it as it is, or declare the parameter's unit "
+                                   "(its FMU variable's, or a kind='parameter' connector's ssc:Real unit)")
+            try:
+                factor, offset = conversion(self.unit, unit, self.units, *tables)
+            except UnitError as exc:
+                raise BindingError(self.file, self.line, f"parameter '{self.name}' = {value!r} {self.unit} cannot be "
+                                   f"set in the parameter's unit '{unit}': {exc}",
+                                   "give the value in the parameter's unit, define both units (ssc:Unit), or set "
+                                   "suppressUnitConversion on a mapping entry") from None
+            value = factor * value + offset
+        if self.transform is not None:
+            value = self.transform[0] * value + self.transform[1]
+        return value
+
+    def _dimensionless(self) -> bool:
+        found = definition(self.unit, self.units)
+        return found is not None and not found.exponents and found.factor == 1.0 and found.offset == 0.0
 
 
 class BindingError(ValueError):
@@ -75,16 +119,15 @@ def binding_values(package: Package, ssd_file: str, bindings: Any, read: Reader)
                                "source='resources/values.ssv' or an inline ssv:ParameterSet")
         mapping = _mapping(package, ssd_file, child(binding, "ssd", "ParameterMapping"), read)
         for v in given:
-            if v.name in mapping:
-                target, factor, offset = mapping[v.name]
-                value = v.value
-                if factor != 1.0 or offset != 0.0:
-                    if not isinstance(value, float):
-                        raise BindingError(v.file, v.line, f"parameter '{v.name}': a linear transformation maps "
-                                           "only Real values")
-                    value = factor * value + offset
-                v = Value(target, value, v.file, v.line)
-            values.append(Value(prefix + v.name, v.value, v.file, v.line))
+            v = replace(v, name=prefix + v.name)
+            if mapping is None:
+                values.append(v)
+                continue
+            for target, transform, convert in mapping.get(v.name, ()):
+                if transform is not None and not isinstance(v.value, float):
+                    raise BindingError(v.file, v.line, f"parameter '{v.name}': a linear transformation maps "
+                                       "only Real values")
+                values.append(replace(v, name=target, transform=transform, convert=convert))
     return values
 
 
@@ -104,14 +147,19 @@ def _read(package: Package, ssd_file: str, line: int | None, source: str, read: 
 def _parameter_set(root: Any, file: str) -> list[Value]:
     if root.tag != q("ssv", "ParameterSet"):
         raise BindingError(file, root.sourceline, f"expected an ssv:ParameterSet, found <{local(root)}>")
+    try:
+        units = read_definitions(child(root, "ssv", "Units"))
+    except UnitError as exc:
+        raise BindingError(file, exc.line, str(exc)) from None
     out = []
     for parameter in children(child(root, "ssv", "Parameters"), "ssv", "Parameter"):
         name = parameter.get("name")
-        typed = elements(parameter)
+        typed = [e for e in elements(parameter) if local(e) != "Annotations"]
         if not name or not typed:
             raise BindingError(file, parameter.sourceline, "ssv:Parameter needs a name and a typed value",
                                "<ssv:Parameter name='k'><ssv:Real value='2'/></ssv:Parameter>")
-        out.append(Value(name, _value(typed[0], name, file), file, parameter.sourceline))
+        out.append(Value(name, _value(typed[0], name, file), file, parameter.sourceline, typed[0].get("unit") or None,
+                         units, enumeration=local(typed[0]) == "Enumeration"))
     return out
 
 
@@ -127,18 +175,22 @@ def _value(element: Any, name: str, file: str) -> Any:
             if text.strip() not in ("true", "false", "1", "0"):
                 raise ValueError(text)
             return text.strip() in ("true", "1")
-        if kind == "String" and text is not None:
+        if kind in ("String", "Enumeration") and text is not None:
             return text
     except ValueError:
         raise BindingError(file, line, f"parameter '{name}': {text!r} is not an ssv:{kind} value") from None
     raise BindingError(file, line, f"parameter '{name}': values of type ssv:{kind} are not supported",
-                       "Real, Float64, Float32, Integer and IntN, Boolean and String values are")
+                       "Real, Float64, Float32, Integer and IntN, Boolean, String and Enumeration values are")
 
 
-def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dict[str, tuple[str, float, float]]:
-    """source name -> (target name, factor, offset) of an ``ssd:ParameterMapping``."""
+Entry = tuple[str, "tuple[float, float] | None", bool]
+"""A mapping entry: its target, its linear transformation's (factor, offset), whether it converts units."""
+
+
+def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dict[str, list[Entry]] | None:
+    """source name -> its entries, of an ``ssd:ParameterMapping`` (None: the binding has none)."""
     if element is None:
-        return {}
+        return None
     line = element.sourceline
     kind = element.get("type", MAPPING_TYPE)
     if kind != MAPPING_TYPE:
@@ -155,9 +207,10 @@ def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dic
                                "ssm:ParameterMapping")
     if root.tag != q("ssm", "ParameterMapping"):
         raise BindingError(file, root.sourceline, f"expected an ssm:ParameterMapping, found <{local(root)}>")
-    out = {}
+    out: dict[str, list[Entry]] = {}
+    targets: set[str] = set()
     for entry in children(root, "ssm", "MappingEntry"):
-        factor, offset = 1.0, 0.0
+        transform = None
         for transformation in elements(entry):
             what = local(transformation)
             if what == "Annotations":
@@ -166,13 +219,19 @@ def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dic
                 raise BindingError(file, transformation.sourceline, f"ssc:{what} in a parameter mapping is not "
                                    "supported", "ssc:LinearTransformation is")
             try:
-                factor = float(transformation.get("factor", "1"))
-                offset = float(transformation.get("offset", "0"))
+                transform = float(transformation.get("factor", "1")), float(transformation.get("offset", "0"))
             except ValueError:
                 raise BindingError(file, transformation.sourceline, "ssc:LinearTransformation: factor and offset "
                                    "must be numbers") from None
         source, target = entry.get("source"), entry.get("target")
+        if source == "" and target:
+            continue  # an entry of no source maps nothing (OMSimulator writes them for unmapped targets)
         if not source or not target:
             raise BindingError(file, entry.sourceline, "ssm:MappingEntry needs 'source' and 'target'")
-        out[source] = (target, factor, offset)
+        if target in targets:
+            raise BindingError(file, entry.sourceline, f"ssm:MappingEntry: two entries map to '{target}'",
+                               "a parameter mapping maps one source to each target (SSP 1.0, 7.1)")
+        targets.add(target)
+        convert = entry.get("suppressUnitConversion") not in ("true", "1")
+        out.setdefault(source, []).append((target, transform, convert))
     return out

@@ -10,19 +10,28 @@ builder's. The translation:
   its parameter bindings, ``interface`` from ``implementation``, its period from the step
   annotations (``blocks.ssp.steps``): its ``osp:StepSizeHint`` (on libcosim's grid when an
   ``osp:FixedStepAlgorithm`` gives one), else its system's OMSimulator ``FixedStepMaster``,
-  else the base step, else the step given to ``read_ssp`` (``--step``); none of them is
-  an error naming the component;
+  else the base step, else the step given to ``read_ssp`` (``--step``), else the FMU's
+  own ``DefaultExperiment`` stepSize (as a diagram's FMU block without a period); none of
+  them is an error naming the component;
 - a nested ``ssd:System`` -> a subsystem of its components, whose ports are its
   connectors (inputs feed the inner connections that start at them, outputs are the one
   that ends at them);
-- ``ssd:Connection`` -> a wire, an element connector (``q[3]``, an FMU's vector element)
-  a connection by element (``plant.q[3]``); an ``ssc:LinearTransformation`` on it a
-  ``Gain`` and/or ``Bias`` block between its ends, as is a unit conversion between two
-  connectors whose units (``ssd:Units``) differ in factor or offset;
+- ``ssd:Connection`` -> a wire, its direction the data flow its connectors' kinds give
+  (start and end say nothing of it, SSP 1.0 5.3.2), an element connector (``q[3]``, an
+  FMU's vector element) a connection by element (``plant.q[3]``); a unit conversion
+  between connectors whose units differ in factor or offset (defined by ``ssd:Units``,
+  else known to pint) and then the ``ssc:LinearTransformation`` on it (SSP 1.0 4.5.2.1:
+  conversion first) a ``Gain`` and/or ``Bias`` block between its ends;
 - parameter bindings of a system name their parameters ``element.parameter`` (through
-  nested systems ``sub.element.parameter``) and win over the component's own;
-- ``ssd:DefaultExperiment`` stopTime -> the end time; a connector's ``unit`` -> the port's
-  unit, checked against the FMU's own and the other end's by the builder.
+  nested systems ``sub.element.parameter``) and win over the component's own; a value
+  with a unit is converted into its parameter's unit (the FMU variable's, else its
+  ``kind="parameter"`` connector's; ``blocks.ssp.parameters``);
+- an input connector of the top-level system -> a ``Constant`` block of its name, holding
+  the value a top-level binding gives it, else the start of the FMU inputs it feeds, else
+  0 (``blocks.ssp.connections``): ``--set NAME.value=...`` sets it;
+- ``ssd:DefaultExperiment`` stopTime -> the end time; an input or output connector's
+  ``unit`` -> the port's unit, checked against the FMU's own and the other end's by the
+  builder.
 
 Every output is logged. What is not supported (signal dictionaries, array connectors
 and indices, components that are not FMUs, other transformations, a start time other
@@ -31,26 +40,28 @@ than 0) is one error naming the element and its line.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
 
-from blocks.builder.context import known, suggest
+from blocks.builder.context import known
 from blocks.builder.diagram_builder import DiagramBuilder
+from ..fmu.description import FMUInfoError, read_description, step_of, variable_unit
 from ..fmu.ports import port_name, port_of
 from ..issues import DiagramError, Issue
 from blocks.builder.records import Site
 from blocks.builder.scopes import NAME
 from ..timebase import DurationError, parse_duration
+from .connections import Wiring
+from .conversion import Definitions, UnitError, fmu_definitions, read_definitions
 from .package import Package, PackageError, open_package
-from .parameters import BindingError, binding_values
+from .parameters import BindingError, Value, binding_values
 from .steps import base_step, feedthrough, libcosim_period, step_hint, system_step
 from .xml import XmlError, child, children, elements, exact, local, parse_file, q, shown
 
 FMU_TYPE = "application/x-fmu-sharedlibrary"
 IMPLEMENTATIONS = {"any": None, "CoSimulation": "co_simulation", "ModelExchange": "model_exchange"}
-CONNECTION_PARTS = ("ConnectionGeometry", "Annotations")
 STEP_HINT = ("add <ssd:Annotations><ssc:Annotation type='com.opensimulationplatform'><osp:StepSizeHint "
              "value='0.001'/>... to it, or pass --step (Python: read_ssp(..., step='1 ms'))")
 
@@ -67,13 +78,21 @@ class Connector:
 
 @dataclass
 class Element:
-    """An element of a system: a component (its ``start_values``) or a nested system."""
+    """An element of a system: a component (its FMU and ``start_values``) or a nested
+    system (its ``values``: those its bindings give its own connectors)."""
 
     kind: str
     connectors: dict[str, Connector]
     start_values: dict[str, Any] = field(default_factory=dict)
     system: "Element | None" = None
     elements: dict[str, "Element"] = field(default_factory=dict)
+    fmu: Path | None = None
+    md: Any = None
+    """The FMU's modelDescription (fmpy's), read when a value's unit needs it; False: unreadable."""
+    values: dict[str, Value] = field(default_factory=dict)
+    links: list[tuple[str, str, str, tuple[float, float], int | None]] = field(default_factory=list)
+    """A system's parameter connections: (its connector, element, the element's parameter,
+    (factor, offset), line), applied once every binding is read (``parameters``)."""
 
 
 def read_ssp(path: str | Path, trust: bool = False, step: Any = None) -> DiagramBuilder:
@@ -97,7 +116,7 @@ class _Reader:
         self.file = package.where(package.ssd)
         self.b: DiagramBuilder | None = None
         self.base: Fraction | None = None
-        self.units: dict[str, tuple[tuple, float, float]] = {}
+        self.units: Definitions = {}
         self.texts: list[str] = []
 
     # -- reporting ---------------------------------------------------------------------
@@ -133,8 +152,11 @@ class _Reader:
             self.fail(root.sourceline, "the SSD has no ssd:System")
             return b
         self.experiment(child(root, "ssd", "DefaultExperiment"))
-        self.read_units(child(root, "ssd", "Units"))
-        self.system(system, b, None)
+        try:
+            self.units = read_definitions(child(root, "ssd", "Units"))
+        except UnitError as exc:
+            self.fail(exc.line, str(exc))
+        self.parameters(self.system(system, b, None, top=True))
         b.log_all(where=self.site(system))
         b.texts.extend(self.texts)
         return b
@@ -159,22 +181,6 @@ class _Reader:
         if found is not None:
             self.base = self.step_value(found[0], found[1], "osp:FixedStepAlgorithm baseStepSize")
 
-    def read_units(self, units: Any) -> None:
-        """``ssd:Units``: each unit's base-unit exponents, factor and offset."""
-        for unit in children(units, "ssc", "Unit"):
-            base = child(unit, "ssc", "BaseUnit")
-            if base is None or not unit.get("name"):
-                continue
-            attrs = dict(base.attrib)
-            try:
-                factor, offset = float(attrs.pop("factor", 1.0)), float(attrs.pop("offset", 0.0))
-                exponents = tuple(sorted((k, int(v)) for k, v in attrs.items() if int(v) != 0))
-            except ValueError:
-                self.fail(base.sourceline, f"ssc:Unit '{unit.get('name')}': its ssc:BaseUnit attributes must be "
-                          "numbers")
-                continue
-            self.units[unit.get("name")] = (exponents, factor, offset)
-
     def step_value(self, text: str, line: int | None, what: str) -> Fraction | None:
         value = _number(text)
         if value is None or value <= 0:
@@ -184,8 +190,9 @@ class _Reader:
 
     # -- systems -----------------------------------------------------------------------
 
-    def system(self, element: Any, b: DiagramBuilder, inherited: Fraction | None) -> Element:
-        """Say the ``ssd:System`` ``element`` to ``b``; its elements, for the bindings."""
+    def system(self, element: Any, b: DiagramBuilder, inherited: Fraction | None, top: bool = False) -> Element:
+        """Say the ``ssd:System`` ``element`` to ``b`` (``top``: the SSD's own system); its
+        elements, for the bindings."""
         oms = system_step(element)
         step = self.step_value(oms[0], oms[1], "oms:FixedStepMaster stepSize") if oms else inherited
         me = Element("system", self.connectors(element, system=True))
@@ -213,13 +220,14 @@ class _Reader:
                                      where=self.site(item))
                 sub.label = f"system '{name}' ({self.file}:{item.sourceline})"
                 found = self.system(item, sub, step)
-                b.add_subsystem(name, sub, where=self.site(item))
+                if found.elements:  # a system of nothing but parameters (OMSimulator writes them) runs nothing
+                    b.add_subsystem(name, sub, where=self.site(item))
             else:
                 found = self.component(item, name, b, step)
             if found is not None:
                 me.elements[name] = found
-        self.connections(element, b, me)
         self.system_bindings(element, me)
+        self.connections(element, b, me, top)
         return me
 
     def connectors(self, element: Any, system: bool) -> dict[str, Connector]:
@@ -261,26 +269,29 @@ class _Reader:
             self.fail(line, f"component '{name}': source {exc}", "an FMU of the SSP, e.g. source='resources/"
                       "plant.fmu'", name=name)
             return None
-        me = Element("component", self.connectors(item, system=False))
+        me = Element("component", self.connectors(item, system=False), fmu=fmu)
         try:
             values = binding_values(self.package, self.file, child(item, "ssd", "ParameterBindings"), self.read_xml)
         except BindingError as exc:
             self.fail(exc.line, f"component '{name}': {exc}", exc.hint, name=name, file=exc.file)
             return None
         for v in values:
-            me.start_values[v.name] = v.value
-        period = self.period(item, name, system_step_)
+            self.assign(me, v.name, v, name)
+        period = self.period(item, name, system_step_, me)
         params: dict[str, Any] = {"path": self.package.relative(fmu), "start_values": me.start_values}
         if IMPLEMENTATIONS[implementation]:
             params["interface"] = IMPLEMENTATIONS[implementation]
         if feedthrough(item):
             params["feedthrough"] = True
         b.add(name, "FMU", period=period, params=params, where=self.site(item))
-        for port, (units, line) in _port_units(me.connectors.values()).items():
+        ports = [c for c in me.connectors.values() if c.kind in ("input", "output")]
+        for port, (units, line) in _port_units(ports).items():
             b.annotate(f"{name}.{port}", units=units, where=Site(self.file, line))
         return me
 
-    def period(self, item: Any, name: str, system_step_: Fraction | None) -> Fraction | None:
+    def period(self, item: Any, name: str, system_step_: Fraction | None, me: Element) -> Fraction | None:
+        """The component's period as the SSD, ``--step`` or its FMU gives it; None (and no
+        error) for the FMU's DefaultExperiment step, which the FMU block takes itself."""
         hint = step_hint(item)
         if hint is not None:
             value = self.step_value(hint[0], hint[1], f"component '{name}': osp:StepSizeHint")
@@ -296,147 +307,56 @@ class _Reader:
             except DurationError as exc:
                 self.fail(item.sourceline, f"component '{name}': the step given: {exc}")
                 return None
+        md = self.description(me)
+        if md is False or _default_step(md):
+            return None  # the FMU block steps at its FMU's DefaultExperiment step (or says why it cannot be read)
         self.fail(item.sourceline, f"component '{name}' has no step size: the SSD gives no osp:StepSizeHint, "
-                  "oms:FixedStepMaster or osp:FixedStepAlgorithm", STEP_HINT, name=name)
+                  "oms:FixedStepMaster or osp:FixedStepAlgorithm, and its FMU no DefaultExperiment stepSize",
+                  STEP_HINT, name=name)
         return None
+
+    def description(self, me: Element) -> Any:
+        """The modelDescription of component ``me``'s FMU, read once; False if it cannot be
+        read (the FMU block says why)."""
+        if me.md is None:
+            try:
+                me.md = read_description(me.fmu, self.package.where(me.fmu)).md
+            except FMUInfoError:
+                me.md = False
+        return me.md
+
+    def assign(self, me: Element, name: str, v: Value, component: str) -> None:
+        """Set parameter ``name`` of component ``me`` to the value ``v`` gives, converted into
+        the parameter's unit (the FMU variable's, else its parameter connector's)."""
+        unit, tables = None, (self.units,)
+        if v.unit or v.enumeration:
+            md = self.description(me)
+            variable = next((x for x in md.modelVariables if x.name == name), None) if md else None
+            if variable is None:  # an FMU that cannot be read, or no such variable: the FMU block says so
+                me.start_values[name] = replace(v, unit=None).value_in(None)
+                return
+            if v.enumeration:
+                me.start_values[name] = self.enumeration_item(v, variable, component)
+                return
+            connector = me.connectors.get(name)
+            unit = variable_unit(variable) or (connector.unit if connector is not None else None)
+            tables = (self.units, fmu_definitions(md))
+        try:
+            me.start_values[name] = v.value_in(unit, *tables)
+        except BindingError as exc:
+            self.fail(exc.line, f"component '{component}': {exc}", exc.hint, name=component, file=exc.file)
 
     # -- connections -------------------------------------------------------------------
 
-    def connections(self, element: Any, b: DiagramBuilder, me: Element) -> None:
-        inputs: dict[str, list[str]] = {}
-        outputs: dict[str, str] = {}
-        count = 0
-        for conn in children(child(element, "ssd", "Connections"), "ssd", "Connection"):
-            line = conn.sourceline
-            if conn.get("startIndices") is not None or conn.get("endIndices") is not None:
-                self.fail(line, "ssd:Connection startIndices/endIndices (array connectors) are not supported",
-                          "connect element connectors such as q[3] instead")
-                continue
-            src = self.end(me, conn.get("startElement"), conn.get("startConnector"), True, line)
-            dst = self.end(me, conn.get("endElement"), conn.get("endConnector"), False, line)
-            if src is None or dst is None:
-                continue
-            (src_text, src_unit), (dst_text, dst_unit) = src, dst
-            factor, offset = 1.0, 0.0
-            for part in elements(conn):
-                what = local(part)
-                if what in CONNECTION_PARTS:
-                    continue
-                if what != "LinearTransformation":
-                    self.fail(part.sourceline, f"ssc:{what} on a connection is not supported",
-                              "ssc:LinearTransformation is")
-                    src = None
-                    break
-                try:
-                    factor, offset = float(part.get("factor", "1")), float(part.get("offset", "0"))
-                except ValueError:
-                    self.fail(part.sourceline, "ssc:LinearTransformation: factor and offset must be numbers")
-                    src = None
-            if src is None:
-                continue
-            if conn.get("suppressUnitConversion") not in ("true", "1"):
-                conversion = self.conversion(src_unit, dst_unit, line)
-                if conversion is None:
-                    continue
-                factor, offset = factor * conversion[0], offset * conversion[0] + conversion[1]
-            where = Site(self.file, line)
-            if factor != 1.0 or offset != 0.0:
-                count += 1
-                stem = f"_lt{count}"
-                while stem in me.elements or f"{stem}_gain" in me.elements:
-                    stem = "_" + stem
-                chain_in = chain_out = None
-                if factor != 1.0:
-                    b.add(f"{stem}_gain", "Gain", params={"k": factor}, where=where)
-                    chain_in = chain_out = f"{stem}_gain"
-                if offset != 0.0:
-                    b.add(f"{stem}_bias", "Bias", params={"bias": offset}, where=where)
-                    if chain_out is not None:
-                        b.connect(f"{chain_out}.y", f"{stem}_bias.u", where=where)
-                    chain_in = chain_in or f"{stem}_bias"
-                    chain_out = f"{stem}_bias"
-                self.wire(b, src_text, f"{chain_in}.u", inputs, outputs, where)
-                self.wire(b, f"{chain_out}.y", dst_text, inputs, outputs, where)
-            else:
-                self.wire(b, src_text, dst_text, inputs, outputs, where)
-        for name, targets in inputs.items():
-            b.input(port_name(name), *targets, where=Site(self.file, me.connectors[name].line))
-        for name, source in outputs.items():
-            b.output(port_name(name), source, where=Site(self.file, me.connectors[name].line))
-
-    def wire(self, b: DiagramBuilder, src: str, dst: str, inputs: dict, outputs: dict, where: Site) -> None:
-        """A wire, or an end at the system's own connector (``("", name)``): an input fed,
-        an output given."""
-        if src.startswith(":"):
-            inputs.setdefault(src[1:], []).append(dst)
-        elif dst.startswith(":"):
-            if dst[1:] in outputs:
-                self.fail(where.line, f"the system's output connector '{dst[1:]}' is connected twice")
-            outputs[dst[1:]] = src
-        else:
-            b.connect(src, dst, where=where)
-
-    def end(self, me: Element, element: str | None, connector: str | None, start: bool,
-            line: int | None) -> tuple[str, str | None] | None:
-        """A connection's end as a wire end (``comp.q[3]``, ``sub.port``; ``:name`` for the
-        system's own connector) and its declared unit; None (reported) if it names nothing."""
-        which = "start" if start else "end"
-        if not connector:
-            self.fail(line, f"ssd:Connection needs a {which}Connector")
-            return None
-        if element is None:
-            c = me.connectors.get(connector)
-            if c is None:
-                self.fail(line, f"ssd:Connection {which}Connector {shown(connector)}: the system has no connector "
-                          "of that name", suggest(connector, list(me.connectors)) or
-                          f"its connectors: {known(list(me.connectors))}")
-                return None
-            wanted = "input" if start else "output"
-            if c.kind != wanted:
-                self.fail(line, f"ssd:Connection {which}s at the system's connector '{connector}' of kind "
-                          f"'{c.kind}'; a connection {which}s at a system's {wanted}")
-                return None
-            return f":{connector}", c.unit
-        found = me.elements.get(element)
-        if found is None:
-            names = list(me.elements)
-            self.fail(line, f"ssd:Connection {which}Element {shown(element)}: no element of that name in the system",
-                      suggest(element, names) or f"its elements: {known(names)}")
-            return None
-        c = found.connectors.get(connector)
-        if c is None:
-            names = list(found.connectors)
-            self.fail(line, f"ssd:Connection {which}Connector {shown(connector)}: element '{element}' declares no "
-                      "connector of that name", suggest(connector, names) or f"its connectors: {known(names)}")
-            return None
-        wanted = "output" if start else "input"
-        if c.kind != wanted:
-            self.fail(line, f"ssd:Connection {which}s at {element}.{connector} of kind '{c.kind}'; "
-                      f"a connection {which}s at an {wanted}")
-            return None
-        if found.kind == "system":
-            return f"{element}.{port_name(connector)}", c.unit
-        port, label = port_of(connector)
-        return (f"{element}.{port}" if label is None else f"{element}.{port}[{label}]"), c.unit
-
-    def conversion(self, a: str | None, b: str | None, line: int | None) -> tuple[float, float] | None:
-        """(factor, offset) from unit ``a`` to ``b`` as ``ssd:Units`` define them; (1, 0) when
-        they are one or either is not given; None (reported) when they do not convert."""
-        if a is None or b is None or a == b:
-            return 1.0, 0.0
-        ua, ub = self.units.get(a), self.units.get(b)
-        if ua is None or ub is None:
-            return 1.0, 0.0  # the builder compares units it knows
-        if ua[0] != ub[0]:
-            self.fail(line, f"ssd:Connection from unit '{a}' to unit '{b}': they measure different quantities",
-                      "connect connectors of one quantity, or set suppressUnitConversion and convert with an "
-                      "ssc:LinearTransformation")
-            return None
-        return ua[1] / ub[1], (ua[2] - ub[2]) / ub[1]
+    def connections(self, element: Any, b: DiagramBuilder, me: Element, top: bool) -> None:
+        """Say the system's connections to ``b`` (``blocks.ssp.connections``)."""
+        Wiring(self, b, me, top).connect_all(children(child(element, "ssd", "Connections"), "ssd", "Connection"))
 
     # -- bindings of a system ----------------------------------------------------------
 
     def system_bindings(self, element: Any, me: Element) -> None:
+        """A system's bindings: ``element.parameter`` (``sub.element.parameter``) a component's
+        parameter; a system's own input or parameter connector by its name (``sub.k``, ``k``)."""
         try:
             values = binding_values(self.package, self.file, child(element, "ssd", "ParameterBindings"),
                                     self.read_xml)
@@ -446,18 +366,70 @@ class _Reader:
         for v in values:
             target, rest = me, v.name
             while True:
+                if rest in target.connectors and target.connectors[rest].kind in ("input", "parameter"):
+                    target.values[rest] = v  # a value of a system's own connector (top-level inputs, parameters)
+                    break
                 head, dot, tail = rest.partition(".")
                 found = target.elements.get(head) if dot else None
                 if found is None:
-                    names = list(target.elements)
                     self.fail(v.line, f"parameter '{v.name}': no element '{head}' to bind it to",
-                              "a system's bindings name element.parameter; elements: " + known(names),
-                              file=v.file)
+                              "a system's bindings name element.parameter or one of its input or parameter "
+                              f"connectors; elements: {known(list(target.elements))}", file=v.file)
                     break
                 if found.kind == "component":
-                    found.start_values[tail] = v.value
+                    self.assign(found, tail, v, head)
                     break
                 target, rest = found, tail
+
+    def start_of(self, me: Element, name: str) -> float | None:
+        """The start value the FMU of component ``me`` declares for its Real variable
+        ``name``; None for a system, an FMU that cannot be read, a variable without one."""
+        md = self.description(me) if me.kind == "component" else False
+        variable = next((x for x in md.modelVariables if x.name == name), None) if md else None
+        try:
+            return float(variable.start) if variable is not None and variable.start is not None else None
+        except (TypeError, ValueError):
+            return None
+
+    def enumeration_item(self, v: Value, variable: Any, component: str) -> Any:
+        """The number of the item ``v`` names in its FMU variable's enumeration type (the name
+        as it is, reported, where the variable's type has no such item)."""
+        items = getattr(getattr(variable, "declaredType", None), "items", None) or []
+        for item in items:
+            if item.name == v.value:
+                return int(item.value)
+        names = [item.name for item in items]
+        self.fail(v.line, f"component '{component}': parameter '{v.name}' = '{v.value}' is no item of the FMU's "
+                  f"enumeration type of '{variable.name}'", f"its items: {known(names)}" if names else
+                  f"'{variable.name}' is not an Enumeration variable", name=component, file=v.file)
+        return v.value
+
+    def parameters(self, me: Element) -> None:
+        """Pass the values of system ``me``'s parameter connectors on along its parameter
+        connections, then those of its nested systems (a higher level's first: it wins)."""
+        for connector, name, parameter, (factor, offset), line in me.links:
+            v = me.values.get(connector)
+            target = me.elements[name]
+            if v is None:
+                continue  # an unbound system parameter leaves the element's own value
+            try:
+                value = v.value_in(me.connectors[connector].unit, self.units)
+            except BindingError as exc:
+                self.fail(exc.line, str(exc), exc.hint, file=exc.file)
+                continue
+            if (factor, offset) != (1.0, 0.0):
+                if not isinstance(value, float):
+                    self.fail(line, f"ssd:Connection from the system's parameter '{connector}': a unit conversion or "
+                              "linear transformation maps only Real values")
+                    continue
+                value = factor * value + offset
+            if target.kind == "component":
+                target.start_values[parameter] = value
+            else:
+                target.values[parameter] = Value(parameter, value, v.file, v.line, target.connectors[parameter].unit)
+        for element in me.elements.values():
+            if element.kind == "system":
+                self.parameters(element)
 
 
 def _port_units(connectors: Any) -> dict[str, tuple[str | list[str], int | None]]:
@@ -487,6 +459,15 @@ def _port_units(connectors: Any) -> dict[str, tuple[str | list[str], int | None]
         elif sorted(elements_) == sorted(str(i) for i in range(1, len(elements_) + 1)):
             found[port] = ([elements_[str(i)][0] for i in range(1, len(elements_) + 1)], line)
     return found
+
+
+def _default_step(md: Any) -> bool:
+    """Whether a modelDescription declares a usable DefaultExperiment stepSize."""
+    step = getattr(md.defaultExperiment, "stepSize", None) if md.defaultExperiment is not None else None
+    try:
+        return step is not None and step_of(step) > 0
+    except ValueError:
+        return False
 
 
 def _number(text: str) -> Fraction | None:

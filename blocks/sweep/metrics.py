@@ -1,9 +1,11 @@
 """Metric expressions: what number a sweep keeps from each run, and computing it.
 
-``NAME=REDUCER(BLOCK.PORT[i])`` reduces one element of a logged signal: final, max, min,
-mean, or ``first_time_above(BLOCK.PORT[i], x)`` / ``first_time_below(BLOCK.PORT[i], x)``
-(the first sample time strictly above / below x; empty when it never happens). The index
-may be left out for a signal of width 1. ``NAME=MEASURE`` or ``NAME=MEASURE(a, ...)``
+``NAME=REDUCER(BLOCK.PORT[e])`` reduces one element of a logged signal: final, max, min,
+mean, or ``first_time_above(BLOCK.PORT[e], x)`` / ``first_time_below(BLOCK.PORT[e], x)``
+(the first sample time strictly above / below x; empty when it never happens). The
+element ``e`` is read as a connection and ``plot -s`` read it (``blocks.builder.elements``):
+the label its block gives it first (an FMU's ``q[1]`` is the element the FMU calls
+``q[1]``), else a 0-based index. It may be left out for a signal of width 1. ``NAME=MEASURE`` or ``NAME=MEASURE(a, ...)``
 names a measure that an application registered (``measures``: the entry-point group
 ``blocks.measures``, or ``register_measure``), with numbers as its arguments.
 
@@ -21,6 +23,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from blocks.builder.elements import pick, split_signal, split_signals
+
 from .errors import SweepError
 from .measures import Measure, arity_problem, find_measure, registered_measures, require_logged
 
@@ -29,9 +33,6 @@ THRESHOLD_REDUCERS = ("first_time_above", "first_time_below")
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _CALL = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)\s*(?:\((.*)\))?$", re.S)
-_SIGNAL = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)\.([A-Za-z_][A-Za-z0-9_]*)\s*"
-                     r"(?:\[\s*(-?\d+)\s*\])?$")
-"""``block.port`` or ``block.port[i]``; the block may be a path into subsystems (``ctrl.integ``)."""
 
 
 @dataclass(frozen=True)
@@ -43,7 +44,9 @@ class Metric:
     """A reducer (REDUCERS, THRESHOLD_REDUCERS) or the name of a measure."""
     text: str
     signal: str | None = None
-    index: int | None = None
+    element: str | None = None
+    """The element of ``signal`` as written between its brackets (a label or an index);
+    None for a signal of width 1."""
     threshold: float | None = None
     measure: Measure | None = None
     """The registered measure that ``kind`` names (None for a reducer)."""
@@ -63,12 +66,25 @@ class Metric:
         spec = diagram.blocks.get(block)
         try:
             units = spec.port_units(port) if spec is not None else None
+            if isinstance(units, (list, tuple)):
+                units = units[self.column(spec.element_labels(port), len(units))]
         except Exception:  # a block's port_units that fails says no unit here; the run says why
             return None
-        if isinstance(units, (list, tuple)):
-            index = self.index or 0
-            units = units[index] if -len(units) <= index < len(units) else None
         return units if isinstance(units, str) and units else None
+
+    def column(self, labels: Sequence[str] | None, width: int) -> int:
+        """The column of this metric's element in a signal of ``width`` elements that its
+        block labels ``labels`` (None: numbered from 0); ValueError if it names none, or
+        more than one."""
+        if self.element is None:
+            if width != 1:
+                first = labels[0] if labels else "0"
+                raise ValueError(f"{self.signal} has width {width}; pick an element, e.g. {self.signal}[{first}]")
+            return 0
+        picked = pick(self.element, labels, width, f"signal '{self.signal}'")
+        if len(picked) != 1:
+            raise ValueError(f"{self.signal}[{self.element}] is {len(picked)} elements; a metric reduces one")
+        return picked[0]
 
     # -- checking against the diagram before the sweep --------------------------------
 
@@ -94,13 +110,10 @@ class Metric:
             require_logged(diagram, [self.signal])
         except ValueError as exc:
             raise SweepError(f"--metric {self.text}: {exc}") from None
-        width = outputs[port]
-        if self.index is None and width != 1:
-            raise SweepError(f"--metric {self.text}: {self.signal} has width {width}; pick an "
-                             f"element, e.g. {self.signal}[0]")
-        if self.index is not None and not 0 <= self.index < width:
-            raise SweepError(f"--metric {self.text}: index {self.index} is out of range for "
-                             f"{self.signal} (width {width}, indices 0..{width - 1})")
+        try:
+            self.column(diagram.blocks[block].element_labels(port), outputs[port])
+        except ValueError as exc:  # an ElementError included
+            raise SweepError(f"--metric {self.text}: {exc}") from None
 
     # -- computing -------------------------------------------------------------------
 
@@ -112,7 +125,7 @@ class Metric:
         t, values = results[self.signal]
         if len(t) == 0:
             raise ValueError(f"{self.signal} has no samples")
-        column = values[:, self.index or 0]
+        column = values[:, self.column(results.element_labels(self.signal), values.shape[1])]
         return reduce(self.kind, t, column, self.threshold)
 
 
@@ -135,28 +148,25 @@ def parse_metric(item: str) -> Metric:
     name, eq, expr = item.partition("=")
     name, expr = name.strip(), expr.strip()
     if not eq or not _NAME.match(name):
-        raise SweepError(f"--metric {item!r}: expected NAME=REDUCER(BLOCK.PORT[i]) or NAME=MEASURE, "
+        raise SweepError(f"--metric {item!r}: expected NAME=REDUCER(BLOCK.PORT[e]) or NAME=MEASURE, "
                          "e.g. --metric y_end=final(plant.y)")
     m = _CALL.match(expr)
     if not m:
-        raise SweepError(f"--metric {item!r}: cannot read {expr!r}; expected REDUCER(BLOCK.PORT[i])")
+        raise SweepError(f"--metric {item!r}: cannot read {expr!r}; expected REDUCER(BLOCK.PORT[e])")
     kind, inner = m.group(1), m.group(2)
-    args = [a.strip() for a in inner.split(",")] if inner is not None and inner.strip() else []
+    args = split_signals(inner) if inner is not None and inner.strip() else []
     if kind not in REDUCERS + THRESHOLD_REDUCERS:
         return _measure_metric(item, name, kind, args)
     want = 2 if kind in THRESHOLD_REDUCERS else 1
     if len(args) != want:
-        form = f"{kind}(BLOCK.PORT[i], X)" if want == 2 else f"{kind}(BLOCK.PORT[i])"
+        form = f"{kind}(BLOCK.PORT[e], X)" if want == 2 else f"{kind}(BLOCK.PORT[e])"
         raise SweepError(f"--metric {item!r}: {kind} takes {want} argument(s): {form}")
-    s = _SIGNAL.match(args[0])
-    if not s:
-        raise SweepError(f"--metric {item!r}: {args[0]!r} is not a signal BLOCK.PORT or BLOCK.PORT[i]")
+    found = split_signal(args[0])
+    if found is None or found[1] == "":
+        raise SweepError(f"--metric {item!r}: {args[0]!r} is not a signal BLOCK.PORT or an element of one "
+                         "BLOCK.PORT[e] (its label, or an index from 0)")
     threshold = _number(item, args[1]) if want == 2 else None
-    index = int(s.group(3)) if s.group(3) is not None else None
-    if index is not None and index < 0:
-        raise SweepError(f"--metric {item!r}: index {index} must be 0 or more")
-    return Metric(name=name, kind=kind, text=item, signal=f"{s.group(1)}.{s.group(2)}", index=index,
-                  threshold=threshold)
+    return Metric(name=name, kind=kind, text=item, signal=found[0], element=found[1], threshold=threshold)
 
 
 def _measure_metric(item: str, name: str, kind: str, args: list[str]) -> Metric:

@@ -37,6 +37,20 @@ def test_parse_duration_is_exact(text, expected):
     assert value == expected
 
 
+@pytest.mark.parametrize("text, seconds", [
+    ("1 min", 60), ("1.5 min", 90), ("2 h", 7200), ("0.25h", 900), ("1 hour", 3600), ("3 minutes", 180),
+    ("1 day", 86400), ("2 ks", 2000), ("1 millisecond", Fraction(1, 1000)), ("-1 min", -60),
+])
+def test_durations_read_any_unit_of_time_exactly(text, seconds):
+    assert parse_duration(text) == Fraction(seconds)
+
+
+@pytest.mark.parametrize("text", ["40 year", "20000 day", "1e-15 min"])
+def test_durations_in_other_units_keep_the_range(text):
+    with pytest.raises(DurationError, match="out of range"):
+        parse_duration(text)
+
+
 def test_parse_duration_does_not_go_through_binary_floats():
     # 0.1 ms written three ways is one exact number, and ten of them make exactly 1 ms.
     assert parse_duration("0.1 ms") == parse_duration("100 us") == parse_duration(0.0001)
@@ -67,7 +81,7 @@ def test_parse_duration_rejects_absurd_magnitudes(text):
 
 
 @pytest.mark.parametrize("bad", [
-    "fast", "", "   ", "ms", "1 m", "1 min", "1 ms ms", "1,5 ms", "1.2.3", "nan", "inf", "-inf",
+    "fast", "", "   ", "ms", "1 m", "1 Hz", "1 s2", "1 kg", "1 nothing", "1 ms ms", "1,5 ms", "1.2.3", "nan", "inf", "-inf",
     "1 ms2", "0x10", "one ms", "1e", "e3", "--1",
     float("nan"), float("inf"), -float("inf"), True, False, None, [1], {"s": 1}, b"1 ms",
 ])

@@ -170,6 +170,11 @@ def test_fmus_of_other_tools_run_isolated_and_this_projects_exports_in_the_run_p
     assert "runs in the run's process" in FMU(ours).describe()
 
 
+@pytest.mark.parametrize("timeout, seconds", [("1 min", 60.0), ("0.5 h", 1800.0), ("1 day", 86400.0)])
+def test_a_call_timeout_is_read_in_any_unit_of_time(fmus, timeout, seconds):
+    assert diagram(fmus.fmi2, params=f"call_timeout: {timeout}").blocks["f"].block._model.timeout == seconds
+
+
 @pytest.mark.parametrize("params, message", [
     ("isolation: sandbox", r"parameter 'isolation' must be one of process, none, got 'sandbox'"),
     ("isolation: none, call_timeout: 5 s", r"parameter 'call_timeout' is for FMUs that run in a process of their own"),

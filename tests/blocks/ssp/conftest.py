@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from tests.blocks.fmu.build import build_error, compile_library, fmi2_files, zip_bytes
+from tests.blocks.fmu.build import SOURCES, build_error, compile_library, fmi2_files, zip_bytes
 
 SCHEMA = Path(__file__).parent / "schema"
 NAMESPACES = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
@@ -22,14 +22,33 @@ NAMESPACES = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescriptio
 
 
 @pytest.fixture(scope="session")
-def first_order(tmp_path_factory) -> bytes:
-    """The bytes of the FMI 2 first-order test FMU (x' = a x + b u, y = x, z = [scale x, t])."""
+def first_order_library(tmp_path_factory) -> bytes:
+    """The shared library of the FMI 2 first-order test FMU."""
     why = build_error()
     if why:
         pytest.skip(why)
     build = tmp_path_factory.mktemp("ssp_fmu")
-    library = compile_library(build / "fo.so", "first_order_fmi2.c", "fmi2_unsupported.c")
-    return zip_bytes(fmi2_files(library))
+    return compile_library(build / "fo.so", "first_order_fmi2.c", "fmi2_unsupported.c")
+
+
+@pytest.fixture(scope="session")
+def first_order(first_order_library) -> bytes:
+    """The bytes of the FMI 2 first-order test FMU (x[k+1] = a x[k] + b u[k], y = x,
+    z = [scale x, t]; its DefaultExperiment step 0.1 s)."""
+    return zip_bytes(fmi2_files(first_order_library))
+
+
+def variant(library: bytes, *edits: tuple[str, str]) -> bytes:
+    """The first-order FMU with its modelDescription edited (each (old, new) replaced once)."""
+    xml = (SOURCES / "first_order_fmi2.xml").read_text()
+    for old, new in edits:
+        assert old in xml, old
+        xml = xml.replace(old, new, 1)
+    return zip_bytes(fmi2_files(library, xml))
+
+
+NO_STEP = ('<DefaultExperiment startTime="0" stopTime="1" stepSize="0.1"/>', '<DefaultExperiment startTime="0" stopTime="1"/>')
+"""The edit that leaves the FMU's DefaultExperiment without a step."""
 
 
 def ssd(body: str, name: str = "system", experiment: str = '<ssd:DefaultExperiment startTime="0" stopTime="1"/>',

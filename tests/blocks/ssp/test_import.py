@@ -12,7 +12,7 @@ import pytest
 from blocks import DiagramBuilder, DiagramError, load_diagram, simulate
 from blocks.ssp import read_ssp
 
-from .conftest import hint, schema_errors, ssd, write_ssp
+from .conftest import NO_STEP, hint, schema_errors, ssd, variant, write_ssp
 
 FIRST_ORDER = """
 <ssd:Connectors>
@@ -123,10 +123,11 @@ SSM = """<?xml version="1.0" encoding="UTF-8"?>
 def test_ssv_files_with_a_mapping_and_a_systems_prefixed_binding_set_the_components_parameters(first_order, tmp_path):
     binding = ('<ssd:ParameterBindings><ssd:ParameterBinding source="resources/plant.ssv">'
                '<ssd:ParameterMapping source="resources/plant.ssm"/></ssd:ParameterBinding></ssd:ParameterBindings>')
+    # the prefix comes first, so the mapping maps prefixed names (SSP 1.0, 5.2.3.1)
     system_binding = ('<ssd:ParameterBindings><ssd:ParameterBinding source="resources/other.ssv" prefix="other.">'
-                      '<ssd:ParameterMapping><ssm:ParameterMapping version="1.0"><ssm:MappingEntry source="pole" '
-                      'target="a"/></ssm:ParameterMapping></ssd:ParameterMapping></ssd:ParameterBinding>'
-                      '</ssd:ParameterBindings>')
+                      '<ssd:ParameterMapping><ssm:ParameterMapping version="1.0"><ssm:MappingEntry source="other.pole" '
+                      'target="other.a"/><ssm:MappingEntry source="pole" target="other.b"/></ssm:ParameterMapping>'
+                      '</ssd:ParameterMapping></ssd:ParameterBinding></ssd:ParameterBindings>')
     text = ssd(f"{system_binding}<ssd:Elements>{component('plant', binding)}{component('other')}</ssd:Elements>")
     other_ssv = SSV.replace('<ssv:Parameter name="start"><ssv:Real value="2"/></ssv:Parameter>', "")
     folder = write_ssp(tmp_path / "values", text, first_order, {"resources/plant.ssv": SSV,
@@ -135,8 +136,9 @@ def test_ssv_files_with_a_mapping_and_a_systems_prefixed_binding_set_the_compone
     assert schema_errors(folder / "SystemStructure.ssd") == []
     diagram = load_diagram(folder)
     plant, other = diagram.blocks["plant"].params, diagram.blocks["other"].params
-    assert plant["start_values"] == {"a": 0.9, "x0": 1.25, "b": 0.25, "frozen": False}
-    assert other["start_values"] == {"a": 0.9, "b": 0.25, "frozen": False}
+    # a parameter no entry of the mapping names is not applied (SSP 1.0, 7.1)
+    assert plant["start_values"] == {"a": 0.9, "x0": 1.25}
+    assert other["start_values"] == {"a": 0.9}
     result = simulate(diagram)
     assert result["plant.y"][1][1, 0] == pytest.approx(0.9 * 1.25)
 
@@ -203,7 +205,8 @@ def test_units_of_the_ssd_convert_between_connectors_and_must_measure_one_quanti
         assert diagram.blocks["a"].units == {"y": "km"}
 
 
-def test_steps_come_from_libcosim_and_omsimulator_annotations_or_the_step_given(first_order, tmp_path):
+def test_steps_come_from_libcosim_and_omsimulator_annotations_or_the_step_given(first_order, first_order_library,
+                                                                               tmp_path):
     oms = ('<ssd:Annotations><ssc:Annotation type="org.openmodelica"><oms:Annotations><oms:SimulationInformation>'
            '<oms:FixedStepMaster description="oms-ma" stepSize="0.05"/></oms:SimulationInformation></oms:Annotations>'
            "</ssc:Annotation></ssd:Annotations>")
@@ -215,13 +218,14 @@ def test_steps_come_from_libcosim_and_omsimulator_annotations_or_the_step_given(
         "base": (ssd(f"<ssd:Elements>{component('a', step=None)}</ssd:Elements>", experiment=base), None, 0.02),
         "grid": (ssd(f"<ssd:Elements>{component('a', step='0.05')}</ssd:Elements>", experiment=base), None, 0.06),
         "given": (ssd(f"<ssd:Elements>{component('a', step=None)}</ssd:Elements>"), "25 ms", 0.025),
+        "the FMU's": (ssd(f"<ssd:Elements>{component('a', step=None)}</ssd:Elements>"), None, 0.1),
     }
     for name, (text, step, period) in cases.items():
         folder = write_ssp(tmp_path / name, text, first_order)
         assert schema_errors(folder / "SystemStructure.ssd") == [], name
         assert float(load_diagram(folder, step=step).blocks["a"].period) == pytest.approx(period), name
     folder = write_ssp(tmp_path / "none", ssd(f"<ssd:Elements>{component('a', step=None)}</ssd:Elements>"),
-                       first_order)
+                       variant(first_order_library, NO_STEP))
     with pytest.raises(DiagramError) as caught:
         load_diagram(folder)
     assert len(caught.value.issues) == 1
@@ -253,7 +257,7 @@ BAD = {
     "unknown connector": ('<ssd:Connection startElement="a" startConnector="w" endElement="a" endConnector="u"/>',
                           "element 'a' declares no connector of that name"),
     "wrong direction": ('<ssd:Connection startElement="a" startConnector="u" endElement="a" endConnector="u"/>',
-                        "starts at a.u of kind 'input'"),
+                        "both are destinations of data"),
     "other transformation": ('<ssd:Connection startElement="a" startConnector="y" endElement="a" endConnector="u">'
                              '<ssc:BooleanMappingTransformation><ssc:MapEntry source="true" target="false"/>'
                              "</ssc:BooleanMappingTransformation></ssd:Connection>",
@@ -291,7 +295,7 @@ BAD_ELEMENTS = {
                         'kind="output"><ssc:Real/><ssc:Dimension size="3"/></ssd:Connector></ssd:Connectors>'
                         f"{hint('0.1')}</ssd:Component>", "array connectors (ssc:Dimension) are not supported", "Dimension"),
     "bad name": ('<ssd:Component name="a b" source="resources/fo.fmu"/>', "is not usable as a block name", 'name="a b"'),
-    "value type": (component("a", values(("x0", "Enumeration", "1"))), "values of type ssv:Enumeration", "ssv:Enumeration"),
+    "value type": (component("a", values(("x0", "Binary", "00"))), "values of type ssv:Binary", "ssv:Binary"),
     "ssv missing": (component("a", '<ssd:ParameterBindings><ssd:ParameterBinding source="resources/none.ssv"/>'
                               "</ssd:ParameterBindings>"), "parameter source 'resources/none.ssv' is not in the SSP", "none.ssv"),
 }

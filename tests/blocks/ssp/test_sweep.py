@@ -13,7 +13,7 @@ from blocks import load_diagram, simulate
 from blocks.sweep import grid_points, parse_metrics
 from blocks.sweep.plan import execute, prepare
 
-from .conftest import ssd, write_ssp
+from .conftest import NO_STEP, ssd, variant, write_ssp
 from .test_import import component
 
 POINTS = grid_points({"a.a": [-1.0, -2.0], "a.x0": [1.0, 3.0]})
@@ -42,11 +42,11 @@ def test_an_ssp_sweeps_where_its_folder_is_not_with_the_step_given(first_order, 
         assert got == pytest.approx(expected, rel=1e-15, abs=0)
 
 
-def test_the_sweep_command_takes_an_ssp_and_its_step(first_order, tmp_path, capsys):
+def test_the_sweep_command_takes_an_ssp_and_its_step(first_order_library, tmp_path, capsys):
     from blocks.cli import PROGRAM, main
 
     folder = write_ssp(tmp_path / "system", ssd(f"<ssd:Elements>{component('a', step=None)}</ssd:Elements>"),
-                       first_order)
+                       variant(first_order_library, NO_STEP))
     args = ["sweep", str(folder), "-o", str(tmp_path / "out"), "--grid", "a.a=-1,-2", "--metric", METRICS[0],
             "--serial", "--quiet"]
     assert main(PROGRAM, args) == 2

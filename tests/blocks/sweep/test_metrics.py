@@ -30,6 +30,7 @@ def results() -> Results:
     ("m=first_time_above(plant.y[0], 1.5)", 0.1),
     ("m=first_time_below(plant.y[1], 2)", 0.2),
     ("m=first_time_above(plant.y[0], 10)", None),
+    ("m=final(plant.y[-1])", 0.5),  # from the end, as a plot's selection and a connection read it
 ])
 def test_reducers(text, value):
     assert parse_metric(text).evaluate(results(), None) == value
@@ -41,7 +42,7 @@ def test_reducers(text, value):
     ("m=final(plant)", "not a signal"),
     ("m=first_time_above(plant.y[0])", "takes 2 argument"),
     ("m=first_time_above(plant.y[0], abc)", "not a number"),
-    ("m=final(plant.y[-1])", "must be 0 or more"),
+    ("m=final(plant.y[])", "not a signal"),
 ])
 def test_bad_metrics_are_refused(text, message):
     with pytest.raises(SweepError, match=message):
@@ -90,3 +91,42 @@ log: [src.y, k.y]
     finally:
         unregister_measure("spread_for_test")
     assert units == {"a": "rad", "b": "m", "c": "s", "d": None, "e": "mm"}
+
+
+@pytest.fixture(scope="module")
+def first_order_fmu(tmp_path_factory):
+    """The FMI 2 first-order test FMU: z[1] = scale x, z[2] = its time."""
+    from tests.blocks.fmu.build import build_error, compile_library, fmi2_files, zip_files
+
+    why = build_error()
+    if why:
+        pytest.skip(why)
+    folder = tmp_path_factory.mktemp("metric_fmu")
+    library = compile_library(folder / "fo.so", "first_order_fmi2.c", "fmi2_unsupported.c")
+    return zip_files(folder / "fo.fmu", fmi2_files(library))
+
+
+def test_an_fmu_element_is_one_element_in_a_metric_a_plot_and_a_connection(first_order_fmu):
+    from blocks import loads_diagram, simulate
+    from blocks.plot.select import select
+
+    diagram = loads_diagram(f"""
+time: {{t_end: 0.5 s}}
+blocks:
+  plant: {{type: FMU, period: 0.1 s, params: {{path: '{first_order_fmu}', start_values: {{x0: 1.0, scale: 3}}}}}}
+  g: {{type: Gain, params: {{k: 1.0}}}}
+connections: ["plant.z[1] -> g.u"]
+log: [plant.z, g.y]
+""")
+    result = simulate(diagram)
+    # z[1] = scale x, x = a^k x0 (a = 0.5); z[2] = t; "-1" is no label: an index from the end, as in a plot
+    for label, want in (("1", 3 * 0.5**5), ("2", 0.5), ("-1", 0.5)):
+        metric = parse_metric(f"m=final(plant.z[{label}])")
+        metric.check(diagram)
+        (trace,) = select(result, f"plant.z[{label}]")
+        assert metric.evaluate(result, diagram) == result["plant.z"][1][-1, trace.columns[0]] == want
+    assert parse_metric("m=final(plant.z[1])").evaluate(result, diagram) == result["g.y"][1][-1, 0]
+    with pytest.raises(SweepError, match="has no element 'x'"):
+        parse_metric("m=final(plant.z[x])").check(diagram)
+    with pytest.raises(SweepError, match="2 elements; a metric reduces one"):
+        parse_metric("m=final(plant.z[0:2])").check(diagram)
