@@ -17,6 +17,13 @@ stopping at the first state event, step event or request to terminate, and say w
   by a 50th of the simulated time, which a block does not know); its right-hand side and root function are the C functions of fmu_me_integration.c, so no Python
   runs inside the integration, and its root finding locates state events.
 
+At a state event both hand the FMU, before event mode, a time and states at which the
+indicator has changed its sign strictly, as FMI asks (``ContinuousCalls.past_crossing``):
+a located crossing whose indicator is exactly 0 (Euler's bisection can land there, and
+CVode's root finding, or an indicator that reaches 0 at a hit, where CVode sees no root)
+moves on along the derivatives by an ulp or so, so an event handler that reads the
+state's sign, as generated code does, sees the event.
+
 Both call completedIntegratorStep (when the FMU needs it) after each step they take,
 Euler's sub-steps and each CVode call. A call into the FMU that fails raises
 ``CallFailed`` (function, status, time), a failing CVode ``SolverError``.
@@ -46,6 +53,8 @@ DEFAULT_TOLERANCE = 1e-5
 """The relative tolerance where neither the diagram nor the FMU's DefaultExperiment gives one (fmpy's)."""
 MAX_NUM_STEPS = 100_000
 """How many internal steps CVode may take within one call (up to the next hit or event)."""
+MAX_NUDGES = 64
+"""How many times the step past a located state event may double before it stops trying."""
 
 
 class CallFailed(Exception):
@@ -163,6 +172,8 @@ class ContinuousCalls:
         self._failed = slots["failed"]
         self._x = self.x.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._z = self.z.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._z_new = self.z_new.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        self._dx = self.dx.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         self._nominals = self.nominals.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         flag = ctypes.c_bool if major == 3 else ctypes.c_int
         self._flags = (flag(), flag())
@@ -203,6 +214,51 @@ class ContinuousCalls:
         if self.nx:
             self.check("set_states", self.functions["set_states"](self.component, self._x, self.nx), t)
 
+    def indicators_now(self, t: float) -> np.ndarray:
+        """The event indicators where the FMU is (at ``t``), in ``z_new``."""
+        self.check("get_indicators", self.functions["get_indicators"](self.component, self._z_new, self.nz), t)
+        return self.z_new[:self.nz]
+
+    def crossed_now(self, t: float) -> dict[int, float]:
+        """The indicators that changed sign (to zero or across it) from ``z`` to where the
+        FMU is now, each with the sign it is heading for (+1 or -1)."""
+        if not self.nz:
+            return {}
+        z, now = self.z[:self.nz], self.indicators_now(t)
+        return {i: (1.0 if z[i] < 0.0 else -1.0) for i in range(self.nz)
+                if (z[i] < 0.0 <= now[i]) or (z[i] > 0.0 >= now[i])}
+
+    def past_crossing(self, t: float, heading: dict[int, float], limit: float) -> float:
+        """The FMU at a located state event ``t`` moved just past the crossing, as FMI
+        requires of the state event mode sees: to the first time at or after ``t`` at which
+        every indicator of ``heading`` (index: +1 or -1) has that sign, strictly (an
+        indicator exactly 0 has not changed its domain, and an event handler that reads a
+        state's sign would see no event). The states move on along their derivatives at
+        ``t``, a step of an ulp or so doubled until the signs are there (at most
+        ``MAX_NUDGES`` times, never past ``limit``). Returns the time the FMU is left at."""
+        if not heading or self._past(heading, t):
+            return t
+        nx = self.nx
+        x0 = self.x[:nx].copy()
+        if nx:
+            self.check("get_derivatives", self.functions["get_derivatives"](self.component, self._dx, nx), t)
+        slope = self.dx[:nx].copy()
+        delta, now = max(abs(t), 1.0) * 2.0**-52, t
+        for _ in range(MAX_NUDGES):
+            now = min(t + delta, limit)
+            if now <= t:
+                return t
+            self.x[:nx] = x0 + (now - t) * slope
+            self.place(now)
+            if self._past(heading, now) or now >= limit:
+                return now
+            delta *= 2.0
+        return now
+
+    def _past(self, heading: dict[int, float], t: float) -> bool:
+        now = self.indicators_now(t)
+        return all(now[i] * sign > 0.0 for i, sign in heading.items())
+
     def completed(self, t: float) -> str:
         """completedIntegratorStep after a step to ``t`` (if the FMU needs it): 'reached',
         'step_event' or 'terminate'."""
@@ -239,7 +295,10 @@ class Euler:
         interrupt.check()
         if outcome == "failed":
             raise calls.failure(SolverError("the Euler integration failed"))
-        return float(calls.values[calls.reached]), outcome
+        reached = float(calls.values[calls.reached])
+        if outcome in ("state_event", "step_event"):
+            reached = calls.past_crossing(reached, calls.crossed_now(reached), beyond(stop, hit))
+        return reached, outcome
 
     def close(self) -> None:
         """Nothing to free."""
@@ -343,10 +402,22 @@ class CVode:
                                             f"{': ' + self.message if self.message else ''}"))
         reached = self._return.value if flag == CV_ROOT_RETURN else stop
         calls.place(reached)
+        # an indicator that lands on 0 exactly at ``stop`` is no root to CVode, nor, once it
+        # restarts from 0, the crossing that follows: a crossing all the same
+        heading = self._heading() if flag == CV_ROOT_RETURN else calls.crossed_now(reached)
+        if heading:
+            reached = calls.past_crossing(reached, heading, beyond(stop, hit))
         outcome = calls.completed(reached)
-        if outcome == "reached" and flag == CV_ROOT_RETURN:
+        if outcome == "reached" and heading:
             outcome = "state_event"
+        if calls.nz:
+            calls.z[:calls.nz] = calls.indicators_now(reached)
         return reached, outcome
+
+    def _heading(self) -> dict[int, float]:
+        """The indicators CVode found a root of, each with the sign it is heading for."""
+        self._ok(self.cv.CVodeGetRootInfo(self.memory, self._roots), "CVodeGetRootInfo")
+        return {i: float(r) for i, r in enumerate(self._roots[:self.calls.nz]) if r}
 
     def close(self) -> None:
         """Free CVode's memory, its linear solver, matrix, vectors and context."""
@@ -366,6 +437,12 @@ class CVode:
         if self.context:
             cv.SUNContext_Free(ctypes.byref(self.context))
             self.context = ctypes.c_void_p()
+
+
+def beyond(stop: float, hit: tuple[float, float]) -> float:
+    """How far past ``stop`` a state event found at (or just before) it may be handed over:
+    a billionth of the hit interval, which the block's time keeping counts as ``stop``."""
+    return stop + 1e-9 * (hit[1] - hit[0])
 
 
 def solver(calls: ContinuousCalls, integration: Integration) -> Euler | CVode:

@@ -126,7 +126,7 @@ ME_MODELS = ("linear", "bouncing", "stair")
 
 
 def me_fmu(build: Path, model: str, fmi: int, defines: dict[str, str] | None = None, name: str | None = None) -> Path:
-    """The model-exchange FMU of the test model ``model`` (``linear``, ``bouncing`` or ``stair``)
+    """The model-exchange FMU of the test model ``model`` (``linear``, ``bouncing``, ``stair``, ``sawtooth``)
     for FMI version ``fmi``: the model's source with the FMI wrapper ``me_fmi2.c`` / ``me_fmi3.c``
     (``defines`` become ``-D`` options), and its ``<model>_fmi<fmi>.xml``."""
     identifier = f"{model.capitalize()}{fmi}"
