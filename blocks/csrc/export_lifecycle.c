@@ -64,6 +64,7 @@ void blk_instance_free(blk_instance *inst)
         return;
     ex_release_build(inst);
     ex_free_export(&inst->x);
+    free(inst->scheduled);
     free(inst->params);
     free(inst->set);
     free(inst->inputs);
