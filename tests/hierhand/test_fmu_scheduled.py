@@ -24,7 +24,7 @@ import blocks
 from hierhand.fmu_export import export_diagram_fmu
 from tests.blocks.fmu_export.scheduler import Scheduler
 
-from .test_fmu_export_diagrams import PLANT_PORTS, REGRASP, REPO, regrasp_controller
+from .test_fmu_export_diagrams import COMPARED, PLANT_PORTS, REGRASP, REPO, regrasp_controller
 
 MS = Fraction(1, 1000)
 
@@ -108,3 +108,25 @@ def test_the_cli_exports_scheduled_execution_and_refuses_it_for_fmi_2(tmp_path, 
     assert cli.main(["fmu", "export", str(REPO / "diagrams" / "controller.yaml"), "--scheduled-execution"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--fmi 3" in err[0], err
+
+
+def test_the_controller_imported_back_as_an_fmu_block_runs_the_native_regrasp(controller_se, native_regrasp,
+                                                                              tmp_path):
+    """The FMU block activates the controller's two clocks on their ticks (1 ms, and 10 ms
+    after it at the instants they share), the native plant around it: the re-grasp to the bit."""
+    doc = yaml.safe_load(REGRASP.read_text(encoding="utf-8"))
+    doc["name"] = "regrasp-scheduled-controller"
+    doc["blocks"] = {"plant": doc["blocks"]["plant"],
+                     "ctrl": {"type": "FMU", "period": "1 ms", "params": {"path": str(controller_se)}}}
+    doc["connections"] = [f"plant.{p} -> ctrl.{p}" for p in PLANT_PORTS] + ["ctrl.tau -> plant.tau",
+                                                                            "ctrl.f_ext -> plant.f_ext"]
+    doc["log"] = [{"signal": signal, "decimate": 10} for signal in COMPARED]  # the plant's rows at 1 ms
+    path = tmp_path / "regrasp_se.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    diagram = blocks.load_diagram(path)
+    assert diagram.blocks["ctrl"].block.interface == "scheduled execution"
+    via = blocks.simulate(diagram)
+    assert via.complete
+    for signal in COMPARED:
+        np.testing.assert_array_equal(via[signal][0], native_regrasp[signal][0])
+        np.testing.assert_array_equal(via[signal][1], native_regrasp[signal][1], err_msg=signal)
