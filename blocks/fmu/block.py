@@ -36,7 +36,7 @@ from blocks.fmu.compiled_step import fmu_kernel
 from .log_messages import status_name
 from .model import INTERFACES, ISOLATIONS, float_or_none, isolation_choice
 from .pool import PooledModel
-from .scheduled import check_period
+from .scheduled import ClockRun, check_period
 from .solvers import DEFAULT_TOLERANCE, CallFailed, Integration, SolverError, integration, solver_choice
 from .start_values import assignments, input_starts, start_of
 
@@ -55,7 +55,7 @@ class FMUState:
     early; otherwise that happens when the state is garbage collected.
     """
 
-    __slots__ = ("instance", "model", "time", "outputs", "ended", "activated", "_release", "__weakref__")
+    __slots__ = ("instance", "model", "time", "outputs", "ended", "clocks", "_release", "__weakref__")
 
     def __init__(self, model: PooledModel):
         if model.closed:
@@ -65,8 +65,8 @@ class FMUState:
         self.time: float | None = None
         self.outputs: dict[str, Signal] | None = None
         self.ended: float | None = None
-        self.activated: float | None = None
-        """Scheduled execution: the hit whose clocks were activated last."""
+        self.clocks = ClockRun()
+        """Scheduled execution: what the run remembers of its clocks."""
         self._release: weakref.finalize | None = None
 
     def acquire(self) -> Instance:
@@ -194,6 +194,11 @@ class FMU(Block):
             self.tolerance = DEFAULT_TOLERANCE
         self.inputs = {p.name: p.width for p in model.inputs.values()}
         self.outputs = {p.name: p.width for p in model.outputs.values()}
+        self._clock_ports = {c.port: c.name for c in model.clocks if c.kind in ("triggered", "output")}
+        """Scheduled execution: the ports of its triggered input clocks and its output clocks."""
+        for c in model.clocks:
+            if c.kind in ("triggered", "output"):
+                (self.inputs if c.kind == "triggered" else self.outputs)[c.port] = 1
         self.input_defaults = input_starts(model, self._assignments)
         self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
         if not isinstance(feedthrough, bool):
@@ -202,6 +207,9 @@ class FMU(Block):
             raise ValueError(f"parameter 'feedthrough' is for co-simulation FMUs; {shown} runs as model exchange")
         self._direct = (feedthrough or model.scheduled) and any(model.direct_reads.values())
         self.feedthrough = model.direct_reads if self._direct else False
+        if model.scheduled and self._clock_ports:  # a triggered clock's port reaches every output at once
+            self._direct = True
+            self.feedthrough = {out: frozenset(self.inputs) for out in self.outputs}
         # scheduled execution: the clocks that tick at t = 0 are activated with the inputs there
         self.initial_feedthrough = self.feedthrough if model.scheduled else model.initial_reads
         self._step = 0.0
@@ -297,6 +305,8 @@ class FMU(Block):
         """The FMU variable behind each element of a port (``q[1]``, ``q[2]``, ...; a scalar's
         own name), as other tools name them (an SSD's connectors); None for an FMI 3
         array, whose elements are one variable."""
+        if port in self._clock_ports:
+            return [self._clock_ports[port]]
         spec = self._model.inputs.get(port) or self._model.outputs.get(port)
         if spec is None:
             raise KeyError(port)
@@ -313,6 +323,8 @@ class FMU(Block):
 
     def variable_of(self, port: str) -> str:
         """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""
+        if port in self._clock_ports:
+            return self._clock_ports[port]
         spec = self._model.inputs.get(port) or self._model.outputs.get(port)
         if spec is None:
             raise KeyError(port)
@@ -406,20 +418,19 @@ class FMU(Block):
         and the clocks that tick there activated, in priority order."""
         if state.time is None:
             self._start(t, state, inputs)
-        if state.activated != t:
-            exact = round(t / self._step) * self._period
-            ticking = [c for c in self._model.clocks if c.ticks_at(exact)]
-            self.step_calls(state.instance, t, self._activate, t, ticking, state, inputs)
+        if state.clocks.activated != t:
+            self.step_calls(state.instance, t, self._activate, t, state, inputs)
         return state.outputs
 
-    def _activate(self, t: float, ticking: list, state: FMUState, inputs: Mapping[str, Signal]) -> None:
+    def _activate(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> None:
         inst = state.instance
         inst.arm()
         inst.write(inputs, t)
-        inst.activate(ticking, t)
+        exact = round(t / self._step) * self._period
+        ticked = inst.activate(self._model.clocks, state.clocks, t, exact, self._period, inputs)
         interrupt.check()
-        state.outputs = inst.read(t)
-        state.time = state.activated = t
+        state.outputs = {**inst.read(t), **ticked}
+        state.time = state.clocks.activated = t
 
     def update(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> FMUState:
         if self._model.scheduled:  # the partitions ran at the hit's outputs: scheduled execution has no step

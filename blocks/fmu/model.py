@@ -88,9 +88,9 @@ class Model:
         element = md.modelExchange if self.exchange else md.scheduledExecution if self.scheduled else md.coSimulation
         self.clocks = ()
         if self.scheduled:
-            from .scheduled import input_clocks
+            from .scheduled import fmu_clocks
 
-            self.clocks = input_clocks(description.xml, shown)
+            self.clocks = fmu_clocks(description.xml, shown)
         self.identifier = element.modelIdentifier
         self.once_per_process = bool(element.canBeInstantiatedOnlyOncePerProcess)
         if element.needsExecutionTool:
@@ -127,10 +127,12 @@ class Model:
             except ValueError as exc:
                 self.default_step_problem = f"its DefaultExperiment stepSize '{shown_text(de.stepSize)}' is {exc}"
         self.default_tolerance = float_or_none(de.tolerance if de else None)
-        if self.scheduled:  # its hits are its clocks' ticks
+        if self.scheduled:  # its hits are its periodic clocks' ticks
             from .scheduled import clock_grid
 
-            self.default_step, self.default_step_problem = clock_grid(self.clocks), None
+            grid = clock_grid(self.clocks)
+            if grid is not None:
+                self.default_step, self.default_step_problem = grid, None
         self.variables = {v.name: v for v in md.modelVariables}
         kinds = KINDS[major]
         ports = [v for v in md.modelVariables if v.type in kinds]

@@ -1,47 +1,63 @@
 """Scheduled-execution FMUs (FMI 3.0) as blocks: their input clocks activated on the tick grid.
 
 A scheduled-execution FMU has one model partition per input clock, which the importer
-activates (``fmi3ActivateModelPartition``). The FMU block runs one at the ticks of its
-clocks: at a hit it sets the inputs, activates the partitions of the clocks that tick
-there in priority order (the smallest ``priority`` value first, as the standard orders
-clocks of one instant) and reads the outputs. Its outputs at a hit thus read its inputs
-there, as far as the ModelStructure says (the block's feedthrough), and hold between hits.
-The block's period is the grid of the clocks' ticks (the greatest common divisor of their
-intervals and shifts, exact where the FMU gives ``intervalCounter / resolution``); a
-period given must divide every interval and shift.
+activates (``fmi3ActivateModelPartition``). The FMU block runs one at the hits of its
+period: at a hit it sets the inputs, activates the partitions of the clocks due there in
+priority order (the smallest ``priority`` value first, as the standard orders the clocks
+of one instant) and reads the outputs, so its outputs at a hit read its inputs there and
+hold between hits. Which input clocks are due at a hit:
 
-Supported: periodic input clocks whose interval the modelDescription gives (``constant``,
-and ``fixed`` or ``tunable`` ones with an interval, run at it). Not supported, and refused
-with a line that says so: triggered and countdown input clocks (activated by a signal or
-at the FMU's request), changing clocks, output clocks (the FMU's ``clockUpdate``
-callback), and running the FMU in a process of its own (``isolation: process``).
+- periodic ones (``constant``; ``fixed`` and ``tunable`` ones at the interval the
+  modelDescription gives) at each of their ticks, exact where the FMU gives
+  ``intervalCounter / resolution``; the block's default period is the grid of their ticks
+  (the gcd of their intervals and shifts), and a period given must divide every one;
+- ``triggered`` ones where their input port (named as the clock) rises: it is nonzero at
+  the hit and was zero at the hit before (or this is the first hit);
+- ``countdown`` ones when the FMU asks: after it calls ``clockUpdate``, the block reads the
+  clock's interval (``fmi3GetIntervalDecimal``) and activates it that long after the hit,
+  at once when the interval is 0 (after the clocks of the hit before it in priority).
+
+An output clock is an output port (named as the clock): 1 at a hit where the FMU said it
+ticked (``fmi3GetClock`` after a ``clockUpdate``), else 0. The FMU's preemption locks are
+no-ops: the block activates one partition at a time. Not supported: changing clocks, FMU
+states of a scheduled run, and running the FMU in a process of its own (``isolation:
+process``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import os
+from dataclasses import dataclass, field
 from fractions import Fraction
 from xml.etree import ElementTree as ET
 
+import numpy as np
+
 from blocks.timebase import fraction_gcd
+from . import interrupt
 from .instance import FMI3Instance
+from .log_messages import record
+from .ports import port_name
 
 PERIODIC = ("constant", "fixed", "tunable")
 """The interval variabilities of the periodic clocks the block runs (at their declared interval)."""
 
 
 @dataclass(frozen=True)
-class InputClock:
-    """An input clock: its name, value reference, priority, and interval and shift in seconds."""
+class Clock:
+    """A clock of the FMU: name, port name, value reference, kind (``periodic``,
+    ``triggered``, ``countdown``, ``output``), priority; a periodic one's interval and shift."""
 
     name: str
+    port: str
     vr: int
-    priority: int
-    interval: Fraction
-    shift: Fraction
+    kind: str
+    priority: int = 0
+    interval: Fraction | None = None
+    shift: Fraction = Fraction(0)
 
     def ticks_at(self, t: Fraction) -> bool:
-        return t >= self.shift and (t - self.shift) % self.interval == 0
+        return self.kind == "periodic" and t >= self.shift and (t - self.shift) % self.interval == 0
 
 
 def _time(element: ET.Element, counter: str, decimal: str) -> Fraction | None:
@@ -53,52 +69,144 @@ def _time(element: ET.Element, counter: str, decimal: str) -> Fraction | None:
     return Fraction(text) if text is not None else None
 
 
-def input_clocks(xml: bytes, shown: str) -> tuple[InputClock, ...]:
-    """The input clocks of a scheduled-execution FMU's modelDescription, in priority order;
-    ValueError naming a clock the block cannot run."""
-    found = []
+def fmu_clocks(xml: bytes, shown: str) -> tuple[Clock, ...]:
+    """The clocks of a scheduled-execution FMU's modelDescription, the input clocks in
+    priority order, then the output clocks; ValueError naming one the block cannot run."""
+    inputs, outputs = [], []
     for element in ET.fromstring(xml).iter("Clock"):
         name, causality = element.get("name"), element.get("causality", "local")
-        kind = element.get("intervalVariability")
+        kind, vr = element.get("intervalVariability"), int(element.get("valueReference"))
         if causality == "output":
-            raise ValueError(f"{shown} has the output clock '{name}': the FMU block does not run output clocks "
-                             "(scheduled execution with periodic input clocks only)")
+            outputs.append(Clock(name, port_name(name), vr, "output"))
+            continue
         if causality != "input":
+            continue
+        priority = int(element.get("priority", 0))
+        if kind in ("triggered", "countdown"):
+            inputs.append(Clock(name, port_name(name), vr, kind, priority))
             continue
         interval = _time(element, "intervalCounter", "intervalDecimal")
         if kind not in PERIODIC or interval is None or interval <= 0:
             raise ValueError(f"{shown}: the input clock '{name}' is {kind} without an interval the "
-                             "modelDescription gives; the FMU block activates periodic clocks only (not "
-                             "triggered, countdown or changing ones)")
+                             "modelDescription gives; the FMU block activates periodic, triggered and countdown "
+                             "clocks")
         shift = _time(element, "shiftCounter", "shiftDecimal") or Fraction(0)
-        found.append(InputClock(name, int(element.get("valueReference")), int(element.get("priority", 0)),
-                                interval, shift))
-    if not found:
+        inputs.append(Clock(name, port_name(name), vr, "periodic", priority, interval, shift))
+    if not inputs:
         raise ValueError(f"{shown} provides scheduled execution without input clocks: nothing activates it")
-    return tuple(sorted(found, key=lambda c: c.priority))
+    return tuple(sorted(inputs, key=lambda c: c.priority)) + tuple(outputs)
 
 
-def clock_grid(clocks: tuple[InputClock, ...]) -> Fraction:
-    """The grid of the clocks' ticks: the gcd of their intervals and shifts."""
-    return fraction_gcd([c.interval for c in clocks] + [c.shift for c in clocks if c.shift])
+def clock_grid(clocks: tuple[Clock, ...]) -> Fraction | None:
+    """The grid of the periodic clocks' ticks (the gcd of their intervals and shifts); None without any."""
+    periodic = [c for c in clocks if c.kind == "periodic"]
+    return fraction_gcd([c.interval for c in periodic] + [c.shift for c in periodic if c.shift]) if periodic else None
 
 
-def check_period(clocks: tuple[InputClock, ...], period: Fraction, shown: str) -> None:
-    """ValueError unless every tick of every clock is a hit of a block of ``period``."""
+def check_period(clocks: tuple[Clock, ...], period: Fraction, shown: str) -> None:
+    """ValueError unless every tick of every periodic clock is a hit of a block of ``period``."""
     for c in clocks:
-        if (c.interval / period).denominator != 1 or (c.shift / period).denominator != 1:
+        if c.kind == "periodic" and ((c.interval / period).denominator != 1 or (c.shift / period).denominator != 1):
             raise ValueError(f"the period {float(period):g} s does not divide the interval {float(c.interval):g} s "
                              f"(shift {float(c.shift):g} s) of clock '{c.name}' of {shown}; use a period of "
                              f"{float(clock_grid(clocks)):g} s or a divisor of it")
 
 
+@dataclass
+class ClockRun:
+    """What a run of a scheduled-execution FMU block remembers between hits."""
+
+    activated: float | None = None
+    """The hit whose clocks were activated last."""
+    previous: dict[str, float] = field(default_factory=dict)
+    """Per triggered clock's port, its value at the hit before."""
+    due: dict[int, Fraction] = field(default_factory=dict)
+    """Per countdown clock (value reference), when the FMU asked to activate it."""
+
+
 class ScheduledExecution3(FMI3Instance):
-    """An FMI 3.0 scheduled-execution instance: partitions activated instead of steps."""
+    """An FMI 3.0 scheduled-execution instance: partitions activated instead of steps,
+    with a ``clockUpdate`` callback that notes the FMU's requests."""
 
     fmpy_class = "FMU3ScheduledExecution"
 
-    def activate(self, clocks: list[InputClock], t: float) -> None:
-        """Activate the partitions of ``clocks`` (in their order) at ``t``; fmpy raises
-        FMICallException for a status that is an error."""
+    def _instantiate(self, who: str) -> None:
+        from fmpy.fmi3 import (fmi3Boolean, fmi3ClockUpdateCallback, fmi3InstanceEnvironment,
+                               fmi3LockPreemptionCallback, fmi3LogMessageCallback, fmi3UnlockPreemptionCallback)
+
+        messages, slave = self.messages, self.slave
+        self.updated = False
+
+        def log3(env, status, category, message):
+            record(messages, status, category, message, who)
+
+        def clock_update(env):
+            self.updated = True
+
+        # kept on the fmpy instance, which keeps them alive as long as the FMU may call them
+        slave.logMessage = fmi3LogMessageCallback(interrupt.callback(log3))
+        slave.clockUpdate = fmi3ClockUpdateCallback(interrupt.callback(clock_update))
+        slave.lockPreemption = fmi3LockPreemptionCallback(lambda: None)
+        slave.unlockPreemption = fmi3UnlockPreemptionCallback(lambda: None)
+        slave.component = slave.fmi3InstantiateScheduledExecution(
+            slave.instanceName.encode(), slave.guid.encode(),
+            (os.path.join(slave.unzipDirectory, "resources") + os.path.sep).encode(), fmi3Boolean(False),
+            fmi3Boolean(False), fmi3InstanceEnvironment(), slave.logMessage, slave.clockUpdate, slave.lockPreemption,
+            slave.unlockPreemption)
+        if not slave.component:
+            raise RuntimeError("fmi3InstantiateScheduledExecution returned no instance")
+
+    def activate(self, clocks: tuple[Clock, ...], run: ClockRun, t: float, exact: Fraction, period: Fraction,
+                 inputs) -> dict[str, np.ndarray]:
+        """Activate the input clocks due at the hit ``t`` (``exact``) in priority order, the
+        countdown clocks the FMU asks for included; the output clocks' ports. fmpy raises
+        FMICallException for a call that fails."""
+        due = set()
         for c in clocks:
-            self.slave.activateModelPartition(c.vr, t)
+            if c.kind == "triggered":
+                value = float(np.asarray(inputs[c.port]).ravel()[0])
+                if value != 0.0 and run.previous.get(c.port, 0.0) == 0.0:
+                    due.add(c.vr)
+                run.previous[c.port] = value
+            elif c.ticks_at(exact) or run.due.get(c.vr) == exact:
+                due.add(c.vr)
+                run.due.pop(c.vr, None)
+        ticked: set[int] = set()
+        done: set[int] = set()
+        self.updated = False
+        while True:
+            waiting = [c for c in clocks if c.vr in due and c.vr not in done]
+            if not waiting:
+                break
+            clock = waiting[0]  # clocks are in priority order
+            self.slave.activateModelPartition(clock.vr, t)
+            done.add(clock.vr)
+            if self.updated:
+                self.updated = False
+                self._requests(clocks, run, exact, period, due, ticked)
+        return {c.port: np.array([1.0 if c.vr in ticked else 0.0]) for c in clocks if c.kind == "output"}
+
+    def _requests(self, clocks, run: ClockRun, exact: Fraction, period: Fraction, due: set, ticked: set) -> None:
+        """After a clockUpdate: the output clocks that ticked, the countdown clocks' new intervals."""
+        from fmpy.fmi3 import fmi3Float64, fmi3IntervalQualifier, fmi3ValueReference
+
+        outputs = [c for c in clocks if c.kind == "output"]
+        if outputs:
+            for c, active in zip(outputs, self.slave.getClock([c.vr for c in outputs])):
+                if active:
+                    ticked.add(c.vr)
+        for c in clocks:
+            if c.kind != "countdown":
+                continue
+            vrs, intervals, qualifiers = (fmi3ValueReference * 1)(c.vr), (fmi3Float64 * 1)(), (fmi3IntervalQualifier * 1)()
+            self.slave.getIntervalDecimal(vrs, intervals, qualifiers)
+            if qualifiers[0] != 2:  # fmi3IntervalChanged
+                continue
+            at = exact + Fraction(repr(float(intervals[0])))
+            if (at / period).denominator != 1:
+                raise ValueError(f"countdown clock '{c.name}' asks for an activation at t={float(at):.9g} s, "
+                                 f"off the block's hits every {float(period):g} s")
+            if at == exact:
+                due.add(c.vr)
+            else:
+                run.due[c.vr] = at

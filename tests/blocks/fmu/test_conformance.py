@@ -313,17 +313,18 @@ def test_csv_columns_of_fmu_vectors_keep_the_fmus_indices(typed, tmp_path):
     assert (again / "signals.csv").read_text() == (tmp_path / "signals.csv").read_text()
 
 
-def test_scheduled_execution_with_a_triggered_clock_is_refused_and_the_message_says_why(typed, tmp_path):
+def test_scheduled_execution_with_a_changing_clock_is_refused_and_the_message_says_why(typed, tmp_path):
     with zipfile.ZipFile(typed[3]) as zf:
         xml = zf.read("modelDescription.xml").decode()
     xml = re.sub(r"<(CoSimulation|ModelExchange) [^>]*/>", '<ScheduledExecution modelIdentifier="Typed3"/>', xml)
+    xml = xml.replace('intervalVariability="triggered"', 'intervalVariability="changing"')
     path = tmp_path / "clocked.fmu"
     with zipfile.ZipFile(path, "w") as zf:
         zf.writestr("modelDescription.xml", xml)
     with pytest.raises(DiagramError) as info:
         fmu_diagram(path, {}, [])
-    assert "the input clock 'tick' is triggered without an interval the modelDescription gives; the FMU block " \
-           "activates periodic clocks only (not triggered, countdown or changing ones)" in str(info.value)
+    assert "the input clock 'tick' is changing without an interval the modelDescription gives; the FMU block " \
+           "activates periodic, triggered and countdown clocks" in str(info.value)
 
 
 def test_fmu_info_lists_every_variable_type(typed):
