@@ -36,7 +36,7 @@ from blocks.fmu.compiled_step import fmu_kernel
 from .log_messages import status_name
 from .model import INTERFACES, ISOLATIONS, float_or_none, isolation_choice
 from .pool import PooledModel
-from .scheduled import ClockRun, check_period
+from .clocks import ClockRun, check_period
 from .solvers import DEFAULT_TOLERANCE, CallFailed, Integration, SolverError, integration, solver_choice
 from .start_values import assignments, input_starts, start_of
 
@@ -486,8 +486,9 @@ class FMU(Block):
 
     def kernel(self) -> Kernel | None:
         """The steady step in C (``blocks.fmu.compiled_step``) when every port is Float64; an FMU
-        with ports of other types, or read with ``feedthrough``, runs in Python."""
-        return None if self._direct else fmu_kernel(self)
+        with ports of other types, read with ``feedthrough``, or run by scheduled execution,
+        runs in Python."""
+        return None if self._direct or self._model.scheduled else fmu_kernel(self)
 
     def _failure(self, inst: Instance, what: str) -> BlockError:
         """The error of a failed call into the FMU, which breaks the instance: ``what`` with

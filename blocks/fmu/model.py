@@ -88,7 +88,7 @@ class Model:
         element = md.modelExchange if self.exchange else md.scheduledExecution if self.scheduled else md.coSimulation
         self.clocks = ()
         if self.scheduled:
-            from .scheduled import fmu_clocks
+            from .clocks import fmu_clocks
 
             self.clocks = fmu_clocks(description.xml, shown)
         self.identifier = element.modelIdentifier
@@ -128,7 +128,7 @@ class Model:
                 self.default_step_problem = f"its DefaultExperiment stepSize '{shown_text(de.stepSize)}' is {exc}"
         self.default_tolerance = float_or_none(de.tolerance if de else None)
         if self.scheduled:  # its hits are its periodic clocks' ticks
-            from .scheduled import clock_grid
+            from .clocks import clock_grid
 
             grid = clock_grid(self.clocks)
             if grid is not None:

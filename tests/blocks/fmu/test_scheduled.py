@@ -88,3 +88,8 @@ def test_a_period_off_the_clock_grid_is_refused(clocks_fmu):
     b.add("fmu", FMU(clocks_fmu), period="0.3 s")
     with pytest.raises(DiagramError, match="does not divide the interval 1 s"):
         b.build()
+
+
+def test_scheduled_execution_in_a_process_of_its_own_is_refused(clocks_fmu):
+    with pytest.raises(ValueError, match="drop 'isolation: process'"):
+        FMU(clocks_fmu, isolation="process")
