@@ -186,8 +186,9 @@ def cmd_fmu_export(args: argparse.Namespace) -> int:
                              "plant's hand itself)")
         print(f"wrote {fmu.export_diagram(args, kernel_set=kernel_set())}")
         return EXIT_OK
-    if args.overrides or args.step:
-        raise UsageError("fmu export: --set and --step need a DIAGRAM (the plant export takes --hand)")
+    if args.overrides or args.step or args.scheduled:
+        raise UsageError("fmu export: --set, --step and --scheduled-execution need a DIAGRAM (the plant export "
+                         "takes --hand)")
     if args.hand is not None and not args.hand.exists():
         raise UsageError(f"--hand {args.hand}: hand file not found")
     try:

@@ -51,10 +51,11 @@ def kernel_set() -> KernelSet:
 
 
 def export_diagram_fmu(diagram: Diagram, out: Path | None = None, fmi: int = 2, **options) -> Path:
-    """Write ``diagram`` as an FMU (default path ``fmu/<name>_fmi<N>.fmu``) and return its
-    path; ``options`` go to ``blocks.fmu_export.export_fmu`` (``model``, ``step``)."""
-    return export_fmu(diagram, _output_path(out, f"{diagram.name}_fmi{fmi}.fmu"), fmi, kernel_set=kernel_set(),
-                      **options)
+    """Write ``diagram`` as an FMU (default path ``fmu/<name>_fmi<N>.fmu``, ``..._se.fmu`` for
+    scheduled execution) and return its path; ``options`` go to
+    ``blocks.fmu_export.export_fmu`` (``model``, ``step``, ``scheduled``)."""
+    name = f"{diagram.name}_fmi{fmi}{'_se' if options.get('scheduled') else ''}.fmu"
+    return export_fmu(diagram, _output_path(out, name), fmi, kernel_set=kernel_set(), **options)
 
 
 def plant_diagram(hand: Path | None = None) -> Diagram:

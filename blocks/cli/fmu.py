@@ -47,13 +47,16 @@ def cmd_fmu_info(args: argparse.Namespace) -> int:
 
 
 def export_args(parser: argparse.ArgumentParser, diagram_required: bool = True) -> None:
-    """DIAGRAM, --set, --trust, --fmi, --step and -o of ``fmu export``."""
+    """DIAGRAM, --set, --trust, --fmi, --scheduled-execution, --step and -o of ``fmu export``."""
     parser.add_argument("diagram", type=Path, metavar="DIAGRAM", nargs=None if diagram_required else "?",
                         help="YAML diagram file whose blocks all have compiled kernels")
     parser.add_argument("--set", action="append", default=[], dest="overrides", metavar="BLOCK.PARAM=VALUE",
                         help="override a parameter before exporting (value read as YAML; repeatable)")
     trust_arg(parser)
     parser.add_argument("--fmi", type=int, choices=(2, 3), default=2, help="FMI version (default: 2)")
+    parser.add_argument("--scheduled-execution", action="store_true", dest="scheduled",
+                        help="FMI 3 scheduled execution: one input clock and model partition per rate, "
+                             "activated by the importer's scheduler (docs: Scheduled execution)")
     parser.add_argument("--step", metavar="T",
                         help="the default communication step, a multiple of the internal step (default: it)")
     parser.add_argument("-o", "--output", type=Path, metavar="PATH",
@@ -84,12 +87,16 @@ def export_diagram(args: argparse.Namespace, **options) -> Path:
     from blocks import load_diagram
     from blocks.fmu_export import FmuExportError, export_fmu
 
+    if args.scheduled and args.fmi != 3:
+        raise UsageError("fmu export: --scheduled-execution needs --fmi 3 (FMI 2 has no clocks)")
+    if args.scheduled and args.step:
+        raise UsageError("fmu export: --step is for co-simulation; the clocks of scheduled execution are the rates")
     diagram = load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
-    name = f"{diagram.name}_fmi{args.fmi}.fmu"
+    name = f"{diagram.name}_fmi{args.fmi}{'_se' if args.scheduled else ''}.fmu"
     out = args.output if args.output is not None else Path("fmu") / name
     if out.suffix.lower() != ".fmu":
         out = out / name
     try:
-        return export_fmu(diagram, out, args.fmi, step=args.step, **options)
+        return export_fmu(diagram, out, args.fmi, step=args.step, scheduled=args.scheduled, **options)
     except (FmuExportError, OSError) as exc:
         raise UsageError(f"fmu export: {exc}") from None

@@ -1,15 +1,17 @@
-/* The FMI 3.0 co-simulation interface of an exported diagram FMU, over export_instance.h.
+/* The FMI 3.0 co-simulation and scheduled-execution interfaces of an exported diagram FMU,
+ * over export_instance.h and export_scheduled.h.
  *
  * Every function of fmi3Functions.h is exported, as importers may look each one up; the
- * ones outside co-simulation without event mode (model exchange, scheduled execution,
- * clocks, configuration mode, derivatives) log why they are not available and return
- * fmi3Error. Every failure is logged through the host's logger with a category; nothing
+ * ones outside co-simulation without event mode and scheduled execution (model exchange,
+ * setting clocks, configuration mode, derivatives) log why they are not available and
+ * return fmi3Error. Every failure is logged through the host's logger with a category; nothing
  * here aborts the host.
  */
 #include <stdlib.h>
 
 #include "fmi3Functions.h"
 #include "export_instance.h"
+#include "export_scheduled.h"
 
 typedef struct {
     blk_instance *inst;
@@ -128,16 +130,20 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String instanceName, fmi3Stri
                                                fmi3LockPreemptionCallback lockPreemption,
                                                fmi3UnlockPreemptionCallback unlockPreemption)
 {
-    (void)instanceName;
-    (void)instantiationToken;
-    (void)resourcePath;
     (void)visible;
-    (void)loggingOn;
-    (void)clockUpdate;
-    (void)lockPreemption;
-    (void)unlockPreemption;
-    refuse_interface(instanceEnvironment, logMessage, "this FMU supports co-simulation only, not scheduled execution");
-    return NULL;
+    (void)clockUpdate; /* no output clocks, no countdown clocks */
+    component *c = calloc(1, sizeof *c);
+    if (c == NULL)
+        return NULL;
+    c->log_message = logMessage;
+    c->environment = instanceEnvironment;
+    c->inst = blk_instance_new_scheduled(instanceName, instantiationToken, resourcePath, log_to_host, c, loggingOn,
+                                         lockPreemption, unlockPreemption);
+    if (c->inst == NULL) {
+        free(c);
+        return NULL;
+    }
+    return c;
 }
 
 void fmi3FreeInstance(fmi3Instance instance)
@@ -386,38 +392,32 @@ fmi3Status fmi3GetIntervalDecimal(fmi3Instance instance, const fmi3ValueReferenc
                                   size_t nValueReferences, fmi3Float64 intervals[],
                                   fmi3IntervalQualifier qualifiers[])
 {
-    (void)valueReferences;
-    (void)intervals;
-    (void)qualifiers;
-    return no_variables(instance, nValueReferences, "Clock");
+    INSTANCE_OR_ERROR(instance);
+    return (fmi3Status)blk_instance_clock_intervals(inst, valueReferences, nValueReferences, intervals, NULL, NULL,
+                                                    (int *)qualifiers);
 }
 
 fmi3Status fmi3GetIntervalFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                                    size_t nValueReferences, fmi3UInt64 counters[], fmi3UInt64 resolutions[],
                                    fmi3IntervalQualifier qualifiers[])
 {
-    (void)valueReferences;
-    (void)counters;
-    (void)resolutions;
-    (void)qualifiers;
-    return no_variables(instance, nValueReferences, "Clock");
+    INSTANCE_OR_ERROR(instance);
+    return (fmi3Status)blk_instance_clock_intervals(inst, valueReferences, nValueReferences, NULL, counters,
+                                                    resolutions, (int *)qualifiers);
 }
 
 fmi3Status fmi3GetShiftDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                                size_t nValueReferences, fmi3Float64 shifts[])
 {
-    (void)valueReferences;
-    (void)shifts;
-    return no_variables(instance, nValueReferences, "Clock");
+    INSTANCE_OR_ERROR(instance);
+    return (fmi3Status)blk_instance_clock_shifts(inst, valueReferences, nValueReferences, shifts, NULL, NULL);
 }
 
 fmi3Status fmi3GetShiftFraction(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                                 size_t nValueReferences, fmi3UInt64 counters[], fmi3UInt64 resolutions[])
 {
-    (void)valueReferences;
-    (void)counters;
-    (void)resolutions;
-    return no_variables(instance, nValueReferences, "Clock");
+    INSTANCE_OR_ERROR(instance);
+    return (fmi3Status)blk_instance_clock_shifts(inst, valueReferences, nValueReferences, NULL, counters, resolutions);
 }
 
 fmi3Status fmi3SetIntervalDecimal(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -584,12 +584,11 @@ fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoi
     return status;
 }
 
-/* -- scheduled execution: not available ------------------------------------------------------- */
+/* -- scheduled execution (export_scheduled.h) ---------------------------------------------------- */
 
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference,
                                       fmi3Float64 activationTime)
 {
-    (void)clockReference;
-    (void)activationTime;
-    return unsupported(instance, "fmi3ActivateModelPartition (scheduled execution)");
+    INSTANCE_OR_ERROR(instance);
+    return (fmi3Status)blk_instance_activate(inst, clockReference, activationTime);
 }

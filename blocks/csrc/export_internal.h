@@ -10,7 +10,8 @@
  * - export_build.c: the kernels built from the records and the parameters, and released;
  * - export_lifecycle.c: instantiation, the phases (initialization, termination, reset);
  * - export_variables.c: values got and set by value reference;
- * - export_snapshot.c: FMU states (get, set, serialize).
+ * - export_snapshot.c: FMU states (get, set, serialize);
+ * - export_scheduled.c: scheduled execution, its clocks and partitions (export_scheduled.h).
  */
 #ifndef BLOCKS_EXPORT_INTERNAL_H
 #define BLOCKS_EXPORT_INTERNAL_H
@@ -106,6 +107,7 @@ struct blk_instance {
     int64_t stop_tick;
     double stop_time;
     blk_phase phase;
+    struct ex_scheduled *scheduled; /* scheduled execution's clocks (one allocation); NULL: co-simulation */
 };
 
 #define LOG_ERROR(inst, ...) blk_instance_log((inst), BLK_STATUS_ERROR, BLK_LOG_ERROR, __VA_ARGS__)
@@ -134,6 +136,8 @@ blk_status ex_wrong_phase(blk_instance *inst, const char *what);
 /* Read BLK_EXPORT_RESOURCE from ``folder`` into inst->x: 0, or -1 after logging why. */
 int ex_read_resources(blk_instance *inst, const char *token, const char *folder);
 void ex_free_export(blk_export *x);
+/* The words of resource file ``name`` in ``folder`` (malloc'ed), *n of them; NULL after logging why. */
+int64_t *ex_read_resource_words(blk_instance *inst, const char *folder, const char *name, int64_t *n);
 
 /* -- export_step.c ----------------------------------------------------------------------- */
 

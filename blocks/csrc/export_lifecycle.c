@@ -64,6 +64,7 @@ void blk_instance_free(blk_instance *inst)
         return;
     ex_release_build(inst);
     ex_free_export(&inst->x);
+    free(inst->scheduled);
     free(inst->params);
     free(inst->set);
     free(inst->inputs);
@@ -107,8 +108,9 @@ blk_status blk_instance_exit_initialization(blk_instance *inst)
 {
     if (inst->phase != BLK_INITIALIZATION)
         return ex_wrong_phase(inst, "exiting initialization mode");
-    if (ex_build_kernels(inst) != 0 ||
-        (!inst->outputs_fresh && (inst->phase = BLK_STEPPING, ex_refresh_outputs(inst) != 0))) {
+    /* scheduled execution: the outputs are the partitions' (clocked ones have no value before their clock ticks) */
+    int outputs = !inst->outputs_fresh && inst->scheduled == NULL;
+    if (ex_build_kernels(inst) != 0 || (outputs && (inst->phase = BLK_STEPPING, ex_refresh_outputs(inst) != 0))) {
         inst->phase = BLK_FAILED;
         return BLK_STATUS_ERROR;
     }

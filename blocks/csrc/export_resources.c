@@ -225,15 +225,29 @@ static void read_variables(reader *r, blk_export *x)
 }
 
 /* Read BLK_EXPORT_RESOURCE: 0, or -1 after logging why. */
-int ex_read_resources(blk_instance *inst, const char *token, const char *folder)
+/* The path of resource file ``name`` in ``folder`` into path; 0, or -1 after logging why. */
+static int resource_path(blk_instance *inst, const char *folder, const char *name, char *path, size_t size)
 {
-    char path[4096];
     size_t len = strlen(folder);
     const char *sep = len > 0 && folder[len - 1] == '/' ? "" : "/";
-    if ((size_t)snprintf(path, sizeof path, "%s%s%s", folder, sep, BLK_EXPORT_RESOURCE) >= sizeof path) {
+    if ((size_t)snprintf(path, size, "%s%s%s", folder, sep, name) >= size) {
         LOG_ERROR(inst, "the resource folder path is too long: %s", folder);
         return -1;
     }
+    return 0;
+}
+
+int64_t *ex_read_resource_words(blk_instance *inst, const char *folder, const char *name, int64_t *n)
+{
+    char path[4096];
+    return resource_path(inst, folder, name, path, sizeof path) != 0 ? NULL : read_file(inst, path, n);
+}
+
+int ex_read_resources(blk_instance *inst, const char *token, const char *folder)
+{
+    char path[4096];
+    if (resource_path(inst, folder, BLK_EXPORT_RESOURCE, path, sizeof path) != 0)
+        return -1;
     blk_export *x = &inst->x;
     int64_t n;
     x->data = read_file(inst, path, &n);

@@ -1,7 +1,8 @@
 /* The variables of an exported FMU's instance by value reference: 0 the time, then the
  * inputs, the outputs and the parameters, each a range that starts where the resources say
  * (export_instance.h). Reading an output computes the outputs first when an input changed
- * (between grid points the outputs hold: export_step.c);
+ * (between grid points the outputs hold: export_step.c; in scheduled execution the
+ * partitions compute them);
  * setting a parameter releases the kernels, which are built again with it. */
 
 #include "export_internal.h"
@@ -24,9 +25,11 @@ blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n
             LOG_ERROR(inst, "output %u is calculated: read it after entering initialization mode", vr[i]);
             return BLK_STATUS_ERROR;
         }
-        int refreshed = ex_build_kernels(inst) != 0                         ? -1
-                        : inst->outputs_fresh || inst->build->held ? 0
-                                                                    : ex_refresh_outputs(inst);
+        /* held between grid points (export_step.c); in scheduled execution the partitions
+         * computed them: a get computes nothing */
+        int fresh = inst->outputs_fresh || inst->build->held
+                    || (inst->scheduled != NULL && inst->phase == BLK_STEPPING);
+        int refreshed = ex_build_kernels(inst) != 0 ? -1 : fresh ? 0 : ex_refresh_outputs(inst);
         if (refreshed < 0)
             return BLK_STATUS_ERROR;
         break;

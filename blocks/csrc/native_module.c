@@ -8,6 +8,7 @@
 
 #include "blocks_kernel.h"
 #include "export_instance.h"
+#include "export_scheduled.h"
 #include "fmu_block_step.h"
 #include "fmu_channel.h"
 #include "fmu_me_integration.h"
@@ -58,6 +59,9 @@ PyMODINIT_FUNC PyInit__native(void)
         PyModule_AddStringConstant(module, "EXPORT_RESOURCE", BLK_EXPORT_RESOURCE) != 0 ||
         PyModule_AddObject(module, "EXPORT_FORMAT", Py_BuildValue("(LL)", (long long)BLK_EXPORT_MAGIC,
                                                                   (long long)BLK_EXPORT_VERSION)) != 0 ||
+        PyModule_AddStringConstant(module, "SCHEDULED_RESOURCE", BLK_SCHEDULED_RESOURCE) != 0 ||
+        PyModule_AddObject(module, "SCHEDULED_FORMAT", Py_BuildValue("(LL)", (long long)BLK_SCHEDULED_MAGIC,
+                                                                     (long long)BLK_SCHEDULED_VERSION)) != 0 ||
         PyModule_AddObject(module, "EXPORT_LOG_CATEGORIES",
                            Py_BuildValue("(sss)", BLK_LOG_EVENTS, BLK_LOG_WARNING, BLK_LOG_ERROR)) != 0) {
         Py_DECREF(module);

@@ -25,9 +25,9 @@ FMU block's compiled step, model-exchange loops and channel to an isolated FMU."
 EXTENSION_HEADERS = ["native_run.h", "native_kernel_call.h", "layout_names.h", "fmu_block_step.h",
                      "fmu_me_integration.h", "fmu_channel.h", "fmu_step_table.h", "fmi_step_calls.h"]
 EXPORT = ["export_log.c", "export_resources.c", "export_step.c", "export_build.c", "export_lifecycle.c",
-          "export_variables.c", "export_snapshot.c"]
+          "export_variables.c", "export_snapshot.c", "export_scheduled.c"]
 """An exported FMU's instance, one concern a file (export_internal.h lists them)."""
-EXPORT_HEADERS = ["export_instance.h", "export_internal.h"]
+EXPORT_HEADERS = ["export_instance.h", "export_internal.h", "export_scheduled.h"]
 FMI_WRAPPERS = {2: "export_fmi2.c", 3: "export_fmi3.c"}
 KERNEL_SET = "library_kernel_set.c"
 """The kernel-set file of a binary holding the library's kernel types only."""

@@ -153,14 +153,18 @@ _plans: dict[int, dict[Fraction | None, Schedule]] = {}
 """Schedules already built: by diagram (its id, while it lives), then by end time."""
 
 
-def build_schedule(diagram: Diagram, t_end: Fraction | None) -> Schedule:
-    """Plan a run of ``diagram`` to ``t_end`` (None: check everything that does not need it).
+def build_schedule(diagram: Diagram, t_end: Fraction | None, *, advance: bool = True) -> Schedule:
+    """Plan a run of ``diagram`` to ``t_end`` (None: check everything that does not need it);
+    ``advance=False``: no block is advanced over spans (every hit an event of its own, as a
+    scheduled-execution FMU runs it; such a plan is not kept).
 
     A Diagram is not changed after loading, so a plan once built is kept for the next
     call with the same end time (loading plans a diagram, then ``simulate``, ``validate``
     and sweeps ask again). The plans are held here, not on the Diagram, which stays pure
     data; they go when their diagram is garbage collected.
     """
+    if not advance:
+        return _Planner(diagram).plan(t_end, advance=False)
     plans = _plans.get(id(diagram))
     if plans is None:
         plans = _plans[id(diagram)] = {}
@@ -230,7 +234,7 @@ class _Planner:
     def fail(self, line: int | None, message: str, hint: str = "", file: str | None = None) -> None:
         raise DiagramError([Issue(file or self.d.file, line, message, hint)])
 
-    def plan(self, t_end: Fraction | None) -> Schedule:
+    def plan(self, t_end: Fraction | None, advance: bool = True) -> Schedule:
         d = self.d
         explicit = {n: s for n, s in d.blocks.items() if s.period is not None}
         for name, spec in d.blocks.items():
@@ -265,7 +269,8 @@ class _Planner:
             n for n, s in d.blocks.items()
             if s.period is None and not s.block.is_stateful() and not s.block.time_varying
             and n not in delayed_into and n not in logged and masks[n].any())
-        advanced = self.advanced_blocks(masks, period_ticks, offset_ticks, lazy, delayed_into, n_ticks)
+        advanced = (self.advanced_blocks(masks, period_ticks, offset_ticks, lazy, delayed_into, n_ticks)
+                    if advance else frozenset())
         events = np.zeros(hyper, dtype=bool)
         for n in d.blocks:
             if n not in lazy and n not in advanced:

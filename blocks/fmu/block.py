@@ -8,7 +8,9 @@ safe; binding it to its period checks the period against the FMU's step rules
 run an ``FMUState``: a handle to one instance of the block's pool, taken at the run's
 first ``output`` or ``update``. ``output`` returns the outputs at the current hit;
 ``update`` steps the FMU to the next hit with the inputs held (a doStep, or the model
-integrated by the block's solver) and reads the outputs there. Failures become
+integrated by the block's solver) and reads the outputs there. A scheduled-execution
+FMU is activated instead: ``output`` sets the inputs, activates the partitions of the
+clocks that tick at the hit and reads the outputs (``scheduled``). Failures become
 BlockErrors naming the FMU, the time and the status, with the FMU's recent log; a request
 to terminate becomes ``EndRun``; Ctrl-C inside an FMU call stays a KeyboardInterrupt
 (``interrupt``).
@@ -34,6 +36,7 @@ from blocks.fmu.compiled_step import fmu_kernel
 from .log_messages import status_name
 from .model import INTERFACES, ISOLATIONS, float_or_none, isolation_choice
 from .pool import PooledModel
+from .clocks import ClockRun, check_period
 from .solvers import DEFAULT_TOLERANCE, CallFailed, Integration, SolverError, integration, solver_choice
 from .start_values import assignments, input_starts, start_of
 
@@ -52,7 +55,7 @@ class FMUState:
     early; otherwise that happens when the state is garbage collected.
     """
 
-    __slots__ = ("instance", "model", "time", "outputs", "ended", "_release", "__weakref__")
+    __slots__ = ("instance", "model", "time", "outputs", "ended", "clocks", "_release", "__weakref__")
 
     def __init__(self, model: PooledModel):
         if model.closed:
@@ -62,6 +65,8 @@ class FMUState:
         self.time: float | None = None
         self.outputs: dict[str, Signal] | None = None
         self.ended: float | None = None
+        self.clocks = ClockRun()
+        """Scheduled execution: what the run remembers of its clocks."""
         self._release: weakref.finalize | None = None
 
     def acquire(self) -> Instance:
@@ -178,22 +183,37 @@ class FMU(Block):
             raise ValueError(f"parameter '{given}' is for model-exchange FMUs; {shown} runs as co-simulation, "
                              f"with its own solver ({other})")
         model.isolation, model.timeout = isolation_choice(model, isolation, call_timeout)
+        if model.scheduled and model.isolation == "process":
+            if isolation == "process":
+                raise ValueError(f"{shown} runs scheduled execution, which the block runs in the run's process "
+                                 "only; drop 'isolation: process'")
+            model.isolation = "none"
         self._assignments = assignments(model, start_values)
         self.tolerance = tolerance if tolerance is not None else model.default_tolerance
         if model.exchange and self.tolerance is None:
             self.tolerance = DEFAULT_TOLERANCE
         self.inputs = {p.name: p.width for p in model.inputs.values()}
         self.outputs = {p.name: p.width for p in model.outputs.values()}
+        self._clock_ports = {c.port: c.name for c in model.clocks if c.kind in ("triggered", "output")}
+        """Scheduled execution: the ports of its triggered input clocks and its output clocks."""
+        for c in model.clocks:
+            if c.kind in ("triggered", "output"):
+                (self.inputs if c.kind == "triggered" else self.outputs)[c.port] = 1
         self.input_defaults = input_starts(model, self._assignments)
         self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
         if not isinstance(feedthrough, bool):
             raise ValueError(f"parameter 'feedthrough' must be true or false, got {feedthrough!r}")
         if feedthrough and model.exchange:
             raise ValueError(f"parameter 'feedthrough' is for co-simulation FMUs; {shown} runs as model exchange")
-        self._direct = feedthrough and any(model.direct_reads.values())
+        self._direct = (feedthrough or model.scheduled) and any(model.direct_reads.values())
         self.feedthrough = model.direct_reads if self._direct else False
-        self.initial_feedthrough = model.initial_reads
+        if model.scheduled and self._clock_ports:  # a triggered clock's port reaches every output at once
+            self._direct = True
+            self.feedthrough = {out: frozenset(self.inputs) for out in self.outputs}
+        # scheduled execution: the clocks that tick at t = 0 are activated with the inputs there
+        self.initial_feedthrough = self.feedthrough if model.scheduled else model.initial_reads
         self._step = 0.0
+        self._period = Fraction(0)
         self.integration: Integration | None = None
         """How a model-exchange FMU is integrated between the hits, once the block has its period."""
 
@@ -285,6 +305,8 @@ class FMU(Block):
         """The FMU variable behind each element of a port (``q[1]``, ``q[2]``, ...; a scalar's
         own name), as other tools name them (an SSD's connectors); None for an FMI 3
         array, whose elements are one variable."""
+        if port in self._clock_ports:
+            return [self._clock_ports[port]]
         spec = self._model.inputs.get(port) or self._model.outputs.get(port)
         if spec is None:
             raise KeyError(port)
@@ -301,6 +323,8 @@ class FMU(Block):
 
     def variable_of(self, port: str) -> str:
         """The FMU variable (or vector ``x[...]``) behind a port, for messages and tools."""
+        if port in self._clock_ports:
+            return self._clock_ports[port]
         spec = self._model.inputs.get(port) or self._model.outputs.get(port)
         if spec is None:
             raise KeyError(port)
@@ -329,9 +353,12 @@ class FMU(Block):
         if model.exchange:
             self.integration = integration(self._solver, self._substep, model.default_step, self.tolerance, period)
             model.integration = self.integration
+        elif model.scheduled:
+            check_period(model.clocks, period, model.shown)
         else:
             self._check_step(period, given)
         super().bind(period)
+        self._period = period
         self._step = float(period)
 
     def _check_step(self, period: Fraction, given: bool) -> None:
@@ -372,6 +399,8 @@ class FMU(Block):
         interrupt.check()
 
     def output(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        if self._model.scheduled:
+            return self._activated(t, state, inputs)
         if state.time is None:
             self._start(t, state, inputs)
         elif self._direct and state.ended is None:
@@ -384,7 +413,28 @@ class FMU(Block):
         inst.write(inputs, t)
         state.outputs = inst.read(t)
 
+    def _activated(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> dict[str, Signal]:
+        """Scheduled execution: the outputs at the hit ``t`` once the inputs of ``t`` are set
+        and the clocks that tick there activated, in priority order."""
+        if state.time is None:
+            self._start(t, state, inputs)
+        if state.clocks.activated != t:
+            self.step_calls(state.instance, t, self._activate, t, state, inputs)
+        return state.outputs
+
+    def _activate(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> None:
+        inst = state.instance
+        inst.arm()
+        inst.write(inputs, t)
+        exact = round(t / self._step) * self._period
+        ticked = inst.activate(self._model.clocks, state.clocks, t, exact, self._period, inputs)
+        interrupt.check()
+        state.outputs = {**inst.read(t), **ticked}
+        state.time = state.clocks.activated = t
+
     def update(self, t: float, state: FMUState, inputs: Mapping[str, Signal]) -> FMUState:
+        if self._model.scheduled:  # the partitions ran at the hit's outputs: scheduled execution has no step
+            return state
         if state.time is None:
             self._start(t, state, inputs)
         inst = state.instance
@@ -436,8 +486,9 @@ class FMU(Block):
 
     def kernel(self) -> Kernel | None:
         """The steady step in C (``blocks.fmu.compiled_step``) when every port is Float64; an FMU
-        with ports of other types, or read with ``feedthrough``, runs in Python."""
-        return None if self._direct else fmu_kernel(self)
+        with ports of other types, read with ``feedthrough``, or run by scheduled execution,
+        runs in Python."""
+        return None if self._direct or self._model.scheduled else fmu_kernel(self)
 
     def _failure(self, inst: Instance, what: str) -> BlockError:
         """The error of a failed call into the FMU, which breaks the instance: ``what`` with

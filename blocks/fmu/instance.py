@@ -78,6 +78,8 @@ class Binary:
     """Where instances run: 'none' (in this process) or 'process' (a process of their own)."""
     timeout: float = 0.0
     """Isolation 'process': how long one call into the FMU may take, in seconds."""
+    scheduled: bool = False
+    """Whether the instance runs the FMU's scheduled-execution interface (FMI 3)."""
 
 
 @dataclass

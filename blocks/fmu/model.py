@@ -29,7 +29,9 @@ from .ports import direct_reads, group_variables, groups, initial_reads, port_na
 
 CO_SIMULATION = "co_simulation"
 MODEL_EXCHANGE = "model_exchange"
-INTERFACES = {CO_SIMULATION: "co-simulation", MODEL_EXCHANGE: "model exchange"}
+SCHEDULED_EXECUTION = "scheduled_execution"
+INTERFACES = {CO_SIMULATION: "co-simulation", MODEL_EXCHANGE: "model exchange",
+              SCHEDULED_EXECUTION: "scheduled execution"}
 """The interfaces the block runs, by the name a diagram's ``interface`` parameter gives them,
 in words."""
 
@@ -78,9 +80,17 @@ class Model:
             raise ValueError(f"{shown} is an FMI {md.fmiVersion} FMU; the FMU block supports FMI 2.0 "
                              "and 3.0")
         self.major = major
-        self.exchange = self._interface(interface) == MODEL_EXCHANGE
+        chosen = self._interface(interface)
+        self.exchange = chosen == MODEL_EXCHANGE
         """Whether the block runs the FMU's model-exchange interface (else co-simulation)."""
-        element = md.modelExchange if self.exchange else md.coSimulation
+        self.scheduled = chosen == SCHEDULED_EXECUTION
+        """Whether it runs FMI 3 scheduled execution (``scheduled``: its input clocks activated)."""
+        element = md.modelExchange if self.exchange else md.scheduledExecution if self.scheduled else md.coSimulation
+        self.clocks = ()
+        if self.scheduled:
+            from .clocks import fmu_clocks
+
+            self.clocks = fmu_clocks(description.xml, shown)
         self.identifier = element.modelIdentifier
         self.once_per_process = bool(element.canBeInstantiatedOnlyOncePerProcess)
         if element.needsExecutionTool:
@@ -117,6 +127,12 @@ class Model:
             except ValueError as exc:
                 self.default_step_problem = f"its DefaultExperiment stepSize '{shown_text(de.stepSize)}' is {exc}"
         self.default_tolerance = float_or_none(de.tolerance if de else None)
+        if self.scheduled:  # its hits are its periodic clocks' ticks
+            from .clocks import clock_grid
+
+            grid = clock_grid(self.clocks)
+            if grid is not None:
+                self.default_step, self.default_step_problem = grid, None
         self.variables = {v.name: v for v in md.modelVariables}
         kinds = KINDS[major]
         ports = [v for v in md.modelVariables if v.type in kinds]
@@ -140,24 +156,23 @@ class Model:
 
     @property
     def interface(self) -> str:
-        """The interface the block runs, in words: 'co-simulation' or 'model exchange'."""
-        return "model exchange" if self.exchange else "co-simulation"
+        """The interface the block runs, in words: 'co-simulation', 'model exchange' or
+        'scheduled execution'."""
+        return "model exchange" if self.exchange else "scheduled execution" if self.scheduled else "co-simulation"
 
     def _interface(self, asked: str | None) -> str:
         """The interface to run: ``asked`` (a value of ``INTERFACES``), else co-simulation
         where the FMU offers it, else model exchange; ValueError if the FMU lacks it."""
         md = self.md
-        offered = [name for name, element in ((CO_SIMULATION, md.coSimulation), (MODEL_EXCHANGE, md.modelExchange))
+        offered = [name for name, element in ((CO_SIMULATION, md.coSimulation), (MODEL_EXCHANGE, md.modelExchange),
+                                              (SCHEDULED_EXECUTION, getattr(md, "scheduledExecution", None)))
                    if element is not None]
         if asked is None and offered:
             return offered[0]
         if asked in offered:
             return asked
         if not offered:
-            other = "scheduled execution" if md.scheduledExecution is not None else "no interface"
-            raise ValueError(f"{self.shown} has neither a co-simulation nor a model-exchange interface (it "
-                             f"provides only {other}); the FMU block runs FMI 2.0 and 3.0 co-simulation and "
-                             "model-exchange FMUs, not scheduled execution")
+            raise ValueError(f"{self.shown} has no co-simulation, model-exchange or scheduled-execution interface")
         raise ValueError(f"{self.shown} has no {INTERFACES[asked]} interface (it provides only "
                          f"{INTERFACES[offered[0]]}); drop 'interface: {asked}' to run it as {INTERFACES[offered[0]]}")
 

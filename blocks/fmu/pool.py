@@ -30,6 +30,7 @@ from .archive import ArchiveError, extract_archive
 from .description import MODEL_DESCRIPTION
 from .cosimulation import CoSimulation2, CoSimulation3
 from .exchange import ModelExchange2, ModelExchange3
+from .scheduled import ScheduledExecution3
 from blocks.fmu.isolation.client import HostedInstance
 from .instance import Binary, Instance
 from .model import Model
@@ -105,7 +106,7 @@ class PooledModel(Model):
                                      self.integration, self.states, self.indicators, self.completed_step,
                                      [(p.name, p.width) for p in self.inputs.values()],
                                      [(p.name, p.width) for p in self.outputs.values()], self.isolation,
-                                     self.timeout)
+                                     self.timeout, self.scheduled)
         return self.binary
 
     def release(self, inst: Instance, report: bool = False) -> None:
@@ -138,6 +139,8 @@ class PooledModel(Model):
 
 def instance_class(model: Binary) -> type[Instance]:
     """The class of an instance of the FMU ``model`` in this process, for its interface and FMI version."""
+    if model.scheduled:
+        return ScheduledExecution3
     kinds = {(False, 2): CoSimulation2, (False, 3): CoSimulation3, (True, 2): ModelExchange2,
              (True, 3): ModelExchange3}
     return kinds[model.exchange, model.major]

@@ -88,7 +88,7 @@ KINDS: dict[int, dict[str, PortKind]] = {
 NOT_PORTS = {
     "String": "a String variable, which cannot be a port (ports carry numbers)",
     "Binary": "a Binary variable, which cannot be a port (ports carry numbers)",
-    "Clock": ("a Clock; FMI 3 clocks are not supported (the FMU block runs co-simulation FMUs without "
-              "event mode and model-exchange FMUs without clocks)"),
+    "Clock": ("a Clock, which is not a port (the block activates the periodic input clocks of a "
+              "scheduled-execution FMU on their ticks; co-simulation and model exchange run without clocks)"),
 }
 """Why the other variable types are not ports, by type name."""

@@ -1,4 +1,5 @@
-"""Export a diagram as a native FMI 2.0 or 3.0 co-simulation FMU: ``export_fmu``.
+"""Export a diagram as a native FMI 2.0 or 3.0 co-simulation FMU, or an FMI 3.0
+scheduled-execution FMU: ``export_fmu``.
 
 Any diagram whose blocks all have compiled kernels with records (the library's, an
 application's) leaves as an FMU whose binary is the op-table core (``blocks/csrc/core.c``)
@@ -16,9 +17,15 @@ period of the blocks the plan advances in one call, whose hits communication poi
 be), and a communication step any whole multiple of it; its samples are those of a
 native run of the diagram, to the last bit.
 
+With ``scheduled=True`` (FMI 3) the FMU declares ``<ScheduledExecution>`` instead: one
+constant periodic input clock per rate, exact as ``intervalCounter / resolution``, and one
+model partition per clock (``partitions``); activated on the tick grid in priority order,
+the partitions compute the native run's samples, to the last bit.
+
 Modules: ``kernel_sets`` (the binaries and the kinds they hold), ``plan`` (the op table
 and the blocks' records), ``variables`` (the FMU's variables), ``resources`` (the binary
-resource file), ``description`` (modelDescription.xml, buildDescription.xml).
+resource file), ``description`` (modelDescription.xml, buildDescription.xml),
+``partitions`` (scheduled execution's clocks and partitions).
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ import platform
 import re
 import uuid
 import zipfile
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 
@@ -37,6 +45,7 @@ from blocks.engine.compiled import native
 from blocks.builder.diagram import Diagram
 from .description import build_description, model_description
 from .kernel_sets import FmuExportError, KernelSet, installed_binary, kernel_sets, set_for
+from .partitions import clocks_resource, partitions, variable_clocks
 from .plan import Plan, plan_export
 from .resources import resource_file
 from .variables import Variables, fmu_variables, output_signals
@@ -54,20 +63,32 @@ LOG_DESCRIPTIONS = (
 
 
 def export_fmu(diagram: Diagram, out: Path | str, fmi: int = 2, *, model: str | None = None,
-               step=None, kernel_set: KernelSet | None = None) -> Path:
+               step=None, kernel_set: KernelSet | None = None, scheduled: bool = False) -> Path:
     """Write ``diagram`` as an FMU at ``out`` (a .fmu file) and return its path.
 
     ``model``: the model's name (default: the diagram's name); ``step``: the default
     communication step (a duration; default: the internal step); ``kernel_set``: the
-    binary to use (default: the smallest installed one holding the diagram's kinds).
+    binary to use (default: the smallest installed one holding the diagram's kinds);
+    ``scheduled``: FMI 3 scheduled execution (its clocks are the diagram's rates, ``step``
+    does not apply).
     DiagramError for a diagram that cannot be exported (a block without a compiled
     kernel, a step that is no multiple of the internal step), FmuExportError when the FMU
     cannot be built.
     """
     if fmi not in FMI_VERSIONS:
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
-    plan = plan_export(diagram, {signal.rsplit(".", 1)[0] for _, signal in output_signals(diagram)}, step)
+    if scheduled and (fmi != 3 or step is not None):
+        raise ValueError("scheduled execution is FMI 3's, and takes no communication step")
+    outputs = {signal.rsplit(".", 1)[0] for _, signal in output_signals(diagram)}
+    plan = plan_export(diagram, outputs, step, advance=not scheduled)
     variables = fmu_variables(plan)
+    clocks, clocks_file, extra = None, b"", {}
+    if scheduled:
+        clocks = partitions(plan, variables.vr_param + len(variables.parameters))
+        plan = replace(plan, table=clocks.table, step=clocks.clocks[0].period * plan.schedule.base_tick)
+        clocks_file = clocks_resource(clocks, plan.schedule.hyperperiod, *native().SCHEDULED_FORMAT)
+        extra = {"clocks": clocks, "base_tick": plan.schedule.base_tick,
+                 "variable_clocks": variable_clocks(clocks, plan.table, variables.inputs, variables.outputs)}
     chosen = kernel_set or set_for({b.record.kind for b in plan.blocks})
     grid = plan.grid * plan.schedule.base_tick
     model = model or diagram.name
@@ -75,18 +96,21 @@ def export_fmu(diagram: Diagram, out: Path | str, fmi: int = 2, *, model: str | 
     sources = {path.name: path.read_bytes() for path in chosen.sources(fmi)}
     compiled = [name for name in sources if name.endswith(".c")]
     token_data = resource_file(plan, variables, "", model)
-    identifier = model_identifier(model, fmi, token_data, library, sources)
+    identifier = model_identifier(model, fmi, token_data + clocks_file, library, sources)
     token = "{" + str(uuid.UUID(hashlib.sha256(identifier.encode()).hexdigest()[:32])) + "}"
     resources = resource_file(plan, variables, token, model)
     described = model_description(
-        fmi, identifier, token, model, _description(diagram, grid), variables, grid, plan.step, diagram.t_end,
-        dict(zip(native().EXPORT_LOG_CATEGORIES, LOG_DESCRIPTIONS)), f"blocks {_version()}", compiled)
+        fmi, identifier, token, model, _description(diagram, grid, scheduled), variables, grid, plan.step,
+        diagram.t_end, dict(zip(native().EXPORT_LOG_CATEGORIES, LOG_DESCRIPTIONS)), f"blocks {_version()}", compiled,
+        **extra)
     files = {
         "modelDescription.xml": described,
         f"binaries/{_platform_folder(fmi)}/{identifier}.so": library,
         f"resources/{native().EXPORT_RESOURCE}": resources,
         **{f"sources/{name}": data for name, data in sources.items()},
     }
+    if scheduled:
+        files[f"resources/{native().SCHEDULED_RESOURCE}"] = clocks_file
     if fmi == 3:
         files["sources/buildDescription.xml"] = build_description(identifier, compiled)
     target = Path(out)
@@ -107,8 +131,11 @@ def model_identifier(model: str, fmi: int, resources: bytes, library: bytes, sou
     return f"{stem}_{h.hexdigest()[:12]}"
 
 
-def _description(diagram: Diagram, grid: Fraction) -> str:
+def _description(diagram: Diagram, grid: Fraction, scheduled: bool = False) -> str:
     text = diagram.description.strip() if diagram.description else f"the diagram '{diagram.name}'"
+    if scheduled:
+        return (f"{text} (exported by blocks for scheduled execution: one model partition per rate, activated "
+                "on its clock's ticks, the clocks of an instant in priority order)")
     return (f"{text} (exported by blocks: internal step {float(grid):g} s, communication steps are multiples "
             "of it)")
 

@@ -10,10 +10,16 @@ internal step is the communication grid (``fixedInternalStepSize``, FMI 2: in a 
 annotation), any communication step is taken (``canHandleVariableCommunicationStepSize``;
 between grid points the outputs hold),
 FMU states can be got, set and serialized.
+
+A scheduled-execution FMU (FMI 3, ``clocks`` given) declares ``<ScheduledExecution>``, its
+input clocks (constant, periodic, with their priorities, the interval and shift exact as
+counters of a resolution) after the parameters, its inputs and outputs discrete with the
+clock they belong to where they have one (``clocks=``), which their dependencies name too.
 """
 
 from __future__ import annotations
 
+import math
 from fractions import Fraction
 from xml.etree import ElementTree as ET
 
@@ -35,8 +41,10 @@ def _units(root: ET.Element, variables: list[Variable], extra: tuple[str, ...] =
 
 def model_description(fmi: int, identifier: str, token: str, model: str, description: str, variables: Variables,
                       grid: Fraction, step: Fraction, stop: Fraction | None, log_categories: dict[str, str],
-                      generation_tool: str, source_files: list[str]) -> bytes:
-    """modelDescription.xml of an FMI ``fmi`` export."""
+                      generation_tool: str, source_files: list[str], *, clocks=None, base_tick: Fraction | None = None,
+                      variable_clocks: dict[int, int] | None = None) -> bytes:
+    """modelDescription.xml of an FMI ``fmi`` export; scheduled execution with ``clocks``
+    (``partitions.Partitions``), the base tick and each clocked variable's clock."""
     common = {"modelName": model, "description": description, "generationTool": generation_tool,
               "variableNamingConvention": "structured"}
     internal = repr(float(grid))
@@ -48,6 +56,10 @@ def model_description(fmi: int, identifier: str, token: str, model: str, descrip
         files = ET.SubElement(cs, "SourceFiles")
         for name in source_files:
             ET.SubElement(files, "File", name=name)
+    elif clocks is not None:
+        root = ET.Element("fmiModelDescription", fmiVersion="3.0", instantiationToken=token, **common)
+        ET.SubElement(root, "ScheduledExecution", modelIdentifier=identifier, canGetAndSetFMUState="true",
+                      canSerializeFMUState="true")
     else:
         root = ET.Element("fmiModelDescription", fmiVersion="3.0", instantiationToken=token, **common)
         ET.SubElement(root, "CoSimulation", modelIdentifier=identifier,
@@ -66,13 +78,31 @@ def model_description(fmi: int, identifier: str, token: str, model: str, descrip
     if fmi == 2:  # FMI 2 has no fixedInternalStepSize: FMI 3's attribute as a vendor annotation
         tool = ET.SubElement(ET.SubElement(root, "VendorAnnotations"), "Tool", name=generation_tool.split()[0])
         ET.SubElement(tool, "CoSimulation", fixedInternalStepSize=internal)
-    _model_variables(ET.SubElement(root, "ModelVariables"), fmi, everything)
-    _structure(ET.SubElement(root, "ModelStructure"), fmi, variables)
+    listed = ET.SubElement(root, "ModelVariables")
+    _model_variables(listed, fmi, everything, variable_clocks)
+    if clocks is not None:
+        _clocks(listed, clocks, base_tick)
+    _structure(ET.SubElement(root, "ModelStructure"), fmi, variables, variable_clocks)
     ET.indent(root)
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8") + b"\n"
 
 
-def _model_variables(parent: ET.Element, fmi: int, everything: list[Variable]) -> None:
+def _clocks(parent: ET.Element, clocks, base_tick: Fraction) -> None:
+    for c in clocks.clocks:
+        interval, shift = c.seconds(base_tick)
+        resolution = math.lcm(interval.denominator, shift.denominator)
+        attrs = {"name": c.name, "valueReference": str(c.vr), "causality": "input",
+                 "description": f"every {float(interval):g} s" + (f" from {float(shift):g} s on" if shift else ""),
+                 "intervalVariability": "constant", "priority": str(c.priority),
+                 "intervalDecimal": repr(float(interval)), "supportsFraction": "true",
+                 "resolution": str(resolution), "intervalCounter": str(int(interval * resolution))}
+        if shift:
+            attrs.update(shiftDecimal=repr(float(shift)), shiftCounter=str(int(shift * resolution)))
+        ET.SubElement(parent, "Clock", **attrs)
+
+
+def _model_variables(parent: ET.Element, fmi: int, everything: list[Variable],
+                     variable_clocks: dict[int, int] | None = None) -> None:
     if fmi == 3:
         ET.SubElement(parent, "Float64", name="time", valueReference=str(VR_TIME), causality="independent",
                       variability="continuous", description="simulation time", unit="s")
@@ -84,6 +114,10 @@ def _model_variables(parent: ET.Element, fmi: int, everything: list[Variable]) -
             attrs.update(variability="discrete" if v.discrete else "continuous", initial="calculated")
         else:
             attrs.update(variability="continuous")
+        if variable_clocks is not None and v.causality != "parameter":  # scheduled execution: discrete
+            attrs["variability"] = "discrete"
+            if v.vr in variable_clocks:
+                attrs["clocks"] = str(variable_clocks[v.vr])
         typed = {}
         if v.unit:
             typed["unit"] = v.unit
@@ -99,7 +133,8 @@ def _model_variables(parent: ET.Element, fmi: int, everything: list[Variable]) -
             ET.SubElement(parent, "Float64", **attrs, **typed)
 
 
-def _structure(parent: ET.Element, fmi: int, variables: Variables) -> None:
+def _structure(parent: ET.Element, fmi: int, variables: Variables,
+               variable_clocks: dict[int, int] | None = None) -> None:
     """Outputs with the inputs they depend on; initial unknowns (the outputs) with the
     inputs that reach them at t = 0 and every parameter."""
     n_in = len(variables.inputs)
@@ -117,9 +152,12 @@ def _structure(parent: ET.Element, fmi: int, variables: Variables) -> None:
             ET.SubElement(block, "Unknown", index=str(output_index[id(o)]), dependencies=" ".join(map(str, known)))
     else:
         for o in variables.outputs:
+            clock = [variable_clocks[o.vr]] if variable_clocks and o.vr in variable_clocks else []
             ET.SubElement(parent, "Output", valueReference=str(o.vr),
-                          dependencies=" ".join(str(variables.inputs[j].vr) for j in o.depends))
+                          dependencies=" ".join(str(r) for r in [variables.inputs[j].vr for j in o.depends] + clock))
         for o in variables.outputs:
+            if variable_clocks and o.vr in variable_clocks:
+                continue  # a clocked output has no value before its clock ticks: no initial unknown
             known = [variables.inputs[j].vr for j in o.initial_depends] + [p.vr for p in parameters]
             ET.SubElement(parent, "InitialUnknown", valueReference=str(o.vr), dependencies=" ".join(map(str, known)))
 

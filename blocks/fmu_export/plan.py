@@ -76,11 +76,12 @@ class Plan:
     """Programs of the table (-1: none needed)."""
 
 
-def plan_export(diagram: Diagram, output_blocks: set[str], step=None) -> Plan:
+def plan_export(diagram: Diagram, output_blocks: set[str], step=None, advance: bool = True) -> Plan:
     """The plan of ``diagram`` as an FMU whose outputs read ``output_blocks``, with the
     default communication step ``step`` (a duration; default: the grid); DiagramError
-    naming every block that cannot leave Python, or for a step off the grid."""
-    schedule = build_schedule(diagram, diagram_length(diagram))
+    naming every block that cannot leave Python, or for a step off the grid.
+    ``advance=False``: no block advanced over spans (scheduled execution's partitions)."""
+    schedule = build_schedule(diagram, diagram_length(diagram), advance=advance)
     grid = math.lcm(1, *(schedule.period_ticks[n] for n in schedule.advanced))
     grid_step = grid * schedule.base_tick
     default_step = grid_step if step is None else _step(diagram, step, grid_step)

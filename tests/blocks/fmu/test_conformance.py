@@ -185,7 +185,7 @@ connections:
     (2, "s_in", "'s_in' is a String variable, which cannot be a port (ports carry numbers); give it a "
                 "value with start_values"),
     (3, "bin_in", "'bin_in' is a Binary variable, which cannot be a port"),
-    (3, "tick", "'tick' is a Clock; FMI 3 clocks are not supported"),
+    (3, "tick", "'tick' is a Clock, which is not a port"),
     (3, "stop_at", "'stop_at' is a parameter of the FMU, not a port; set it with start_values"),
 ])
 def test_variables_that_are_not_ports_say_why(typed, fmi, port, what):
@@ -313,18 +313,18 @@ def test_csv_columns_of_fmu_vectors_keep_the_fmus_indices(typed, tmp_path):
     assert (again / "signals.csv").read_text() == (tmp_path / "signals.csv").read_text()
 
 
-def test_scheduled_execution_alone_is_refused_and_the_message_says_what_is(typed, tmp_path):
+def test_scheduled_execution_with_a_changing_clock_is_refused_and_the_message_says_why(typed, tmp_path):
     with zipfile.ZipFile(typed[3]) as zf:
         xml = zf.read("modelDescription.xml").decode()
     xml = re.sub(r"<(CoSimulation|ModelExchange) [^>]*/>", '<ScheduledExecution modelIdentifier="Typed3"/>', xml)
+    xml = xml.replace('intervalVariability="triggered"', 'intervalVariability="changing"')
     path = tmp_path / "clocked.fmu"
     with zipfile.ZipFile(path, "w") as zf:
         zf.writestr("modelDescription.xml", xml)
     with pytest.raises(DiagramError) as info:
         fmu_diagram(path, {}, [])
-    assert "has neither a co-simulation nor a model-exchange interface (it provides only scheduled " \
-           "execution); the FMU block runs FMI 2.0 and 3.0 co-simulation and model-exchange FMUs, not " \
-           "scheduled execution" in str(info.value)
+    assert "the input clock 'tick' is changing without an interval the modelDescription gives; the FMU block " \
+           "activates periodic, triggered and countdown clocks" in str(info.value)
 
 
 def test_fmu_info_lists_every_variable_type(typed):

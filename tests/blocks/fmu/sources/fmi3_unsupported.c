@@ -2,15 +2,15 @@
  * the API when it loads an FMU, so they must exist; they are never called and report
  * fmi3Error (3). Defined without the FMI headers, so one generic signature serves all.
  * With TYPED_ACCESSORS the typed get/set functions that typed_fmi3.c defines are left out,
- * with MODEL_EXCHANGE the model-exchange functions (typed_fmi3.c, me_fmi3.c); NO_CO_SIMULATION
- * adds the co-simulation ones that a model-exchange-only FMU lacks (me_fmi3.c). */
+ * with MODEL_EXCHANGE the model-exchange functions (typed_fmi3.c, me_fmi3.c), with
+ * SCHEDULED_EXECUTION those of scheduled execution (clocks_fmi3.c); NO_CO_SIMULATION adds the
+ * co-simulation ones that an FMU without co-simulation lacks (me_fmi3.c, clocks_fmi3.c). */
 #if defined(__GNUC__)
 #define EXPORT __attribute__((visibility("default")))
 #else
 #define EXPORT
 #endif
 #define UNSUPPORTED(name) EXPORT int name(void) { return 3; }
-UNSUPPORTED(fmi3ActivateModelPartition)
 UNSUPPORTED(fmi3DeserializeFMUState)
 UNSUPPORTED(fmi3EnterConfigurationMode)
 UNSUPPORTED(fmi3EnterStepMode)
@@ -18,10 +18,8 @@ UNSUPPORTED(fmi3EvaluateDiscreteStates)
 UNSUPPORTED(fmi3ExitConfigurationMode)
 UNSUPPORTED(fmi3FreeFMUState)
 UNSUPPORTED(fmi3GetAdjointDerivative)
-UNSUPPORTED(fmi3GetClock)
 UNSUPPORTED(fmi3GetDirectionalDerivative)
 UNSUPPORTED(fmi3GetFMUState)
-UNSUPPORTED(fmi3GetIntervalDecimal)
 UNSUPPORTED(fmi3GetIntervalFraction)
 UNSUPPORTED(fmi3GetNumberOfVariableDependencies)
 UNSUPPORTED(fmi3GetOutputDerivatives)
@@ -29,7 +27,6 @@ UNSUPPORTED(fmi3GetShiftDecimal)
 UNSUPPORTED(fmi3GetShiftFraction)
 UNSUPPORTED(fmi3GetString)
 UNSUPPORTED(fmi3GetVariableDependencies)
-UNSUPPORTED(fmi3InstantiateScheduledExecution)
 UNSUPPORTED(fmi3SerializeFMUState)
 UNSUPPORTED(fmi3SerializedFMUStateSize)
 UNSUPPORTED(fmi3SetClock)
@@ -39,6 +36,12 @@ UNSUPPORTED(fmi3SetIntervalFraction)
 UNSUPPORTED(fmi3SetShiftDecimal)
 UNSUPPORTED(fmi3SetShiftFraction)
 UNSUPPORTED(fmi3SetString)
+#ifndef SCHEDULED_EXECUTION /* clocks_fmi3.c provides these */
+UNSUPPORTED(fmi3ActivateModelPartition)
+UNSUPPORTED(fmi3GetClock)
+UNSUPPORTED(fmi3GetIntervalDecimal)
+UNSUPPORTED(fmi3InstantiateScheduledExecution)
+#endif
 #ifndef MODEL_EXCHANGE /* the model-exchange FMUs provide these */
 UNSUPPORTED(fmi3CompletedIntegratorStep)
 UNSUPPORTED(fmi3EnterContinuousTimeMode)
