@@ -7,6 +7,7 @@ binary float, so that 0.1 ms is exactly 1/10000 s and rate coincidences are exac
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from fractions import Fraction
@@ -75,6 +76,7 @@ def positive_duration(value: object, what: str) -> Fraction:
     return seconds
 
 
+@functools.lru_cache(maxsize=256)
 def format_duration(seconds: Fraction) -> str:
     """Short human text for an exact duration, in the largest unit giving a clean number."""
     if seconds == 0:
