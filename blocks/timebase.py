@@ -10,6 +10,7 @@ a decimal number of seconds.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from fractions import Fraction
@@ -95,6 +96,7 @@ def positive_duration(value: object, what: str) -> Fraction:
     return seconds
 
 
+@functools.lru_cache(maxsize=256)
 def format_duration(seconds: Fraction) -> str:
     """Short human text for an exact duration, in the largest unit giving a clean number."""
     if seconds == 0:

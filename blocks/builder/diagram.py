@@ -391,6 +391,13 @@ class Diagram:
 def jsonable(value: Any) -> Any:
     """``value`` with every mapping, sequence and array turned into JSON types (other
     objects as their text): parameters as run.json records them and the loader hashes them."""
+    kind = type(value)
+    if kind is float or kind is int or kind is str or kind is bool or value is None:
+        return value  # the common leaves first: every run records its parameters
+    if kind is dict:
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if kind is list:
+        return [jsonable(v) for v in value]
     if isinstance(value, Mapping):
         return {str(k): jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

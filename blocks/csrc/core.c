@@ -178,12 +178,35 @@ static void log_row(blk_run *r, int64_t e, const double *outputs)
 {
     const int64_t *lg = r->table->logs + e * BLK_L_N;
     int64_t *c = r->counters + e * BLK_LC_N;
-    if (c[BLK_LC_HITS] % lg[BLK_L_DECIMATE] == 0 && c[BLK_LC_ROWS] < lg[BLK_L_CAPACITY]) {
+    if ((lg[BLK_L_DECIMATE] == 1 || c[BLK_LC_HITS] % lg[BLK_L_DECIMATE] == 0) && c[BLK_LC_ROWS] < lg[BLK_L_CAPACITY]) {
         memcpy(r->logs[e] + c[BLK_LC_ROWS] * lg[BLK_L_WIDTH], outputs + lg[BLK_L_COLUMN],
                (size_t)lg[BLK_L_WIDTH] * sizeof(double));
         c[BLK_LC_ROWS]++;
     }
     c[BLK_LC_HITS]++;
+}
+
+/* log_row for each of n rows of width values (an advance's): every row of a log entry
+   that keeps every hit copied in one go when it takes whole rows, as log_row would. */
+static void log_rows(blk_run *r, int64_t e, const double *rows, int64_t n, int64_t width)
+{
+    const int64_t *lg = r->table->logs + e * BLK_L_N;
+    int64_t *c = r->counters + e * BLK_LC_N;
+    if (lg[BLK_L_DECIMATE] != 1) {
+        for (int64_t i = 0; i < n; i++)
+            log_row(r, e, rows + i * width);
+        return;
+    }
+    int64_t room = lg[BLK_L_CAPACITY] - c[BLK_LC_ROWS], kept = n < room ? n : room, w = lg[BLK_L_WIDTH];
+    double *to = r->logs[e] + c[BLK_LC_ROWS] * w;
+    if (kept > 0 && w == width)
+        memcpy(to, rows, (size_t)(kept * w) * sizeof(double));
+    else
+        for (int64_t i = 0; i < kept; i++)
+            memcpy(to + i * w, rows + i * width + lg[BLK_L_COLUMN], (size_t)w * sizeof(double));
+    if (kept > 0)
+        c[BLK_LC_ROWS] += kept;
+    c[BLK_LC_HITS] += n;
 }
 
 static void lock_for(blk_run *r, const blk_kernel *k)
@@ -237,13 +260,13 @@ static void end_at_next_hit(blk_run *r, int64_t block)
     }
 }
 
-/* A block's output (into the arena) or update at tick ke: its kernel, or the host's call hook. */
-static int step(blk_run *r, int64_t index, const int64_t *op, int64_t ke, int *which)
+/* A block's output (into the arena) or update at tick ke (time t): its kernel, or the
+   host's call hook. */
+static int step(blk_run *r, int64_t index, const int64_t *op, int64_t ke, double t, int *which)
 {
     const int64_t *b = r->table->blocks + op[BLK_OP_A] * BLK_B_N;
     const blk_kernel *k = r->kernels + op[BLK_OP_A];
     const double *const *inputs = r->pointers + b[BLK_B_FIRST_INPUT];
-    double t = tick_time(r->table, ke);
     int done = 0;
     lock_for(r, k);
     if (k->output == NULL)
@@ -318,9 +341,9 @@ static int64_t nonfinite_output(const blk_run *r, const int64_t *op)
     return -1;
 }
 
-static int output(blk_run *r, int64_t index, const int64_t *op, int64_t ke)
+static int output(blk_run *r, int64_t index, const int64_t *op, int64_t ke, double t)
 {
-    int which = 0, code = step(r, index, op, ke, &which);
+    int which = 0, code = step(r, index, op, ke, t, &which);
     if (code)
         return fail(r, index, ke, code, which);
     int64_t bad = r->allow_nonfinite ? -1 : nonfinite_output(r, op);
@@ -332,9 +355,9 @@ static int output(blk_run *r, int64_t index, const int64_t *op, int64_t ke)
     return 0;
 }
 
-static int update(blk_run *r, int64_t index, const int64_t *op, int64_t ke)
+static int update(blk_run *r, int64_t index, const int64_t *op, int64_t ke, double t)
 {
-    int which = 0, code = step(r, index, op, ke, &which);
+    int which = 0, code = step(r, index, op, ke, t, &which);
     if (code == BLK_END_RUN) {
         if (r->hooks.end && r->hooks.end(r->hooks.host, index, which, ke))
             return fail(r, index, ke, code, which);
@@ -357,7 +380,7 @@ static int advance(blk_run *r, int64_t index, const int64_t *op, int64_t ke, int
     const blk_kernel *k = r->kernels + block;
     double *rows = r->arena + b[BLK_B_ROWS], *out = r->arena + b[BLK_B_OUT];
     int64_t width = b[BLK_B_WIDTH], period = b[BLK_B_PERIOD], capacity = b[BLK_B_ROWS_CAPACITY];
-    int64_t n = (next - ke) / period, stepped = 0;
+    int64_t n = period == 1 ? next - ke : (next - ke) / period, stepped = 0;
     while (n > 0) {
         int m = (int)(n < capacity ? n : capacity), done = 0, which = 0, code;
         int64_t first = ke + stepped * period;
@@ -374,9 +397,8 @@ static int advance(blk_run *r, int64_t index, const int64_t *op, int64_t ke, int
             bad -= logged * width;
             memcpy(out, rows + logged * width, (size_t)width * sizeof(double));
         }
-        for (int i = 0; i < logged; i++)
-            for (int64_t e = op[BLK_OP_B]; e < op[BLK_OP_C]; e++)
-                log_row(r, e, rows + i * width);
+        for (int64_t e = op[BLK_OP_B]; e < op[BLK_OP_C]; e++)
+            log_rows(r, e, rows, logged, width);
         if (bad >= 0)
             return fail(r, index, first + (logged + 1) * period, BLK_NONFINITE, (int)bad);
         if (code)
@@ -405,16 +427,17 @@ static int head(blk_run *r, int64_t p, int64_t ke, int64_t *tail)
     const blk_table *t = r->table;
     const int64_t *row = t->programs + p * BLK_PR_N;
     r->outcome.reached = ke;
+    double t_ke = tick_time(t, ke); /* one time for the event's ops */
     int64_t i = row[BLK_PR_FIRST];
     for (; i < row[BLK_PR_END]; i++) {
         const int64_t *op = t->ops + i * BLK_OP_N;
         int stop = 0;
         switch (op[BLK_OP_CODE]) {
         case BLK_OUTPUT:
-            stop = output(r, i, op, ke);
+            stop = output(r, i, op, ke, t_ke);
             break;
         case BLK_UPDATE:
-            stop = update(r, i, op, ke);
+            stop = update(r, i, op, ke, t_ke);
             break;
         case BLK_ADVANCE:
             *tail = i;

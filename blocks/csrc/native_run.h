@@ -121,6 +121,10 @@ int run_python_op(RunObject *r, int64_t op, double t, int n, int *done);
 /* native_run_hooks.c: the hooks of r's run (blk_hooks of core.h). */
 blk_hooks run_hooks(RunObject *r);
 
+/* A kernel row's state column that names the block's entry of the states list (its
+   array's data, bound with the row) rather than an address. */
+#define RUN_STATE_OF_LIST (-1)
+
 /* native_run_bind.c: the tables, arena, logs, counters, kernel rows and Python blocks of
    Run(...) checked and bound into r->table, r->run and r->python; -1 with an exception. */
 int run_bind(RunObject *r, PyObject *tables, PyObject *arena, PyObject *logs, PyObject *counters, PyObject *kernels,

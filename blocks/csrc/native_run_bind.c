@@ -105,7 +105,18 @@ static int bind_kernels(RunObject *r, PyObject *rows)
         kb->update = (blk_update_fn)(intptr_t)k[1];
         kb->advance = (blk_advance_fn)(intptr_t)k[2];
         kb->ctx = (const void *)(intptr_t)k[3];
-        kb->state = (double *)(intptr_t)k[4];
+        if (k[4] == RUN_STATE_OF_LIST) { /* the block's state in the states list: a flat float64 array */
+            Py_ssize_t size;
+            if (b >= PyList_GET_SIZE(r->states)) {
+                PyErr_SetString(PyExc_ValueError, "Run: a kernel row names a state the states list lacks");
+                return -1;
+            }
+            kb->state = array_data(PyList_GET_ITEM(r->states, b), 1, 'd', &size, "a kernel's state");
+            if (kb->state == NULL)
+                return -1;
+        } else {
+            kb->state = (double *)(intptr_t)k[4];
+        }
         kb->nogil = (int)k[5];
     }
     return 0;

@@ -23,6 +23,10 @@ from blocks.engine.optable import ADVANCE, L_CAPACITY, L_WIDTH, LC_ROWS, OP_A, O
 KERNEL_COLUMNS = ("output", "update", "advance", "context", "state", "nogil")
 """A run's kernel rows, one per block (all zero for a Python block), as the host reads them."""
 
+STATE_OF_LIST = -1
+"""A kernel row's state: the block's entry of the run's states list (native_run.h's
+RUN_STATE_OF_LIST), whose data the host binds."""
+
 
 class Binding:
     """What one run of ``table`` owns: states, input mappings, kernels, arena and logs."""
@@ -79,12 +83,16 @@ class Binding:
         return address(state) if state is not None and compiled.flat(state) else 0
 
     def kernel_rows(self) -> np.ndarray:
-        """The kernel rows (``KERNEL_COLUMNS``) the C host binds."""
-        rows = np.zeros((len(self.blocks), len(KERNEL_COLUMNS)), dtype=np.int64)
-        for b, k in enumerate(self.kernels):
-            if k is not None:
-                rows[b] = [k.output, k.update, k.advance, k.context, self.state_address(b), int(k.nogil)]
-        return rows
+        """The kernel rows (``KERNEL_COLUMNS``) the C host binds; a flat state is named by
+        ``STATE_OF_LIST``, its array's data found by the host in the states list."""
+        rows = [[0] * len(KERNEL_COLUMNS) if k is None else
+                [k.output, k.update, k.advance, k.context, self._state_column(b), int(k.nogil)]
+                for b, k in enumerate(self.kernels)]
+        return np.array(rows, dtype=np.int64).reshape(len(self.blocks), len(KERNEL_COLUMNS))
+
+    def _state_column(self, b: int) -> int:
+        state = self.states[b]
+        return STATE_OF_LIST if state is not None and compiled.flat(state) else 0
 
     def kernel_error(self, b: int, code: int, which: int, tick: int, phase: str) -> BaseException:
         """The exception of block ``b``'s kernel failure ``code``, from its error factory

@@ -124,6 +124,36 @@ class Schedule:
         ticks = rel[j % rel.size] + self.hyperperiod * (j // rel.size)
         return np.where(j < 0, 0, ticks).astype(np.int64)
 
+    def sample_times(self, block: str, count: int, decimate: int = 1) -> np.ndarray:
+        """The times in seconds of the block's hits numbered 0, decimate, 2 decimate, ...
+        (``count`` of them): ``tick * num / den`` of each hit's tick, as float64. A block
+        whose hits are evenly spaced gets them without listing its ticks as integers
+        (the same values: each ``tick * num`` is exact in double, run lengths keep it so)."""
+        num, den = self.base_tick.numerator, self.base_tick.denominator
+        spacing = self._spacing(block)
+        if spacing is None:
+            return self.nth_hits(block, np.arange(count) * decimate) * num / den
+        first, step = spacing
+        times = np.arange(count, dtype=np.float64)
+        times *= step * decimate * num
+        if first:
+            times += first * num
+        times /= den
+        return times
+
+    def _spacing(self, block: str) -> tuple[int, int] | None:
+        """(first, step) when the block's hits are the ticks first + step * i, i >= 0."""
+        mask = self.masks[block]
+        rel = np.flatnonzero(mask)
+        if rel.size == 0:
+            return None
+        step = self.hyperperiod // rel.size
+        if step * rel.size != self.hyperperiod or np.any(rel != rel[0] + step * np.arange(rel.size)):
+            return None
+        if self.fires_at_zero[block] and not mask[0]:
+            return (0, step) if rel[0] == step else None
+        return int(rel[0]), step
+
     def hit_count(self, block: str, n_ticks: int) -> int:
         """How many ticks in [0, n_ticks] ``block`` fires at, without listing them."""
         mask = self.masks[block]

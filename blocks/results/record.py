@@ -117,13 +117,13 @@ def signals(diagram: Diagram, schedule: Schedule, binding: Binding) -> dict[str,
 
 
 def _signals(diagram: Diagram, schedule: Schedule, binding: Binding) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    tick = schedule.base_tick
     row_of = {j: r for r, j in enumerate(binding.table.names.log_order)}
     found = {}
     for j, e in enumerate(diagram.log):
-        rows = binding.rows_logged(row_of[j]).copy()
-        ticks = schedule.nth_hits(e.block, np.arange(len(rows)) * e.decimate)
-        found[e.signal] = (ticks * tick.numerator / tick.denominator, rows)
+        rows, buffer = binding.rows_logged(row_of[j]), binding.logs[row_of[j]]
+        # the run's own buffer when the run filled it; a copy of what a run cut short logged
+        rows = buffer if len(rows) == len(buffer) else rows.copy()
+        found[e.signal] = (schedule.sample_times(e.block, len(rows), e.decimate), rows)
     return found
 
 
