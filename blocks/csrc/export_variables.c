@@ -27,9 +27,12 @@ blk_status blk_instance_get(blk_instance *inst, const unsigned int *vr, size_t n
         }
         /* held between grid points (export_step.c); in scheduled execution the partitions
          * computed them: a get computes nothing */
-        int fresh = inst->outputs_fresh || inst->build->held
-                    || (inst->scheduled != NULL && inst->phase == BLK_STEPPING);
-        int refreshed = ex_build_kernels(inst) != 0 ? -1 : fresh ? 0 : ex_refresh_outputs(inst);
+        int refreshed = -1;
+        if (ex_build_kernels(inst) == 0) {
+            int fresh = inst->outputs_fresh || inst->build->held
+                        || (inst->scheduled != NULL && inst->phase == BLK_STEPPING);
+            refreshed = fresh ? 0 : ex_refresh_outputs(inst);
+        }
         if (refreshed < 0)
             return BLK_STATUS_ERROR;
         break;
