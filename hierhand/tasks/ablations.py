@@ -60,10 +60,11 @@ ABLATIONS = (
              "the paper starts with the object held; here the fingers start 0.1 mm off it and close while a "
              "support carries its weight",
              {"support.until": 0.0}, mechanism=False),
-    Ablation("squeeze from the object's weight", "reflex.squeeze_from_weight false, min_force 0.1 N",
+    Ablation("squeeze set up beforehand", "reflex.squeeze_from_weight false, min_force 0.1 N",
              "when the support lets go two fingers must carry m g by friction at once, m g / (2 x the ratio "
              "target) each (2.6 N for 0.3 kg), more than the integrator builds up in time: the squeeze is set "
-             "up beforehand, from the object's weight",
+             "up beforehand, from the object's weight, at least 3 N (a light object's squeeze must still hold "
+             "the forefinger on against its withdrawal without the suppresser)",
              {"reflex.squeeze_from_weight": False, "reflex.min_force": 0.1}),
     Ablation("ratio target below sliding friction", "reflex.friction_cap false",
              "a contact slides at |f_t|/f_n = mu_d, so a safety ratio at or above mu_d never calls for more "
@@ -86,11 +87,11 @@ ABLATIONS = (
              "the sigmoid closes a loop through the grasping torque and the finger of gain |tau_g| S_a / 4, "
              "several times what the 10 ms PD tolerates",
              {"suppress.time_constant": 0.0}),
-    Ablation("suppression by |tau_m|", "suppress.mode magnitude (the paper's prose, not its formula)",
+    Ablation("suppression signed against the grasp", "suppress.mode magnitude (the paper's prose, not its formula)",
              "the shipped mode is the paper's formula with tau_m signed against the grasp; by magnitude, "
              "voluntary motion pushing along the grasp suppresses it too",
              {"suppress.mode": "magnitude"}),
-    Ablation("the re-grasp's S_b in every task", "suppress.S_b 0.02 N m in the grasp and manipulation tasks",
+    Ablation("per-task S_b (0.1 N m but in the re-grasp)", "suppress.S_b 0.02 N m in the grasp and manipulation tasks",
              "the grasp and manipulation tasks use S_b = 0.1 N m: the PD's resistance to a push or its drive "
              "of the object is not to release a finger there",
              {"suppress.S_b": 0.02}, tasks=("grasp", "manipulate")),
