@@ -44,14 +44,30 @@ DIAGRAMS = ROOT / "diagrams"
 NAMES = tuple(task.name for task in TASKS)
 
 
-def _judge(args: tuple[Variation, dict]) -> dict[str, str]:
+def _judge(args: tuple[Variation, dict]) -> tuple[dict[str, str], dict]:
     variation, extra = args
-    return judge(variation, DIAGRAMS, extra)
+    margins: dict = {}
+    return judge(variation, DIAGRAMS, extra, margins=margins), margins
 
 
-def run(points: list[Variation], extra: dict, workers: int) -> list[dict[str, str]]:
+def run(points: list[Variation], extra: dict, workers: int, margins: list | None = None) -> list[dict[str, str]]:
+    """Each point's outcomes; ``margins``, when given, receives each point's threshold margins."""
     with ProcessPoolExecutor(workers) as pool:
-        return list(pool.map(_judge, [(p, extra) for p in points], chunksize=4))
+        got = list(pool.map(_judge, [(p, extra) for p in points], chunksize=4))
+    if margins is not None:
+        margins.extend(m for _, m in got)
+    return [outcomes for outcomes, _ in got]
+
+
+def margin_spread(margins: list[dict]) -> None:
+    """Per task with a threshold claim: its margin (safety ratio less the ratio it is judged
+    by, plant rate) over the points where the object stayed held: least, 5 %, median."""
+    for task in NAMES:
+        values = np.array([m[task] for m in margins if m.get(task) is not None])
+        if values.size:
+            low, five, mid = np.min(values), np.quantile(values, 0.05), np.median(values)
+            print(f"{task:22s} margin to the safety ratio over {values.size} points: least {low:+.3f}, "
+                  f"5 % {five:+.3f}, median {mid:+.3f}")
 
 
 def rate(points: list[Variation], rows: list[dict[str, str]], task: str, only_seeing_slip: bool = False) -> tuple[int, int]:
@@ -148,11 +164,13 @@ def main() -> None:
     args = parser.parse_args()
     points = sample(args.points, args.seed, SPREADS[args.spread])
     start = time.perf_counter()
-    rows = run(points, {}, args.workers)
+    margins: list[dict] = []
+    rows = run(points, {}, args.workers, margins)
     paper = None if args.no_paper_only else run(points, paper_only(), args.workers)
     print(f"{args.points} points of the {args.spread} spread, seed {args.seed}, {time.perf_counter() - start:.1f} s "
           f"on {args.workers} worker(s)")
     report(points, rows, paper)
+    margin_spread(margins)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "rows.json").write_text(json.dumps([{"point": p.as_dict(), **r} for p, r in zip(points, rows)]))
     if not args.no_plot:

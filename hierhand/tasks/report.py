@@ -157,7 +157,11 @@ Each of these is beyond the paper; the ablation table below switches each off al
   about 0.6-0.8 N m/rad and 0.013-0.017 N m s/rad).
 - **The PD aims a squeezed fingertip as deep as its normal force presses it** (fn / k_n along
   the contact normal): aimed at the surface, posture holding pushes back against the squeeze,
-  and the suppresser reads that as voluntary motion against the grasp.
+  and the suppresser reads that as voluntary motion against the grasp. fn / k_n is the summed
+  depth of every surface point under the tip, about three times the tip's own depth (0.35 mm
+  at 3 N), so the aim is deeper than the tip sits and the PD adds a squeeze of its own; aimed
+  at the tip's own depth, heavy objects end nearer their manipulation target but the re-grasp
+  drops the object on most of the wide spread: it relies on that extra squeeze.
 - **Feedforward** (output `tau_ff`, added after the suppresser: it is not voluntary motion):
   the fingers' gravity torques and J^T of the object's load, shared by the grasp matrix at the
   contact points in proportion to the normal forces, so that the shares balance the load's
@@ -266,7 +270,7 @@ def needed_lines(summary: dict) -> str:
     lines = []
     for task, needed in summary.get("needed_at_shipped_point", {}).items():
         outcome = paper.get(task)
-        lines.append(f"- {task}: paper only {'succeeds' if outcome == '' else _cell(outcome or 'not run')}; needs "
+        lines.append(f"- {task}: paper only {_outcome(outcome) if outcome is not None else 'not run'}; needs "
                      + (", ".join(needed) if needed else "no addition to the mechanism") + " at the shipped point")
     return "\n".join(lines)
 
