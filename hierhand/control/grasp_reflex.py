@@ -82,6 +82,27 @@ _PORTS = port_columns(REFLEX_OUT)
 """The output ports (tau_g, force, active) and their columns of the law's output."""
 
 
+FRICTION_SHARE = 0.9
+"""With ``friction_cap`` the reflex's safety ratio is at most this share of the hand's mu_d."""
+
+
+def aimed_safety_ratio(hand, safety_ratio: float, friction_cap: bool) -> float:
+    """The safety ratio the reflex keeps to: the given one, or with ``friction_cap`` at most
+    FRICTION_SHARE mu_d. A contact slides at |f_t|/f_n = mu_d, so a safety ratio at or above
+    mu_d never sees a sliding object and never squeezes harder while it slides."""
+    if not friction_cap:
+        return safety_ratio
+    return min(safety_ratio, FRICTION_SHARE * float(hand.params.contact.mu_d))
+
+
+def weight_squeeze(hand, ratio_target: float, fingers: int) -> float:
+    """N per finger: the normal force with which ``fingers`` fingers carry the object's
+    weight by friction at ``ratio_target`` (|f_t| / f_n): ``m |g| / (fingers ratio_target)``,
+    2.6 N for the 0.3 kg object in a two-finger pinch aiming at 0.6 / 1.05."""
+    weight = float(hand.params.object.mass) * float(np.linalg.norm(hand.gravity))
+    return weight / (max(fingers, 1) * ratio_target)
+
+
 def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray:
     """Boolean mask over the hand's fingers for a list of finger names."""
     chosen = [chosen] if isinstance(chosen, str) else list(chosen or [])
@@ -128,6 +149,12 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
     follow_suppression : bool
         hand fingers over as the suppresser switches their grasp off (the hold above);
         false: the paper's reflex, which holds every touching finger whole
+    squeeze_from_weight : bool
+        raise min_force to the squeeze the object's weight needs when the fingers of
+        'grasp' alone carry it at the ratio target (``weight_squeeze``)
+    friction_cap : bool
+        aim at most at FRICTION_SHARE of the plant's sliding friction mu_d, so that a
+        sliding contact always calls for more squeeze (``aimed_safety_ratio``)
     """
 
     type_name = "GraspReflex"
@@ -135,7 +162,8 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
     def __init__(self, hand, grasp=("thumb", "fore"), ki: float = 50.0, safety_ratio: float = 0.6,
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,
                  approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.5,
-                 hold_share: float = 0.9, follow_suppression: bool = True):
+                 hold_share: float = 0.9, follow_suppression: bool = True, squeeze_from_weight: bool = False,
+                 friction_cap: bool = False):
         self.hand = hand_of(hand)
         self._links = hand_link(hand, REFLEX_RECORD.SEGMENT)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
@@ -145,6 +173,10 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                             ("release_share", release_share), ("hold_share", hold_share)):
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ValueError(f"parameter '{name}' must be a number, got {value!r}")
+        self.squeeze_from_weight, self.friction_cap = bool(squeeze_from_weight), bool(friction_cap)
+        safety_ratio = aimed_safety_ratio(self.hand, safety_ratio, self.friction_cap)
+        if self.squeeze_from_weight and safety_ratio > 0 and 1.0 + margin > 0:  # else pack_params refuses them
+            min_force = max(min_force, weight_squeeze(self.hand, safety_ratio / (1.0 + margin), int(self.initial.sum())))
         given = np.empty(GIVEN.size)
         given[GIVEN.KI], given[GIVEN.SAFETY_RATIO], given[GIVEN.MARGIN] = ki, safety_ratio, margin
         given[GIVEN.MIN_FORCE], given[GIVEN.MAX_FORCE], given[GIVEN.APPROACH] = min_force, max_force, approach_force

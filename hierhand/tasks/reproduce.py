@@ -19,7 +19,8 @@ from blocks.process.progress import above, progress_bar
 
 from ..examples import SHIPPED
 from ..model import load_hand
-from .ablations import ABLATIONS, shipped_outcomes
+from .ablations import ABLATIONS, MECHANISMS, needed_at_shipped_point, shipped_outcomes
+from .robustness import TASKS as JUDGED
 from .figures import draw_figures
 from .report import report_markdown
 from .separation import RUNS as SEPARATION_RUNS, separation_relation
@@ -30,6 +31,8 @@ TASKS = ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed")
 
 
 DEFAULT_DIAGRAMS = SHIPPED
+REACTION_SHARES = (0.05, 0.1, 0.5)
+"""Shares of their moves at which Fig. 10's torques are compared besides the first change."""
 SETTLED = 0.01
 """Seconds after the hand-over, the middle finger's first touch or the push from which the
 ratio excursions are counted (the contact's first milliseconds settle its anchors)."""
@@ -84,6 +87,8 @@ def summarize(runs: dict[str, Results]) -> dict:
     grasp = grasp_summary(runs["grasp"], push, handover_time=handover)
     grasp.update(reaction_times(runs["grasp"], push))
     grasp.update(reaction_times(runs["grasp"], push, part=0.01, label="first_moves"))
+    grasp["reaction_shares"] = {f"{round(100 * part)} %": reaction_times(runs["grasp"], push, part=part, label="at")
+                                for part in REACTION_SHARES}
     trajectories = manipulate_params[roles["manipulate"].block("manip")]["trajectories"]
     manipulation = manipulation_summary(runs["manipulate"], trajectories,
                                         load_hand(manipulate_params[roles["manipulate"].plant]).object_pose0)
@@ -94,17 +99,26 @@ def summarize(runs: dict[str, Results]) -> dict:
     def excursions(results: Results, since: float, fingers, until: float = float("inf")) -> dict:
         return {names[f]: v for f, v in ratio_excursions(results, since, fingers, until=until).items()}
 
+    start = regrasp["suppressed"]["withdrawal_start_s"]
+    unsuppressed = regrasp["unsuppressed"]
     return {
         "grasp": grasp,
         "manipulation": manipulation,
         "regrasp": regrasp,
         "ratio_excursions": {
+            "grasp while the fingers close, before the hand-over": excursions(runs["grasp"], 0.0, (THUMB, FORE), handover),
+            f"grasp, the hand-over's first {1000 * SETTLED:g} ms": excursions(
+                runs["grasp"], handover, (THUMB, FORE), handover + SETTLED),
             "grasp after the hand-over, before the push": excursions(
                 runs["grasp"], handover + SETTLED, (THUMB, FORE), push),
             "grasp after the push": excursions(runs["grasp"], push, (THUMB, FORE)),
             "manipulation from its first waypoint": excursions(runs["manipulate"], settle, (THUMB, FORE)),
+            "re-grasp, as the middle finger lands (from its first touch to the withdrawal's start)": excursions(
+                runs["regrasp"], middle or 0.0, (THUMB, FORE, MIDDLE), start),
             "re-grasp, the holding fingers after the middle finger's first touch": excursions(
                 runs["regrasp"], (middle or 0.0) + SETTLED, (THUMB, MIDDLE)),
+            "re-grasp without the suppresser, from the withdrawal's start": excursions(
+                runs["regrasp_unsuppressed"], unsuppressed["withdrawal_start_s"], (THUMB, FORE, MIDDLE)),
         },
     }
 
@@ -116,14 +130,18 @@ def reproduce(out: Path, diagrams: Path = DEFAULT_DIAGRAMS, report: Callable[[st
     relation and of each ablation row, and one for the figures and report."""
     check_diagrams(diagrams)
     out.mkdir(parents=True, exist_ok=True)
-    steps = len(TASKS) + SEPARATION_RUNS + 1 + len(ABLATIONS) + 1
+    steps = len(TASKS) + SEPARATION_RUNS + 2 + len(ABLATIONS) + len(JUDGED) * (len(MECHANISMS) + 1) + 1
     with progress_bar(steps, "reproduce", unit="step", enabled=progress) as bar:
         say, done = above(bar, report), lambda: bar.update(1)
         runs = run_tasks(diagrams, out, say, done)
         summary = summarize(runs)
         summary["separation_relation"] = separation_relation(diagrams / "regrasp.yaml", done)
         summary["ablations"] = shipped_outcomes(diagrams, done=done)
-        say(f"ablations: {len(summary['ablations']) - 1} additions switched off one by one")
+        say(f"ablations: the paper-only configuration, {len(summary['ablations']) - 2} additions switched off one by one")
+        summary["needed_at_shipped_point"] = {}
+        for task in JUDGED:
+            needed = needed_at_shipped_point(diagrams, task, done)
+            summary["needed_at_shipped_point"][task.name] = [a.name for a in MECHANISMS if a.name in needed]
         (out / "summary.json").write_text(json.dumps(summary, indent=2) + "\n", encoding="utf-8")
         draw_figures(runs, summary, out)
         (out / "report.md").write_text(report_markdown(summary, runs), encoding="utf-8")

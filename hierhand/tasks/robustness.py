@@ -70,28 +70,46 @@ def unsuppressed_outcome(results: Results) -> str:
     return "forefinger separates" if events["fore_separation_time_s"] is not None else ""
 
 
+def grasp_margin(results: Results) -> float:
+    """How far the grasp's |f_t|/f_n stays under its safety ratio over the last 0.2 s (plant rate)."""
+    parameters = results.info["parameters"]
+    summary = grasp_summary(results, float(parameters["push"]["time"]))
+    return summary["safety_ratio"] - summary["steady_ratio_max"]
+
+
+def manipulation_margin(results: Results) -> float:
+    """How far the manipulation's |f_t|/f_n stays under its safety ratio once settled (plant rate)."""
+    parameters, b = results.info["parameters"], TaskBlocks.of_run(results)
+    summary = manipulation_summary(results, parameters[b.block("manip")]["trajectories"],
+                                   load_hand(parameters[b.plant]).object_pose0, b)
+    return summary["safety_ratio"] - summary["max_ratio_after_settle"]
+
+
 @dataclass(frozen=True)
 class Task:
-    """A shipped task diagram, whether it moves the object, and how it is judged."""
+    """A shipped task diagram, whether it moves the object, how it is judged, and the margin
+    of its threshold claim (safety ratio less the ratio it is judged by; None without one)."""
 
     name: str
     moves_object: bool
     outcome: Callable[[Results], str]
+    margin: Callable[[Results], float] | None = None
 
 
 TASKS = (
-    Task("grasp", False, grasp_outcome),
-    Task("manipulate", True, manipulation_outcome),
+    Task("grasp", False, grasp_outcome, grasp_margin),
+    Task("manipulate", True, manipulation_outcome, manipulation_margin),
     Task("regrasp", False, regrasp_outcome),
     Task("regrasp_unsuppressed", False, unsuppressed_outcome),
 )
 
 
 def judge(variation: Variation, diagrams: Path, extra: Mapping[str, Mapping[str, Any]] | None = None,
-          tasks: tuple[Task, ...] = TASKS) -> dict[str, str]:
+          tasks: tuple[Task, ...] = TASKS, margins: dict[str, float | None] | None = None) -> dict[str, str]:
     """Each task's outcome on the variation; ``extra``: more ``--set`` values per task name
     (an ablation), written by role (``reflex.margin``, see ``TaskBlocks.resolve``) and
-    applied after the variation's."""
+    applied after the variation's. ``margins``, when given, receives each task's threshold
+    margin (``Task.margin``; None where the task has none, did not run or dropped the object)."""
     outcomes = {}
     for task in tasks:
         path = diagrams / f"{task.name}.yaml"
@@ -103,7 +121,7 @@ def judge(variation: Variation, diagrams: Path, extra: Mapping[str, Mapping[str,
             outcomes[task.name] = UNREACHABLE
             continue
         overrides.update(by_name(b, (extra or {}).get(task.name, {})))
-        outcomes[task.name] = _outcome(task, path, overrides)
+        outcomes[task.name] = _outcome(task, path, overrides, margins)
     return outcomes
 
 
@@ -123,6 +141,10 @@ def by_name(b: TaskBlocks, values: Mapping[str, Any]) -> dict[str, Any]:
     return {b.resolve(key): value for key, value in values.items()}
 
 
-def _outcome(task: Task, path: Path, overrides: dict[str, Any]) -> str:
+def _outcome(task: Task, path: Path, overrides: dict[str, Any], margins: dict | None = None) -> str:
     results = blocks.simulate(blocks.load_diagram(path, overrides=overrides))
-    return task.outcome(results) if results.complete else f"run failed: {results.status}"
+    outcome = task.outcome(results) if results.complete else f"run failed: {results.status}"
+    if margins is not None:
+        held = results.complete and outcome != "dropped" and task.margin is not None
+        margins[task.name] = task.margin(results) if held else None
+    return outcome

@@ -46,6 +46,22 @@ SPREAD: dict[str, tuple[float, float]] = {
     "push": (1.0, 4.0),  # N, in a direction drawn uniformly
 }
 """The ranges of the spread: those of the audit that found the tasks fragile (issue 24)."""
+WIDE: dict[str, tuple[float, float]] = {
+    **SPREAD,
+    "mass": (0.15, 0.6),  # kg: up to twice the paper's object
+    "mu_s": (0.6, 1.2),
+    "ki": (0.4, 1.6),  # the gains +-60 %
+    "kp": (0.4, 1.6),
+    "kd": (0.4, 1.6),
+    "S_a": (0.7, 1.3),  # the suppresser +-30 %
+    "S_b": (0.7, 1.3),
+    "push": (1.0, 5.0),
+    "torque": (-0.05, 0.05),  # N m about the object's centre with the push (2 N at its edge)
+}
+"""A wider spread (issue 45): heavier and more slippery objects, larger pushes with a torque,
+the gains +-60 % and the suppresser +-30 %."""
+SPREADS = {"shipped": SPREAD, "wide": WIDE}
+"""The spreads by name (``benchmarks/robustness.py --spread``)."""
 LOG_UNIFORM = frozenset({"stiffness", "damping", "ki", "kp", "kd"})
 MU_D_PER_MU_S = 0.9
 """The sliding friction of a varied hand, as a share of its static friction (the default hand's)."""
@@ -68,6 +84,7 @@ class Variation:
     S_a: float
     S_b: float
     push: tuple[float, float]
+    torque: float = 0.0
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -94,10 +111,12 @@ def draw(rng: np.random.Generator, spread: Mapping[str, tuple[float, float]] = S
 
     angle = rng.uniform(0.0, 2.0 * math.pi)
     magnitude = value("push")
+    torque = value("torque") if "torque" in spread else 0.0  # drawn last: the other spreads' points stay
     return Variation(mass=value("mass"), size=value("size", 2), links=value("links", 9), mu_s=value("mu_s"),
                      stiffness=value("stiffness"), damping=value("damping"), ki=value("ki"),
                      safety_ratio=value("safety_ratio"), kp=value("kp"), kd=value("kd"), S_a=value("S_a"),
-                     S_b=value("S_b"), push=(magnitude * math.cos(angle), magnitude * math.sin(angle)))
+                     S_b=value("S_b"), push=(magnitude * math.cos(angle), magnitude * math.sin(angle)),
+                     torque=torque)
 
 
 def sample(n: int, seed: int, spread: Mapping[str, tuple[float, float]] = SPREAD) -> list[Variation]:
@@ -180,7 +199,7 @@ def carry(parameters: Mapping[str, Any], v: Variation, moves_object: bool, b: Ta
         overrides[b.resolve("manip.trajectories")] = trajectories
     if "push" in parameters:
         after = list(parameters["push"].get("after", [0.0, 0.0, 0.0]))
-        overrides["push.after"] = [v.push[0], v.push[1], *after[2:]]
+        overrides["push.after"] = [v.push[0], v.push[1], after[2] + v.torque if len(after) > 2 else v.torque]
     return overrides
 
 

@@ -24,11 +24,12 @@ def reproduced(tmp_path_factory):
 
 def test_summary_has_exactly_the_documented_keys(reproduced):
     _, s = reproduced
-    assert set(s) == {"grasp", "manipulation", "regrasp", "ratio_excursions", "separation_relation", "ablations"}
+    assert set(s) == {"grasp", "manipulation", "regrasp", "ratio_excursions", "separation_relation", "ablations",
+                      "needed_at_shipped_point"}
     assert set(s["grasp"]) == {"safety_ratio", "disturbance_time_s", "peak_ratio", "recovery_time_s",
                                "steady_ratio_max", "closing_peak_ratio", "object_displacement_m", "object_dropped",
                                "grasp_torque_reacts_s", "manipulation_torque_reacts_s",
-                               "grasp_torque_first_moves_s", "manipulation_torque_first_moves_s"}
+                               "grasp_torque_first_moves_s", "manipulation_torque_first_moves_s", "reaction_shares"}
     assert set(s["manipulation"]) == {"safety_ratio", "max_ratio_after_settle", "target_pose", "final_pose",
                                       "position_error_m", "angle_error_rad", "object_dropped"}
     for case in ("suppressed", "unsuppressed"):
@@ -44,7 +45,9 @@ def test_summary_has_exactly_the_documented_keys(reproduced):
 
 def test_grasp_closes_within_the_safety_ratio_and_recovers_from_the_disturbance(reproduced):
     g = reproduced[1]["grasp"]
-    assert g["closing_peak_ratio"] <= 0.6  # the fingers close on the object without slipping
+    # the fingers close on the object inside the friction cone (mu_s 1); at the plant's rate
+    # a contact's first anchors take one finger briefly above 0.6 (report.md grades that claim)
+    assert g["closing_peak_ratio"] < 1.0
     assert g["peak_ratio"] > 0.6  # the push takes the ratio over the safety ratio ...
     assert g["recovery_time_s"] is not None and g["recovery_time_s"] < 0.1  # ... and the reflex brings it back
     assert g["steady_ratio_max"] <= 0.6
@@ -108,19 +111,28 @@ def test_figures_and_report_are_written(reproduced):
 
     assert f'"{PAPER_TITLE}"' in report.split("\n## ")[0]  # the paper cited by its title, at the top
     assert "![Fig. 14](fig14.png)" in report
-    assert report.count("| reproduced |") + report.count("| NOT reproduced |") == 10
-    assert "| NOT reproduced |" not in report
-    from hierhand.tasks.ablations import ABLATIONS
+    claims = [line for line in report.split("\n## ")[0].splitlines() if line.startswith("| ") and "|---" not in line][1:]
+    assert len(claims) == 10
+    verdicts = [re.split(r"(?<!\\)\|", row)[-2].strip() for row in claims]
+    assert all(v.startswith(("by the paper's mechanism alone", "with additions: ", "not reproduced")) for v in verdicts)
+    closing = next(v for row, v in zip(claims, verdicts) if "fingers close on the object" in row)
+    assert (closing == "not reproduced") == (s["grasp"]["closing_peak_ratio"] > 0.6)  # graded by the 0.1 ms samples
+    from hierhand.tasks.ablations import ABLATIONS, MECHANISMS, PAPER_ONLY
 
-    for ablation in ABLATIONS:  # one row per addition beyond the paper, each switched off alone
-        escaped = f"| {ablation.name.replace('|', chr(92) + '|')} | {ablation.off} |"
-        assert escaped in report
-    section = report.split("## Each addition switched off alone")[1].split("\n## ")[0]
+    section = report.split("## The paper-only configuration and each addition switched off alone")[1].split("\n## ")[0]
     rows = [line for line in section.splitlines() if line.startswith("|")]
-    assert len(rows) == 2 + 1 + len(ABLATIONS)
+    assert len(rows) == 2 + 2 + len(ABLATIONS)  # header, rule, as shipped, paper only, one per addition
     assert {len(re.split(r"(?<!\\)\|", row)) for row in rows} == {8}  # six cells each, '|' escaped
-    assert [row["name"] for row in s["ablations"]] == ["as shipped", *(a.name for a in ABLATIONS)]
+    for ablation in ABLATIONS:
+        assert f"| {ablation.off} |" in section
+    assert [row["name"] for row in s["ablations"]][:2] == ["as shipped", PAPER_ONLY]
     assert all(row[task] == "" for row in s["ablations"][:1] for task in ("grasp", "manipulate", "regrasp"))
+    # the additions each task needs at the shipped point are additions to the mechanism
+    names = {a.name for a in MECHANISMS}
+    assert set(s["needed_at_shipped_point"]) == {"grasp", "manipulate", "regrasp", "regrasp_unsuppressed"}
+    assert all(set(needed) <= names for needed in s["needed_at_shipped_point"].values())
+    assert "S_a S_b = 3 everywhere" not in report
+    assert "grasp S_a S_b = 15" in report and "regrasp S_a S_b = 3" in report
     for task in ("grasp", "manipulate", "regrasp", "regrasp_unsuppressed"):
         assert (out / "runs" / task / "signals.npz").is_file()
 

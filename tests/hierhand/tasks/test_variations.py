@@ -118,3 +118,16 @@ def test_the_sample_is_fixed_by_its_seed_and_stays_in_the_spread():
     angles = [math.atan2(p.push[1], p.push[0]) for p in points]
     assert min(angles) < -2.5 and max(angles) > 2.5  # pushes from every direction
     assert 0.03 < np.mean([not p.sees_slip for p in points]) < 0.2
+
+
+def test_the_wide_spread_adds_heavier_objects_and_a_torque_with_the_push_and_leaves_the_old_points_alone():
+    from hierhand.tasks.variations import WIDE
+
+    wide = sample(100, 7, WIDE)
+    assert max(p.mass for p in wide) > SPREAD["mass"][1]  # heavier than the shipped spread holds
+    assert all(WIDE["torque"][0] <= p.torque <= WIDE["torque"][1] for p in wide)
+    assert min(p.torque for p in wide) < 0 < max(p.torque for p in wide)
+    assert all(p.torque == 0.0 for p in sample(20, 7))  # the shipped spread draws no torque ...
+    assert [p.mass for p in sample(20, 7)] == [p.mass for p in sample(20, 7, SPREAD)]  # ... and the same points
+    overrides = carried(parameters("grasp"), dataclasses.replace(SAME, push=(1.0, 2.0), torque=0.03))
+    assert overrides["push.after"] == [1.0, 2.0, 0.03]  # the push's torque reaches the object

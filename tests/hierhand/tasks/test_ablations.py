@@ -1,0 +1,66 @@
+"""The additions beyond the paper as named switches: the paper-only configuration and the search."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from hierhand.control.grasp_reflex import GraspReflex
+from hierhand.model import load_hand
+from hierhand.tasks.ablations import ABLATIONS, ALL, MECHANISMS, paper_only, smallest_set, switched_off
+
+
+def test_the_paper_only_configuration_switches_every_mechanism_off_and_keeps_the_modelling_choices():
+    extra = paper_only()
+    for ablation in ABLATIONS:
+        for task in ablation.tasks:
+            present = all(extra[task].get(key) == value for key, value in ablation.overrides.items())
+            assert present == ablation.mechanism, (ablation.name, task)
+    kept = paper_only(keep=[MECHANISMS[0].name])
+    assert all(key not in kept[task] for key in MECHANISMS[0].overrides for task in ALL)
+    with pytest.raises(KeyError, match="no addition called"):
+        paper_only(keep=["a wish"])
+
+
+def test_each_switch_is_declared_once():
+    keys = [key for a in ABLATIONS for key in a.overrides]
+    assert len(keys) == len(set(keys))  # no two additions set the same parameter
+    assert len({a.name for a in ABLATIONS}) == len(ABLATIONS)
+
+
+def test_backward_elimination_keeps_exactly_the_additions_a_task_fails_without():
+    needed = {MECHANISMS[1].name, MECHANISMS[4].name}
+
+    def succeeds(off: frozenset[str]) -> float:
+        return float(not (off & needed))
+
+    assert smallest_set(succeeds) == needed
+    # a rate that each dropped addition lowers by one success: kept unless the tolerance allows it
+    assert smallest_set(lambda off: 10.0 - len(off)) == {a.name for a in MECHANISMS}
+    assert smallest_set(lambda off: 10.0 - len(off), tolerance=2) == {a.name for a in MECHANISMS[2:]}
+    assert switched_off([])["grasp"] == {}
+
+
+def _hand(mass: float, mu_s: float):
+    return load_hand({"object": {"mass": mass}, "contact": {"mu_s": mu_s, "mu_d": 0.9 * mu_s}})
+
+
+def test_the_squeeze_follows_the_object_s_weight_above_the_floor():
+    for mass in (0.15, 0.3, 0.6):
+        hand = _hand(mass, 1.0)
+        reflex = GraspReflex(hand=hand, min_force=1.0, squeeze_from_weight=True)
+        # two fingers carry m g by friction at the ratio target: each m g / (2 ratio_target)
+        carried = 2 * reflex.min_force * reflex.ratio_target
+        assert carried == pytest.approx(max(mass * 9.81, 2 * 1.0 * reflex.ratio_target))
+        assert GraspReflex(hand=hand, min_force=1.0).min_force == 1.0  # switched off: the floor alone
+
+
+def test_the_ratio_target_stays_below_sliding_friction():
+    for mu_s in (0.6, 0.8, 1.2):
+        hand = _hand(0.3, mu_s)
+        capped = GraspReflex(hand=hand, safety_ratio=0.6, friction_cap=True)
+        plain = GraspReflex(hand=hand, safety_ratio=0.6)
+        assert capped.ratio_target < hand.params.contact.mu_d  # a sliding contact (at mu_d) asks for more squeeze
+        assert capped.ratio_target <= plain.ratio_target
+        assert math.isclose(capped.ratio_target, plain.ratio_target) == (0.6 <= 0.9 * hand.params.contact.mu_d)
