@@ -18,8 +18,9 @@ from typing import Any
 from .options import end_time, picture_output, trust_arg
 from .program import EXIT_FAILED, EXIT_OK, Command, UsageError
 
-REDUCERS_HELP = ("a column per run (repeatable): REDUCER(BLOCK.PORT[i]) with final, max, min, mean, "
-                 "first_time_above(BLOCK.PORT[i], X), first_time_below(BLOCK.PORT[i], X)")
+REDUCERS_HELP = ("a column per run (repeatable): REDUCER(BLOCK.PORT[e]) with final, max, min, mean, "
+                 "first_time_above(BLOCK.PORT[e], X), first_time_below(BLOCK.PORT[e], X); the element e by its "
+                 "label (an FMU's q[1]) or 0-based index, as plot -s reads it")
 MEASURES_HELP = "a measure registered under the 'blocks.measures' entry-point group: MEASURE[(ARGS)]"
 
 
