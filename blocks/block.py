@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
 import numpy as np
 
+from blocks.units import unit_problem
+
 if TYPE_CHECKING:
     from blocks.engine.kernel import Kernel
 
@@ -123,6 +125,12 @@ class Block:
     path_params: ClassVar[tuple[str, ...]] = ()
     """Parameters holding file paths: the loader resolves relative ones against the
     diagram's folder, as it does ``params_file``."""
+    confined_params: ClassVar[tuple[str, ...]] = ()
+    """Those of ``path_params`` that name data a diagram reads (FromFile's table): as a
+    params file, the file must lie in the diagram's folder or below unless the diagram is
+    trusted (``--trust``), so that a diagram from elsewhere cannot play back, and copy into
+    its results, a file of the user's. A path given on the command line (``--set``) is the
+    user's own and may lie anywhere."""
     block_params: ClassVar[tuple[str, ...]] = ()
     """Parameters whose diagram value is the name of another block of the diagram; the
     constructor receives that block (built and bound before this one)."""
@@ -344,14 +352,24 @@ def checked_units(units: Any, width: int | None, port: str) -> str | list[str] |
     (a list whose elements are all alike becomes that one string); ValueError for anything
     else, or a list whose length is not ``width`` (not checked when ``width`` is None)."""
     if units is None or isinstance(units, str):
+        _check_unit_texts(units, port)
         return units
     if not isinstance(units, (list, tuple)) or not all(isinstance(u, str) for u in units):
         raise ValueError(f"the units of '{port}' must be a string or a list of strings, got {units!r}")
+    _check_unit_texts(units, port)
     if width is not None and len(units) != width:
         raise ValueError(f"{len(units)} units for the {width} elements of '{port}'")
     if units and all(u == units[0] for u in units):
         return units[0]
     return list(units)
+
+
+def _check_unit_texts(units: str | list[str] | tuple[str, ...] | None, port: str) -> None:
+    """ValueError for a unit text that the unit grammar (``blocks.units.unit_problem``) refuses."""
+    for text in [units] if isinstance(units, str) else units or ():
+        problem = unit_problem(text)
+        if problem:
+            raise ValueError(f"the unit {text[:40]!r} of '{port}' is not one: {problem}")
 
 
 @functools.cache
