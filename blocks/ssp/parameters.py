@@ -13,10 +13,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+import math
 from typing import Any, Callable
 
 from .package import Package, PackageError
-from .xml import XmlError, child, children, elements, local, q
+from .xml import XmlError, child, children, elements, local, q, shown
 
 FLOATS = ("Real", "Float64", "Float32")
 INTEGERS = ("Integer", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64")
@@ -120,8 +121,14 @@ def _value(element: Any, name: str, file: str) -> Any:
     line = element.sourceline
     try:
         if kind in FLOATS and text is not None:
-            return float(text)
+            return finite(text)
         if kind in INTEGERS and text is not None:
+            if len(text.strip()) > 24:  # an Int64 has 20 characters at most
+                raise ValueError(text)
+            low, high = integer_range(kind)
+            if not low <= int(text.strip()) <= high:
+                raise BindingError(file, line, f"parameter '{name}': {text.strip()} is out of the range of an "
+                                   f"ssv:{kind} ({low} to {high})")
             return int(text.strip())
         if kind == "Boolean" and text is not None:
             if text.strip() not in ("true", "false", "1", "0"):
@@ -130,9 +137,24 @@ def _value(element: Any, name: str, file: str) -> Any:
         if kind == "String" and text is not None:
             return text
     except ValueError:
-        raise BindingError(file, line, f"parameter '{name}': {text!r} is not an ssv:{kind} value") from None
+        raise BindingError(file, line, f"parameter '{name}': {shown(text)} is not an ssv:{kind} value") from None
     raise BindingError(file, line, f"parameter '{name}': values of type ssv:{kind} are not supported",
                        "Real, Float64, Float32, Integer and IntN, Boolean and String values are")
+
+
+def integer_range(kind: str) -> tuple[int, int]:
+    """The values an ``ssv`` integer type holds (``Integer`` is 32 bits, as in FMI)."""
+    bits = 32 if kind == "Integer" else int(kind.removeprefix("U").removeprefix("Int"))
+    return (0, 2**bits - 1) if kind.startswith("U") else (-2 ** (bits - 1), 2 ** (bits - 1) - 1)
+
+
+def finite(text: str) -> float:
+    """A real number written in the XML; ValueError for one that is not finite (``INF``,
+    ``NaN``, ``1e999``): no parameter, factor or offset is meant to be."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(text)
+    return value
 
 
 def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dict[str, tuple[str, float, float]]:
@@ -166,8 +188,8 @@ def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dic
                 raise BindingError(file, transformation.sourceline, f"ssc:{what} in a parameter mapping is not "
                                    "supported", "ssc:LinearTransformation is")
             try:
-                factor = float(transformation.get("factor", "1"))
-                offset = float(transformation.get("offset", "0"))
+                factor = finite(transformation.get("factor", "1"))
+                offset = finite(transformation.get("offset", "0"))
             except ValueError:
                 raise BindingError(file, transformation.sourceline, "ssc:LinearTransformation: factor and offset "
                                    "must be numbers") from None

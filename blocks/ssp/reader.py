@@ -31,6 +31,7 @@ than 0) is one error naming the element and its line.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
 from pathlib import Path
@@ -42,9 +43,9 @@ from ..fmu.ports import port_name, port_of
 from ..issues import DiagramError, Issue
 from blocks.builder.records import Site
 from blocks.builder.scopes import NAME
-from ..timebase import DurationError, parse_duration
+from ..timebase import DurationError, positive_duration
 from .package import Package, PackageError, open_package
-from .parameters import BindingError, binding_values
+from .parameters import BindingError, binding_values, finite
 from .steps import base_step, feedthrough, libcosim_period, step_hint, system_step
 from .xml import XmlError, child, children, elements, exact, local, parse_file, q, shown
 
@@ -143,16 +144,13 @@ class _Reader:
         if experiment is None:
             return
         start = experiment.get("startTime")
-        if start is not None and _number(start) != 0:
+        if start is not None and _number(start)[0] != 0:
             self.fail(experiment.sourceline, f"ssd:DefaultExperiment startTime {shown(start)} is not supported",
                       "runs start at t = 0: leave startTime out or make it 0")
         stop = experiment.get("stopTime")
         if stop is not None:
-            value = _number(stop)
-            if value is None or value <= 0:
-                self.fail(experiment.sourceline, f"ssd:DefaultExperiment stopTime {shown(stop)} is not a positive "
-                          "number of seconds")
-            else:
+            value = self.step_value(stop, experiment.sourceline, "ssd:DefaultExperiment stopTime")
+            if value is not None:
                 self.b.t_end = value
                 self.b.t_end_site = self.site(experiment)
         found = base_step(experiment)
@@ -167,18 +165,22 @@ class _Reader:
                 continue
             attrs = dict(base.attrib)
             try:
-                factor, offset = float(attrs.pop("factor", 1.0)), float(attrs.pop("offset", 0.0))
+                factor, offset = finite(attrs.pop("factor", "1")), finite(attrs.pop("offset", "0"))
                 exponents = tuple(sorted((k, int(v)) for k, v in attrs.items() if int(v) != 0))
             except ValueError:
-                self.fail(base.sourceline, f"ssc:Unit '{unit.get('name')}': its ssc:BaseUnit attributes must be "
-                          "numbers")
+                self.fail(base.sourceline, f"ssc:Unit {shown(unit.get('name'))}: its ssc:BaseUnit attributes must "
+                          "be numbers: finite factor and offset, whole exponents")
+                continue
+            if factor == 0:
+                self.fail(base.sourceline, f"ssc:Unit {shown(unit.get('name'))}: its factor is 0",
+                          "a unit's factor is its size in the SI base units: 1000 for km")
                 continue
             self.units[unit.get("name")] = (exponents, factor, offset)
 
     def step_value(self, text: str, line: int | None, what: str) -> Fraction | None:
-        value = _number(text)
+        value, problem = _number(text)
         if value is None or value <= 0:
-            self.fail(line, f"{what} {shown(text)} is not a positive number of seconds")
+            self.fail(line, f"{what} {shown(text)} is not a positive number of seconds{problem}")
             return None
         return value
 
@@ -292,9 +294,9 @@ class _Reader:
                 return given
         if self.cli_step is not None:
             try:
-                return parse_duration(self.cli_step)
+                return positive_duration(self.cli_step, "the step given")
             except DurationError as exc:
-                self.fail(item.sourceline, f"component '{name}': the step given: {exc}")
+                self.fail(item.sourceline, f"component '{name}': {exc}")
                 return None
         self.fail(item.sourceline, f"component '{name}' has no step size: the SSD gives no osp:StepSizeHint, "
                   "oms:FixedStepMaster or osp:FixedStepAlgorithm", STEP_HINT, name=name)
@@ -343,7 +345,7 @@ class _Reader:
             if factor != 1.0 or offset != 0.0:
                 count += 1
                 stem = f"_lt{count}"
-                while stem in me.elements or f"{stem}_gain" in me.elements:
+                while any(n in me.elements for n in (stem, f"{stem}_gain", f"{stem}_bias")):  # the user's names
                     stem = "_" + stem
                 chain_in = chain_out = None
                 if factor != 1.0:
@@ -432,7 +434,12 @@ class _Reader:
                       "connect connectors of one quantity, or set suppressUnitConversion and convert with an "
                       "ssc:LinearTransformation")
             return None
-        return ua[1] / ub[1], (ua[2] - ub[2]) / ub[1]
+        factor, offset = ua[1] / ub[1], (ua[2] - ub[2]) / ub[1]
+        if not (math.isfinite(factor) and math.isfinite(offset)) or factor == 0:
+            self.fail(line, f"ssd:Connection from unit {shown(a)} to unit {shown(b)}: their factors and offsets "
+                      "give no finite conversion")
+            return None
+        return factor, offset
 
     # -- bindings of a system ----------------------------------------------------------
 
@@ -489,8 +496,9 @@ def _port_units(connectors: Any) -> dict[str, tuple[str | list[str], int | None]
     return found
 
 
-def _number(text: str) -> Fraction | None:
+def _number(text: str) -> tuple[Fraction | None, str]:
+    """A time's exact value, or None and why not (`` (...)``, for a message)."""
     try:
-        return exact(text)
-    except (ValueError, ZeroDivisionError):
-        return None
+        return exact(text), ""
+    except ValueError as exc:
+        return None, f" ({exc})"

@@ -10,9 +10,14 @@ readers (libcosim) match the prefixes rather than the namespaces.
 from __future__ import annotations
 
 import os
+import re
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
+
+from ..timebase import DurationError, parse_duration
+
+_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -108,9 +113,13 @@ def annotations(element: Any, kind: str) -> list:
 
 
 def exact(text: str) -> Fraction:
-    """A number written in the XML (``xs:double``: ``0.001``, ``1e-4``) as the exact
-    rational of its decimal text; ValueError if it is not one."""
-    return Fraction(text.strip())
+    """A time written in the XML (``xs:double``: ``0.001``, ``1e-4``) as the exact
+    rational of its decimal text, read by ``timebase.parse_duration`` so that its range
+    (0, or 1e-12 s to 1e9 s) is checked before any exact arithmetic (``1e999999999`` would
+    be a number of a billion digits); ValueError (a DurationError) says why it is not one."""
+    if not _DECIMAL.fullmatch(text.strip()):
+        raise DurationError(f"{shown(text)} is not a decimal number")
+    return parse_duration(text.strip())
 
 
 def shown(text: Any) -> str:
