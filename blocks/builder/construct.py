@@ -28,7 +28,7 @@ from blocks.limits import MAX_PORT_WIDTH
 from blocks.builder.param_paths import PathError, set_path
 from blocks.builder.references import build_order, chain_text
 from blocks.registry import PYTHON_PREFIX, RegistryError, block_types, resolve_type
-from blocks.safepath import inside
+from blocks.safepath import OUTSIDE_HINT, inside
 from blocks.builder.scopes import NOT_A_NAME, SUBSYSTEM, UNKNOWN, Bound, Level, Override, resolve_reference
 from blocks.timebase import DurationError, parse_duration, positive_duration
 
@@ -324,12 +324,18 @@ class Constructor:
         if not ok:
             return None
         path_refs = {}
+        overridden = {ov.path[0] for ov in level.overrides.get(level.name_of(name), []) if ov.path}
         for key in cls.path_params:
             value = params.get(key)
             if isinstance(value, str) and value.strip():
                 path_refs[key] = value
                 if not Path(value).expanduser().is_absolute():
                     params[key] = str(level.scope.folder / value)
+                if (key in cls.confined_params and key not in overridden and not level.builder.trust
+                        and not inside(Path(params[key]).expanduser(), level.scope.folder)):
+                    self.error(site, "params", f"block '{name}': {key} '{value}' is outside the diagram's folder",
+                               OUTSIDE_HINT)
+                    return None
         return params, path_refs
 
     def params_file(self, level: Level, name: str, entry: BlockEntry) -> ParamsFile | None:
@@ -343,8 +349,7 @@ class Constructor:
         path = folder / rel
         if not level.builder.trust and not inside(path, folder):
             self.error(site, "params_file", f"block '{name}': params_file '{rel}' is outside the diagram's folder",
-                       "a diagram reads files only from its own folder and below; pass --trust "
-                       "(Python: trust=True) if you trust this diagram")
+                       OUTSIDE_HINT)
             return None
         ref = level.scope.ref(rel)
         read = level.builder.read_params or default_params_reader()

@@ -83,9 +83,10 @@ def export_diagram(args: argparse.Namespace, **options) -> Path:
     """The FMU of ``args``' diagram, written: its path. ``options`` go to ``export_fmu``."""
     from blocks import load_diagram
     from blocks.fmu_export import FmuExportError, export_fmu
+    from blocks.safepath import folder_name
 
     diagram = load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
-    name = f"{diagram.name}_fmi{args.fmi}.fmu"
+    name = f"{folder_name(diagram.name)}_fmi{args.fmi}.fmu"  # one file name, whatever the diagram is called
     out = args.output if args.output is not None else Path("fmu") / name
     if out.suffix.lower() != ".fmu":
         out = out / name
