@@ -39,6 +39,7 @@ from .names import SSD_NAME
 from .steps import add_base_step, add_feedthrough, add_step_hint, add_system_step, number
 from .units import add_units, unit_definitions
 from .xml import PREFIXES, q
+from blocks.builder.api_args import diagram_argument
 
 CONNECTOR_TYPES = {"Float64": "Real", "Float32": "Real", "Int32": "Integer", "Int16": "Integer", "Int8": "Integer",
                    "UInt16": "Integer", "UInt8": "Integer", "Boolean": "Boolean"}
@@ -52,6 +53,7 @@ VALUE_TYPES = {"Real": "Real", "Float64": "Real", "Float32": "Real", "Integer": 
 def export_ssp(diagram: Diagram, out: str | Path) -> Path:
     """Write ``diagram`` as the SSP archive ``out`` (a ``.ssp`` file); DiagramError naming
     each block or connection that SSP cannot carry."""
+    diagram_argument(diagram)
     with tempfile.TemporaryDirectory(prefix="blocks-ssp-") as scratch:
         problems: list[Issue] = []
         components = _components(diagram, Path(scratch), problems)
