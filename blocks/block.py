@@ -17,8 +17,6 @@ from typing import TYPE_CHECKING, Any, ClassVar, Mapping
 
 import numpy as np
 
-from blocks.units import unit_problem
-
 if TYPE_CHECKING:
     from blocks.engine.kernel import Kernel
 
@@ -352,24 +350,14 @@ def checked_units(units: Any, width: int | None, port: str) -> str | list[str] |
     (a list whose elements are all alike becomes that one string); ValueError for anything
     else, or a list whose length is not ``width`` (not checked when ``width`` is None)."""
     if units is None or isinstance(units, str):
-        _check_unit_texts(units, port)
         return units
     if not isinstance(units, (list, tuple)) or not all(isinstance(u, str) for u in units):
         raise ValueError(f"the units of '{port}' must be a string or a list of strings, got {units!r}")
-    _check_unit_texts(units, port)
     if width is not None and len(units) != width:
         raise ValueError(f"{len(units)} units for the {width} elements of '{port}'")
     if units and all(u == units[0] for u in units):
         return units[0]
     return list(units)
-
-
-def _check_unit_texts(units: str | list[str] | tuple[str, ...] | None, port: str) -> None:
-    """ValueError for a unit text that the unit grammar (``blocks.units.unit_problem``) refuses."""
-    for text in [units] if isinstance(units, str) else units or ():
-        problem = unit_problem(text)
-        if problem:
-            raise ValueError(f"the unit {text[:40]!r} of '{port}' is not one: {problem}")
 
 
 @functools.cache
