@@ -13,6 +13,7 @@ the block's ``params:``, its params file or a subsystem entry's ``params``.
 from __future__ import annotations
 
 import copy
+import re
 import sys
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -32,6 +33,17 @@ from blocks.safepath import OUTSIDE_HINT, inside
 from blocks.builder.scopes import NOT_A_NAME, SUBSYSTEM, UNKNOWN, Bound, Level, Override, resolve_reference
 from blocks.timebase import DurationError, parse_duration, positive_duration
 
+
+
+_PARAMETER = re.compile(r"parameter '([^'.\[]+)'")
+"""How a block's ValueError names the parameter it is about (``blocks.library._params``)."""
+
+
+def _named(exc: Exception) -> tuple[str, ...]:
+    """The parameter a constructor's exception names (``("k",)``), or ``()``: so that it is
+    reported where that parameter was given (the diagram's line, or ``--set``)."""
+    found = _PARAMETER.match(str(exc))
+    return (found[1],) if found else ()
 
 class ParamsFile(NamedTuple):
     """A block's params file: its content and where it is (its path, and the lines of its
@@ -462,7 +474,7 @@ class Constructor:
             try:
                 block = cls(**arguments)
             except Exception as exc:  # a block's own message says which parameter is wrong
-                problems = exc.problems if isinstance(exc, ParameterError) else [((), str(exc))]
+                problems = exc.problems if isinstance(exc, ParameterError) else [(_named(exc), str(exc))]
                 hint = getattr(exc, "hint", "") or f"see 'hierhand blocks {cls.registered_name()}' for its parameters"
                 for path, text in problems:
                     self.param_error(p, path, f"block '{name}' ({type_name}): {text}", hint)

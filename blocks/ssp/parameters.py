@@ -123,23 +123,30 @@ def _value(element: Any, name: str, file: str) -> Any:
         if kind in FLOATS and text is not None:
             return finite(text)
         if kind in INTEGERS and text is not None:
-            if len(text.strip()) > 24:  # an Int64 has 20 characters at most
-                raise ValueError(text)
-            low, high = integer_range(kind)
-            if not low <= int(text.strip()) <= high:
-                raise BindingError(file, line, f"parameter '{name}': {text.strip()} is out of the range of an "
-                                   f"ssv:{kind} ({low} to {high})")
-            return int(text.strip())
+            value, (low, high) = _whole(text), integer_range(kind)
+            if not low <= value <= high:
+                raise BindingError(file, line, f"parameter '{name}': {value} is out of the range of an ssv:{kind} "
+                                   f"({low} to {high})")
+            return value
         if kind == "Boolean" and text is not None:
             if text.strip() not in ("true", "false", "1", "0"):
                 raise ValueError(text)
             return text.strip() in ("true", "1")
         if kind == "String" and text is not None:
             return text
+    except BindingError:
+        raise
     except ValueError:
         raise BindingError(file, line, f"parameter '{name}': {shown(text)} is not an ssv:{kind} value") from None
     raise BindingError(file, line, f"parameter '{name}': values of type ssv:{kind} are not supported",
                        "Real, Float64, Float32, Integer and IntN, Boolean and String values are")
+
+
+def _whole(text: str) -> int:
+    """A whole number of at most 24 characters (an Int64 has 20); ValueError otherwise."""
+    if len(text.strip()) > 24:
+        raise ValueError(text)
+    return int(text.strip())
 
 
 def integer_range(kind: str) -> tuple[int, int]:

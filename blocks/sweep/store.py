@@ -45,6 +45,9 @@ def check_folder(directory: Path) -> None:
         entry = directory / name
         if entry.exists() and not entry.is_file():
             raise SweepError(f"{entry} is not a regular file (hint: move it away, or choose another -o folder)")
+    if (directory / RUNS).exists() and not (directory / RUNS).is_dir():
+        raise SweepError(f"{directory / RUNS} is not a folder; the sweep keeps its runs' results there (hint: move "
+                         "it away, or choose another -o folder)")
 
 
 def columns(parameters: Sequence[str], metrics: Sequence[str]) -> list[str]:
