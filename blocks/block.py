@@ -123,6 +123,12 @@ class Block:
     path_params: ClassVar[tuple[str, ...]] = ()
     """Parameters holding file paths: the loader resolves relative ones against the
     diagram's folder, as it does ``params_file``."""
+    confined_params: ClassVar[tuple[str, ...]] = ()
+    """Those of ``path_params`` that name data a diagram reads (FromFile's table): as a
+    params file, the file must lie in the diagram's folder or below unless the diagram is
+    trusted (``--trust``), so that a diagram from elsewhere cannot play back, and copy into
+    its results, a file of the user's. A path given on the command line (``--set``) is the
+    user's own and may lie anywhere."""
     block_params: ClassVar[tuple[str, ...]] = ()
     """Parameters whose diagram value is the name of another block of the diagram; the
     constructor receives that block (built and bound before this one)."""

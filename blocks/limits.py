@@ -76,3 +76,28 @@ MAX_DATA_BYTES = 64 * 1024 * 1024
 hold once decompressed (64 MiB, 8 million samples): an archive's members are checked
 before anything is decompressed, so a small file that inflates to gigabytes is refused.
 CSV data files are text and read under MAX_YAML_BYTES, as points files are."""
+
+MAX_DECIMATE = 10**12
+"""Largest ``decimate`` of a log entry (and of ``run --decimate`` times an entry's own): a
+count of sample hits, kept in the executor's 64-bit integers; a trillion hits of a 1 ps
+period is a second, so a larger one logs only the first sample anyway."""
+
+MAX_BLOCK_VALUES = 16 * 1024**2
+"""Most numbers one block may hold beyond its ports (state, windows, tables, matrices), 16 Mi
+float64 values (128 MiB): products of bounded parameters (a window of 10^6 on an input of
+width 1000, a transfer function of degree 10^5) are counted before anything is allocated,
+by ``check_block_size``. The shipped blocks hold a few hundred."""
+
+
+def check_block_size(*factors: tuple[str, int], limit: int = MAX_BLOCK_VALUES,
+                     what: str = "values to hold") -> int:
+    """The product of ``factors`` (each ``(parameter, value)``: what sizes a block's memory,
+    ``("window", 10**6), ("width", 1000)``), or ValueError naming them when it exceeds
+    ``limit``: the one check of a block's size, made before its arrays are allocated."""
+    total = 1
+    for _, value in factors:
+        total *= value
+    if total > limit:
+        shown = " x ".join(f"{name} {value}" for name, value in factors)
+        raise ValueError(f"{shown} make {total:.3g} {what}, more than the limit of {limit}")
+    return total

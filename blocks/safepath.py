@@ -20,6 +20,11 @@ _UNSAFE = re.compile(r"(?:[^\w.-]|\.{2,})+")
 separators, NUL and other control characters, spaces, and '..'."""
 
 
+OUTSIDE_HINT = ("a diagram reads files only from its own folder and below; pass --trust (Python: trust=True) "
+                "if you trust this diagram")
+"""The hint of every refusal of a file outside a diagram's folder."""
+
+
 def unusable_path(exc: ValueError) -> str:
     """Why a path that the system refused with ``exc`` cannot be opened (``os.open`` raises
     ValueError for a NUL character, UnicodeEncodeError for a character that the system's

@@ -31,6 +31,11 @@ MAX_DURATION = Fraction(10**9)
 of such spans would not fit the executor's integer and float arithmetic."""
 
 
+MAX_DURATION_CHARS = 60
+"""Longest duration text: 17 significant digits, a point, a sign, an exponent and a unit
+fit many times over; a text of 100 000 digits is refused before it becomes a number."""
+
+
 class DurationError(ValueError):
     """A duration text that is not a number with an optional unit."""
 
@@ -58,6 +63,9 @@ def parse_duration(value: object) -> Fraction:
             raise DurationError(f"expected a finite duration, got {value!r}")
         return _in_range(Fraction(repr(value)), value)
     if isinstance(value, str):
+        if len(value) > MAX_DURATION_CHARS:
+            raise DurationError(f"duration {value[:20]!r}... has {len(value)} characters; a duration is a number "
+                                f"of at most {MAX_DURATION_CHARS} characters and a unit")
         m = _DURATION.match(value)
         if m:
             mantissa, _, exponent = m["num"].lower().partition("e")

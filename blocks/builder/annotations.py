@@ -20,7 +20,7 @@ from blocks.block import checked_units
 from blocks.builder.context import known, suggest
 from blocks.builder.diagram import BlockSpec, Connection
 from blocks.builder.elements import parse_endpoint
-from blocks.units import differs
+from blocks.units import differs, unit_problem
 
 Report = Callable[[str | None, int | None, str, str], None]
 """``report(file, line, message, hint)``."""
@@ -78,6 +78,10 @@ def _keep(spec: BlockSpec, port: str, width: int | None, key: str, value: Any) -
             units = checked_units(value, width, port)
         except ValueError as exc:
             return str(exc), "one unit ('rad', 'N m', '1'), or a list of one per element"
+        problem = next((f"{u[:40]!r} is not a unit: {unit_problem(u)}" for u in element_units(units, 1)
+                        if unit_problem(u)), None)
+        if problem:  # read by the unit grammar here, where the diagram gives it, never computed by pint
+            return problem, "units of names, numbers, '*', '/' and whole powers ('m/s^2', 'kg m^2')"
         own = checked_units(block.port_units(port), width, port)
         if own is not None and own != units:
             return (f"block '{spec.name}' ({spec.type_name}) gives it {own!r}, the diagram {units!r}",

@@ -64,3 +64,19 @@ def _plain(value: Any, where: str, depth: int, active: set[int]) -> None:
             _plain(item, where, depth + 1, active)
     finally:
         active.discard(id(value))
+
+
+def diagram_argument(value: Any, name: str = "diagram") -> Any:
+    """``value`` if it is a ``Diagram``; TypeError naming the argument otherwise, with how to
+    make one of what was given (a path, a builder)."""
+    from blocks.builder.diagram import Diagram
+
+    if isinstance(value, Diagram):
+        return value
+    if isinstance(value, (str, os.PathLike)):
+        hint = f"load the file first: load_diagram({str(value)!r})"
+    elif hasattr(value, "build") and hasattr(value, "add"):
+        hint = "build the builder first: builder.build()"
+    else:
+        hint = "load one with load_diagram(path) or make one with DiagramBuilder(...).build()"
+    raise TypeError(f"{name} must be a Diagram, got {type(value).__name__} ({hint})")

@@ -13,6 +13,7 @@ the block's ``params:``, its params file or a subsystem entry's ``params``.
 from __future__ import annotations
 
 import copy
+import re
 import sys
 from dataclasses import dataclass, field
 from fractions import Fraction
@@ -28,10 +29,21 @@ from blocks.limits import MAX_PORT_WIDTH
 from blocks.builder.param_paths import PathError, set_path
 from blocks.builder.references import build_order, chain_text
 from blocks.registry import PYTHON_PREFIX, RegistryError, block_types, resolve_type
-from blocks.safepath import inside
+from blocks.safepath import OUTSIDE_HINT, inside
 from blocks.builder.scopes import NOT_A_NAME, SUBSYSTEM, UNKNOWN, Bound, Level, Override, resolve_reference
 from blocks.timebase import DurationError, parse_duration, positive_duration
 
+
+
+_PARAMETER = re.compile(r"parameter '([^'.\[]+)'")
+"""How a block's ValueError names the parameter it is about (``blocks.library._params``)."""
+
+
+def _named(exc: Exception) -> tuple[str, ...]:
+    """The parameter a constructor's exception names (``("k",)``), or ``()``: so that it is
+    reported where that parameter was given (the diagram's line, or ``--set``)."""
+    found = _PARAMETER.match(str(exc))
+    return (found[1],) if found else ()
 
 class ParamsFile(NamedTuple):
     """A block's params file: its content and where it is (its path, and the lines of its
@@ -324,12 +336,18 @@ class Constructor:
         if not ok:
             return None
         path_refs = {}
+        overridden = {ov.path[0] for ov in level.overrides.get(level.name_of(name), []) if ov.path}
         for key in cls.path_params:
             value = params.get(key)
             if isinstance(value, str) and value.strip():
                 path_refs[key] = value
                 if not Path(value).expanduser().is_absolute():
                     params[key] = str(level.scope.folder / value)
+                if (key in cls.confined_params and key not in overridden and not level.builder.trust
+                        and not inside(Path(params[key]).expanduser(), level.scope.folder)):
+                    self.error(site, "params", f"block '{name}': {key} '{value}' is outside the diagram's folder",
+                               OUTSIDE_HINT)
+                    return None
         return params, path_refs
 
     def params_file(self, level: Level, name: str, entry: BlockEntry) -> ParamsFile | None:
@@ -343,8 +361,7 @@ class Constructor:
         path = folder / rel
         if not level.builder.trust and not inside(path, folder):
             self.error(site, "params_file", f"block '{name}': params_file '{rel}' is outside the diagram's folder",
-                       "a diagram reads files only from its own folder and below; pass --trust "
-                       "(Python: trust=True) if you trust this diagram")
+                       OUTSIDE_HINT)
             return None
         ref = level.scope.ref(rel)
         read = level.builder.read_params or default_params_reader()
@@ -457,7 +474,7 @@ class Constructor:
             try:
                 block = cls(**arguments)
             except Exception as exc:  # a block's own message says which parameter is wrong
-                problems = exc.problems if isinstance(exc, ParameterError) else [((), str(exc))]
+                problems = exc.problems if isinstance(exc, ParameterError) else [(_named(exc), str(exc))]
                 hint = getattr(exc, "hint", "") or f"see 'hierhand blocks {cls.registered_name()}' for its parameters"
                 for path, text in problems:
                     self.param_error(p, path, f"block '{name}' ({type_name}): {text}", hint)

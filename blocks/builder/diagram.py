@@ -23,6 +23,7 @@ import numpy as np
 
 from blocks.block import Block
 from blocks.issues import Issue
+from blocks.limits import MAX_DECIMATE
 from blocks.builder.references import Reference
 
 
@@ -327,6 +328,8 @@ class Diagram:
         is a positive whole number."""
         if isinstance(factor, bool) or not isinstance(factor, int) or factor < 1:
             raise ValueError(f"decimation must be a positive whole number, got {factor!r}")
+        if any(e.decimate * factor > MAX_DECIMATE for e in self.log):
+            raise ValueError(f"decimation {factor} makes a log entry's decimate more than {MAX_DECIMATE}")
         return dataclasses.replace(self, log=[dataclasses.replace(e, decimate=e.decimate * factor) for e in self.log])
 
     def drivers_of(self, block: str, port: str) -> list[Connection]:

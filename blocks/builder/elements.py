@@ -21,6 +21,9 @@ from typing import Any, Sequence
 
 SIGNAL = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)+)\s*(?:\[(.*)\])?\s*$")
 _SLICE = re.compile(r"^\s*(-?\d+)?\s*:\s*(-?\d+)?\s*(?::\s*(-?\d+)\s*)?$")
+_NUMBERED = re.compile(r"^\d+(?:,\d+)*$")
+"""An element label that is a number (an FMU's ``z[1]``, ``m[1,2]``): where every label of a
+port is one, ``[0]`` could be read as a label or as an index, so it is read only as a label."""
 _ENDPOINT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*$")
 _WIRE_END = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[(.*)\])?\s*$")
 
@@ -108,6 +111,9 @@ def pick(spec: str, labels: Sequence[str] | None, width: int, what: str) -> list
     except ValueError:
         pass
     else:
+        if labels is not None and all(_NUMBERED.match(name) for name in names):
+            raise ElementError(f"{what} numbers its elements {names[0]} to {names[-1]}: [{text}] is none of them "
+                               "(on such a port a number names an element; it is not an index)")
         if not -width <= index < width:
             raise ElementError(f"{what} has {width} element(s): index {index} is out of range")
         return [index % width]

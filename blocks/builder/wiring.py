@@ -26,6 +26,7 @@ from blocks.builder.element_wiring import carried, check_assembled, received, re
 from blocks.builder.elements import ElementError, Endpoint, parse_endpoint, parse_wire_end
 from blocks.builder.scopes import NAME, Level
 from blocks.builder.widths import propagate_widths
+from blocks.limits import MAX_DECIMATE
 
 _PATH = re.compile(r"^\s*[A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)+\s*$")
 
@@ -102,6 +103,10 @@ class Wiring:
         for decl in level.builder.outputs:
             name = self.port_name(level, decl, ports.outputs, "output")
             if name is None:
+                continue
+            if name in ports.inputs:  # 'sub.x' would name two ports
+                self.ctx.add(decl.site.issue(f"the diagram's output '{name}' has the name of one of its inputs",
+                                             "give each input and output of a diagram its own name"))
                 continue
             (text,) = decl.signals
             ep = parse_endpoint(text)
@@ -402,8 +407,9 @@ class Wiring:
             return [LogEntry(name, port, 1, site.line, file) for name, spec in self.specs.items() if name in inside
                     for port in spec.block.outputs]
         decimate = request.decimate
-        if not isinstance(decimate, int) or isinstance(decimate, bool) or decimate < 1:
-            self.ctx.add(site.issue(f"log decimate must be a positive integer, got {decimate!r}", key="decimate"))
+        if not isinstance(decimate, int) or isinstance(decimate, bool) or not 1 <= decimate <= MAX_DECIMATE:
+            self.ctx.add(site.issue(f"log decimate must be a whole number from 1 to {MAX_DECIMATE}, got "
+                                    f"{decimate!r}", key="decimate"))
             return []
         text = request.signal
         if not isinstance(text, str) or not _PATH.match(text):

@@ -86,13 +86,14 @@ def export_diagram(args: argparse.Namespace, **options) -> Path:
     """The FMU of ``args``' diagram, written: its path. ``options`` go to ``export_fmu``."""
     from blocks import load_diagram
     from blocks.fmu_export import FmuExportError, export_fmu
+    from blocks.safepath import folder_name
 
     if args.scheduled and args.fmi != 3:
         raise UsageError("fmu export: --scheduled-execution needs --fmi 3 (FMI 2 has no clocks)")
     if args.scheduled and args.step:
         raise UsageError("fmu export: --step is for co-simulation; the clocks of scheduled execution are the rates")
     diagram = load_diagram(args.diagram, overrides=parse_overrides(args.overrides), trust=args.trust)
-    name = f"{diagram.name}_fmi{args.fmi}{'_se' if args.scheduled else ''}.fmu"
+    name = f"{folder_name(diagram.name)}_fmi{args.fmi}{'_se' if args.scheduled else ''}.fmu"  # one file name, whatever the diagram is called
     out = args.output if args.output is not None else Path("fmu") / name
     if out.suffix.lower() != ".fmu":
         out = out / name

@@ -41,12 +41,15 @@ def cmd_graph(args: argparse.Namespace) -> int:
         sys.stdout.write(to_dot(diagram, schedule, args.expand))
         return EXIT_OK
     suffix = out.suffix.lower()
-    if suffix in (".dot", ".gv"):
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_text(to_dot(diagram, schedule, args.expand), encoding="utf-8")
-    elif suffix in (".svg", ".png", ".pdf"):
-        render(diagram, schedule, out, args.expand)
-    else:
-        raise UsageError(f"-o {out}: unknown format {suffix or '(none)'!r}; use .dot, .svg or .png")
+    try:
+        if suffix in (".dot", ".gv"):
+            out.parent.mkdir(parents=True, exist_ok=True)
+            out.write_text(to_dot(diagram, schedule, args.expand), encoding="utf-8")
+        elif suffix in (".svg", ".png", ".pdf"):
+            render(diagram, schedule, out, args.expand)
+        else:
+            raise UsageError(f"-o {out}: unknown format {suffix or '(none)'!r}; use .dot, .svg or .png")
+    except OSError as exc:  # a folder on the way is a file, not writable, ...
+        raise UsageError(f"-o {out}: cannot write it: {exc.strerror or exc}") from None
     print(f"wrote {out}")
     return EXIT_OK

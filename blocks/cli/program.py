@@ -27,6 +27,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Sequence
 
+from blocks.process.terminal import EscapedStream, unescaped
+
 if TYPE_CHECKING:
     from blocks.issues import Issue
 
@@ -148,6 +150,7 @@ def entry(program: Program) -> None:
     for stream in (sys.stdout, sys.stderr):  # a name in any script, on a terminal that shows only ASCII
         with contextlib.suppress(AttributeError, ValueError):
             stream.reconfigure(errors="backslashreplace")
+    sys.stdout, sys.stderr = EscapedStream(unescaped(sys.stdout)), EscapedStream(unescaped(sys.stderr))
     if os.environ.get(debug):
         sys.exit(main(program))
     try:

@@ -69,9 +69,12 @@ typedef enum {
  *   follow rules: their count, per rule its block, its flag slot, the parameters that set
  *   it (a count, then their indices) and those that prevent it (likewise),
  *   links: their count, per link its block, slot, source block, source slot, length,
- *   the word BLK_EXPORT_MAGIC again. */
+ *   the word BLK_EXPORT_MAGIC again,
+ *   the CRC-32 (zlib's) of every byte before it, as a word: checked before anything else
+ *   is read, so that a damaged file is refused whole rather than trusted in part (a
+ *   block's record holds sizes its kernel believes). */
 #define BLK_EXPORT_MAGIC 0x31554d46584b4c42LL /* "BLKXFMU1" */
-#define BLK_EXPORT_VERSION 1
+#define BLK_EXPORT_VERSION 2
 
 /* The host's logger; the wrapper adapts it to its FMI version's callback. */
 typedef void (*blk_logger)(void *environment, const char *instance, blk_status status, const char *category,

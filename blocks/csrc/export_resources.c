@@ -148,6 +148,18 @@ static void *read_file(blk_instance *inst, const char *path, int64_t *words_read
     return data;
 }
 
+/* zlib's CRC-32 of n bytes. */
+static uint32_t crc32_of(const unsigned char *p, size_t n)
+{
+    uint32_t crc = 0xFFFFFFFFu;
+    for (size_t i = 0; i < n; i++) {
+        crc ^= p[i];
+        for (int k = 0; k < 8; k++)
+            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+    }
+    return ~crc;
+}
+
 /* The blocks: names, kinds (looked up in this binary), records and states. */
 static void read_blocks(reader *r, blk_export *x)
 {
@@ -253,7 +265,11 @@ int ex_read_resources(blk_instance *inst, const char *token, const char *folder)
     x->data = read_file(inst, path, &n);
     if (x->data == NULL)
         return -1;
-    reader r = {x->data, n, 0, 1};
+    if (n < 3 || (int64_t)crc32_of((const unsigned char *)x->data, (size_t)(n - 1) * 8) != x->data[n - 1]) {
+        LOG_ERROR(inst, "%s is damaged: its checksum does not match its content", path);
+        return -1;
+    }
+    reader r = {x->data, n - 1, 0, 1}; /* the words before the checksum */
     if (word(&r) != BLK_EXPORT_MAGIC || word(&r) != BLK_EXPORT_VERSION) {
         LOG_ERROR(inst, "%s is not the resource of a diagram FMU of this version", path);
         return -1;
@@ -290,7 +306,8 @@ int ex_read_resources(blk_instance *inst, const char *token, const char *folder)
     read_blocks(&r, x);
     read_variables(&r, x);
     if (!r.ok || word(&r) != BLK_EXPORT_MAGIC || r.at != r.n) {
-        LOG_ERROR(inst, "%s is damaged or incomplete (at word %lld of %lld)", path, (long long)r.at, (long long)n);
+        LOG_ERROR(inst, "%s is damaged or incomplete (at word %lld of %lld)", path, (long long)r.at,
+                  (long long)r.n);
         return -1;
     }
     for (int64_t b = 0; b < x->n_blocks; b++) {

@@ -25,7 +25,7 @@ from blocks.builder.diagram_builder import DiagramBuilder, Site
 from blocks.builder.diagram import FileScope
 from blocks.builder.context import known, suggest
 from blocks.issues import DiagramError, Issue
-from blocks.safepath import inside
+from blocks.safepath import OUTSIDE_HINT, inside
 from blocks.builder.scopes import NAME
 from blocks.diagram_file.params_file import read_params_file
 from blocks.diagram_file.yaml_source import (
@@ -125,8 +125,7 @@ class IncludedFile:
         what = f"subsystem '{path}': diagram '{rel}'"
         if not self.trust and not inside(target, self.folder):
             raise DiagramError([site.issue(f"{what} is outside the diagram's folder",
-                                           "a diagram reads files only from its own folder and below; pass --trust "
-                                           "(Python: trust=True) if you trust this diagram", key="diagram")])
+                                           OUTSIDE_HINT, key="diagram")])
         ref = scope.ref(rel)
         real = self.reading.files_map.get(ref, target)
         found = self.reading.known(real)

@@ -23,6 +23,7 @@ import yaml
 
 from blocks.builder.diagram import Composite, Diagram
 from blocks.timebase import exact_duration_text
+from blocks.builder.api_args import diagram_argument
 
 
 class WriteError(ValueError):
@@ -33,12 +34,14 @@ def dump_diagram(diagram: Diagram, folder: str | Path | None = None) -> str:
     """The diagram as YAML text, its paths written from ``folder`` (default: the
     diagram's own folder). WriteError for a subsystem built in Python (``save_diagram``
     writes those too) or a parameter YAML cannot hold."""
+    diagram_argument(diagram)
     return _Writer(diagram, Path(folder) if folder is not None else diagram.base_dir, None).text(diagram.root)
 
 
 def save_diagram(diagram: Diagram, path: str | Path) -> Path:
     """Write the diagram to ``path``, and each subsystem built in Python beside it as
     ``<stem>.<subsystem>.yaml``; returns ``path``."""
+    diagram_argument(diagram)
     path = Path(path)
     writer = _Writer(diagram, path.parent, path.stem)
     text = writer.text(diagram.root)

@@ -34,9 +34,10 @@ from typing import NamedTuple
 import networkx as nx
 import numpy as np
 
+from blocks.builder.api_args import diagram_argument
 from blocks.builder.diagram import Connection, Diagram
 from blocks.issues import DiagramError, Issue
-from blocks.timebase import format_duration, fraction_gcd
+from blocks.timebase import format_duration, fraction_gcd, positive_duration
 
 MAX_HYPERPERIOD_TICKS = 10_000_000
 
@@ -193,6 +194,9 @@ def build_schedule(diagram: Diagram, t_end: Fraction | None, *, advance: bool = 
     and sweeps ask again). The plans are held here, not on the Diagram, which stays pure
     data; they go when their diagram is garbage collected.
     """
+    diagram_argument(diagram)
+    if t_end is not None:
+        t_end = positive_duration(t_end, "t_end")
     if not advance:
         return _Planner(diagram).plan(t_end, advance=False)
     plans = _plans.get(id(diagram))

@@ -24,7 +24,7 @@ from typing import Any, Callable
 from blocks.engine.binding import Binding
 from blocks.block import Block
 from blocks.engine import compiled
-from blocks.builder.api_args import boolean
+from blocks.builder.api_args import boolean, diagram_argument
 from blocks.builder.diagram import Diagram
 from blocks.engine.native_run import run_native
 from blocks.issues import DiagramError
@@ -73,6 +73,7 @@ def simulate(diagram: Diagram, t_end: Any = None, progress: ProgressCallback | N
     the run at its first hit, naming block, port, element and time (``blocks.engine.finite``),
     unless ``check_finite`` is False.
     """
+    diagram_argument(diagram)
     boolean("raise_on_failure", raise_on_failure)
     try:
         t_end = run_end_time(diagram, t_end)

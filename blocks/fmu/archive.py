@@ -28,6 +28,7 @@ FIFO would block the reader forever and a device such as ``/dev/zero`` never end
 from __future__ import annotations
 
 import contextlib
+import errno
 import itertools
 import os
 import shutil
@@ -35,6 +36,8 @@ import stat
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
+
+from ..safepath import unusable_path
 
 MAX_MEMBERS = 10_000
 """Limit on the number of members (files and folders) of an archive."""
@@ -289,6 +292,10 @@ def extract_archive(archive: str | os.PathLike, dest: str | os.PathLike, limits:
         try:
             for info, parts in checked:
                 target = root.joinpath(*parts)
+                try:
+                    os.fsencode(target)
+                except UnicodeEncodeError as exc:  # 'ö' in an ASCII locale: not unsafe, but not here
+                    raise OSError(errno.EILSEQ, f"member {info.filename!r}: {unusable_path(exc)}") from None
                 if not target.resolve().is_relative_to(root):  # defence in depth
                     raise ArchiveError(f"{where}: member {info.filename!r} would be written outside "
                                        "the extraction folder")

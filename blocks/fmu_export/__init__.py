@@ -49,6 +49,7 @@ from .partitions import clocks_resource, partitions, variable_clocks
 from .plan import Plan, plan_export
 from .resources import resource_file
 from .variables import Variables, fmu_variables, output_signals
+from blocks.builder.api_args import diagram_argument
 
 __all__ = ["FMI_VERSIONS", "FmuExportError", "KernelSet", "export_fmu", "installed_binary", "kernel_sets",
            "model_identifier"]
@@ -75,6 +76,7 @@ def export_fmu(diagram: Diagram, out: Path | str, fmi: int = 2, *, model: str | 
     kernel, a step that is no multiple of the internal step), FmuExportError when the FMU
     cannot be built.
     """
+    diagram_argument(diagram)
     if fmi not in FMI_VERSIONS:
         raise ValueError(f"fmi must be 2 or 3, got {fmi!r}")
     if scheduled and (fmi != 3 or step is not None):

@@ -3,13 +3,14 @@
 The layout is ``BLK_EXPORT_RESOURCE``'s in ``blocks/csrc/export_instance.h``: little-endian
 int64 words (doubles as their IEEE 754 bits, exact), the op table as ``OpTable.pack``
 writes it, the blocks' records and initial states, the variables' offsets, the tunables'
-slots and the follow and link rules. The binary reads and checks it when it is
+slots, the follow and link rules, and a checksum of it all. The binary reads and checks it when it is
 instantiated, so one compiled library serves every diagram whose kinds it holds.
 """
 
 from __future__ import annotations
 
 import sys
+import zlib
 
 import numpy as np
 
@@ -83,4 +84,5 @@ def resource_file(plan: Plan, variables: Variables, token: str, model: str) -> b
     for link in variables.links:
         w.int(link.block, link.slot, link.source, link.source_slot, link.length)
     w.int(magic)
-    return w.bytes()
+    data = w.bytes()
+    return data + np.array([zlib.crc32(data)], dtype="<i8").tobytes()  # the checksum the binary checks first

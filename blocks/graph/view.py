@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from blocks.builder.diagram import Composite, Connection, Diagram
 from blocks.engine.schedule import Schedule
 from .rates import MIXED_COLOR, Rate, rate_colors, rate_line
+from blocks.builder.api_args import diagram_argument
 
 NOTE_CHARS = 34
 """The longest parameter note a box shows in full; a longer one shows its name only."""
@@ -72,6 +73,7 @@ class Picture:
 def picture(diagram: Diagram, schedule: Schedule, expand: bool = False) -> Picture:
     """The picture of ``diagram``: its top level with subsystems as boxes, or ``expand``ed
     to every block, each subsystem a frame."""
+    diagram_argument(diagram)
     rates = rate_colors(diagram, schedule)
     legend = list(rates.legend)
     nodes: dict[str, Node] = {}

@@ -13,6 +13,7 @@ from typing import Any, Sequence
 import numpy as np
 
 from blocks.arrays import float_array
+from blocks.limits import MAX_PORT_WIDTH
 
 
 def choice(name: str, value: Any, options: Sequence[str]) -> str:
@@ -96,13 +97,25 @@ def spread(value: np.ndarray, width: int) -> np.ndarray:
     return np.broadcast_to(np.asarray(value, dtype=np.float64).reshape(-1), (width,))
 
 
-def widths_list(name: str, value: Any) -> list[int]:
-    """Port widths: a count n (n ports of width 1) or a list of positive widths."""
+def widths_list(name: str, value: Any, ports: str, most: int) -> list[int]:
+    """Port widths: a count n (n ports of width 1) or a list of positive widths, at most
+    ``most`` ports (checked before any list is built) whose widths add up to at most
+    MAX_PORT_WIDTH."""
     if isinstance(value, (list, tuple)):
         if not value:
             raise ValueError(f"parameter '{name}' must list at least one width")
-        return [integer(name, w, minimum=1) for w in value]
-    return [1] * integer(name, value, minimum=1)
+        if len(value) > most:
+            raise ValueError(f"parameter '{name}' gives {len(value)} {ports}; at most {most}")
+        widths = [integer(name, w, minimum=1) for w in value]
+    else:
+        count = integer(name, value, minimum=1)
+        if count > most:
+            raise ValueError(f"parameter '{name}' gives {count} {ports}; at most {most}")
+        widths = [1] * count
+    if sum(widths) > MAX_PORT_WIDTH:
+        raise ValueError(f"parameter '{name}': its widths add up to {sum(widths)}, more than the widest port "
+                         f"({MAX_PORT_WIDTH})")
+    return widths
 
 
 def check_limits(lower: np.ndarray, upper: np.ndarray) -> None:

@@ -8,6 +8,7 @@ from typing import Any
 
 from blocks.library import _params
 from blocks.library.kernel_block import SINGULAR, KernelBlock
+from blocks.limits import MAX_PORT_WIDTH, check_block_size
 
 
 class Elementwise(KernelBlock):
@@ -213,6 +214,7 @@ def _matrix_shapes(shapes: Any, ops: str) -> list[tuple[int, int]]:
         if not isinstance(shape, (list, tuple)) or len(shape) != 2:
             raise ValueError(f"parameter 'shapes': entry {j} must be [rows, columns], got {shape!r}")
         r, c = (_params.integer("shapes", v, minimum=1) for v in shape)
+        check_block_size((f"input {j}'s rows", r), ("columns", c), limit=MAX_PORT_WIDTH, what="elements of a port")
         if ops[j] == "/" and r != c:
             raise ValueError(f"parameter 'shapes': input {j} is inverted ('/') and must be square, got {r}x{c}")
         checked.append((r, c))

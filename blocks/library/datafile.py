@@ -133,8 +133,8 @@ def _check(series: Series, shown: str) -> None:
         raise ValueError(f"{shown} holds no samples")
     if not np.all(np.isfinite(times)):
         raise ValueError(f"{shown}: the times must be finite (row {int(np.argmin(np.isfinite(times))) + 1})")
-    if np.any(np.diff(times) < 0):
-        row = int(np.argmax(np.diff(times) < 0)) + 2
+    if np.any(times[1:] < times[:-1]):  # compared, not subtracted: times of +-1e308 overflow a difference
+        row = int(np.argmax(times[1:] < times[:-1])) + 2
         raise ValueError(f"{shown}: the times must not decrease (row {row} is earlier than the row before)")
     if not np.all(np.isfinite(values)):
         row = int(np.argmax(~np.all(np.isfinite(values), axis=1))) + 1

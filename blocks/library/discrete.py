@@ -12,6 +12,7 @@ from blocks.arrays import float_array
 from blocks.block import Signal
 from blocks.library import _params
 from blocks.library.kernel_block import Advancing, KernelBlock
+from blocks.limits import check_block_size
 
 
 class UnitDelay(Advancing):
@@ -123,6 +124,14 @@ class MovingAverage(KernelBlock):
         width = _params.common_width(initial=self.initial)
         self.inputs, self.outputs = {"u": width}, {"y": width}
         self.feedthrough = True
+        self._check_size(width or 1)
+
+    def set_width(self, width: int) -> None:
+        self._check_size(width)
+        super().set_width(width)
+
+    def _check_size(self, width: int) -> None:
+        check_block_size(("window", self.window), ("width", width))
 
     def initial_state(self) -> Signal:
         width = self.outputs["y"] or self.initial.size

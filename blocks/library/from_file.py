@@ -47,6 +47,7 @@ class FromFile(KernelBlock):
 
     kernel_name = "from_file"
     path_params = ("path",)
+    confined_params = ("path",)
     time_varying = True
 
     def __init__(self, path: Any, signal: str | None = None, method: str = "hold"):

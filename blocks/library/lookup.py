@@ -19,8 +19,13 @@ def _breakpoints(name: str, value: Any) -> np.ndarray:
     x = float_array(value, name, ndim=1)
     if x.size < 2:
         raise ValueError(f"parameter '{name}' needs at least 2 breakpoints, got {x.size}")
-    if np.any(np.diff(x) <= 0):
+    if np.any(x[1:] <= x[:-1]):
         raise ValueError(f"parameter '{name}' must be strictly increasing")
+    with np.errstate(over="ignore"):
+        finite_gaps = np.all(np.isfinite(x[1:] - x[:-1]))
+    if not finite_gaps:  # interpolation divides by the gap: an infinite one answers nonsense
+        raise ValueError(f"parameter '{name}': the gaps between breakpoints must be finite numbers (breakpoints "
+                         "of +-1e308 are more than a float's range apart)")
     return x
 
 

@@ -17,6 +17,7 @@ import numpy as np
 from blocks.arrays import float_array
 from blocks.block import Signal
 from blocks.library.kernel_block import Advancing
+from blocks.limits import check_block_size
 
 METHODS = ("zoh", "tustin")
 """Discretisation methods accepted by ``method`` (python-control names)."""
@@ -48,6 +49,7 @@ def _state_space_matrices(A: Any, B: Any, C: Any, D: Any) -> tuple[np.ndarray, .
     if C.shape[1] != n or C.shape[0] == 0:
         raise ValueError(f"parameter 'C' must have shape (p, {n}) to match A, got {C.shape}")
     p = C.shape[0]
+    _check_size(n, m, p)
     if D is None:
         D = np.zeros((p, m))
     else:
@@ -55,6 +57,12 @@ def _state_space_matrices(A: Any, B: Any, C: Any, D: Any) -> tuple[np.ndarray, .
         if D.shape != (p, m):
             raise ValueError(f"parameter 'D' must have shape ({p}, {m}) to match C and B, got {D.shape}")
     return A, B, C, D
+
+
+def _check_size(n: int, m: int, p: int) -> None:
+    """ValueError before a model of ``n`` states, ``m`` inputs and ``p`` outputs is built
+    whose matrices, and the CHUNK maps of its kernel's context, would hold too much."""
+    check_block_size(("steps per advance map", CHUNK), ("states + outputs", n + p), ("states + inputs", n + m))
 
 
 def _initial_vector(x0: Any, n: int) -> np.ndarray:
@@ -84,6 +92,7 @@ def transfer_function_realisation(num: Any, den: Any) -> tuple[np.ndarray, ...]:
             f"{den.size - 1}; only proper transfer functions have a state-space realisation"
         )
     n = den.size - 1
+    _check_size(n, 1, 1)
     a = den[1:] / den[0]
     b = np.concatenate((np.zeros(den.size - num.size), num)) / den[0]
     A = np.zeros((n, n))

@@ -8,6 +8,7 @@ from typing import Any
 
 from blocks.library import _params
 from blocks.library.kernel_block import KernelBlock
+from blocks.limits import MAX_PORT_WIDTH
 
 MAX_PORTS = 64
 """Most inputs of a Concatenate or Mux, outputs of a Demux."""
@@ -15,10 +16,7 @@ MAX_PORTS = 64
 
 def port_widths(value: Any, ports: str) -> list[int]:
     """The ``widths`` parameter: one width per port (a count n: n ports of width 1)."""
-    widths = _params.widths_list("widths", value)
-    if len(widths) > MAX_PORTS:
-        raise ValueError(f"parameter 'widths' gives {len(widths)} {ports}; at most {MAX_PORTS}")
-    return widths
+    return _params.widths_list("widths", value, ports, MAX_PORTS)
 
 
 class Concatenate(KernelBlock):
@@ -117,7 +115,7 @@ class Selector(KernelBlock):
     kernel_name = "selector"
 
     def __init__(self, indices: Any, width: int | None = None):
-        self.width = None if width is None else _params.integer("width", width, minimum=1)
+        self.width = None if width is None else _params.integer("width", width, minimum=1, maximum=MAX_PORT_WIDTH)
         self.indices = self._parse(indices)
         self.inputs, self.outputs = {"u": self.width}, {"y": len(self.indices)}
         self.feedthrough = True
@@ -130,6 +128,9 @@ class Selector(KernelBlock):
             if found is None:
                 raise ValueError(f"parameter 'indices' must be a list of indices or a slice 'start:stop[:step]', "
                                  f"got {indices!r}")
+            if any(g is not None and len(g.lstrip("+-")) > 7 for g in found.groups()):  # beyond MAX_PORT_WIDTH
+                raise ValueError(f"parameter 'indices': the slice {indices!r} reaches beyond the widest port "
+                                 f"({MAX_PORT_WIDTH} elements)")
             start, stop, step = (None if g is None else int(g) for g in found.groups())
             if step == 0:
                 raise ValueError("parameter 'indices': a slice step must not be 0")
@@ -137,9 +138,13 @@ class Selector(KernelBlock):
                 raise ValueError(f"parameter 'indices': the slice {indices!r} counts from the input's end; "
                                  "give 'width' too")
             span = range(self.width if self.width is not None else max(start, stop) + 1)[slice(start, stop, step)]
+            if len(span) > MAX_PORT_WIDTH:
+                raise ValueError(f"parameter 'indices': the slice {indices!r} selects {len(span)} elements, more "
+                                 f"than the widest port ({MAX_PORT_WIDTH})")
             picked = list(span)
         elif isinstance(indices, (list, tuple)) and indices:
-            picked = [_params.integer("indices", i) for i in indices]
+            picked = [_params.integer("indices", i, minimum=-MAX_PORT_WIDTH, maximum=MAX_PORT_WIDTH - 1)
+                      for i in indices]
             if self.width is None and any(i < 0 for i in picked):
                 raise ValueError("parameter 'indices': negative indices count from the input's end; give 'width' too")
         else:

@@ -18,6 +18,8 @@ import os
 import signal
 import sys
 
+from blocks.process.terminal import EscapedStream
+
 _PR_SET_PDEATHSIG = 1
 
 
@@ -45,8 +47,8 @@ def own_std_streams() -> None:
             continue
         new = open(fd, "w", encoding=getattr(old, "encoding", None), errors=getattr(old, "errors", None),
                    closefd=False, buffering=1 if getattr(old, "line_buffering", False) else -1)
-        setattr(sys, name, new)
-        replaced[id(old)] = new
+        setattr(sys, name, EscapedStream(new) if isinstance(old, EscapedStream) else new)
+        replaced[id(old)] = getattr(sys, name)
     logging = sys.modules.get("logging")
     if logging is None or not replaced:
         return

@@ -10,6 +10,8 @@ from __future__ import annotations
 import sys
 from typing import Any, TextIO
 
+from blocks.process.terminal import escape_controls, unescaped
+
 
 def progress_bar(total: float | None, description: str, unit: str = "it", enabled: bool = True,
                  stream: TextIO | None = None, **options: Any):
@@ -18,9 +20,10 @@ def progress_bar(total: float | None, description: str, unit: str = "it", enable
     ``options`` go to tqdm (``delay``, ``bar_format``, ...)."""
     from tqdm import tqdm
 
-    stream = stream or sys.stderr
+    stream = unescaped(stream or sys.stderr)  # tqdm draws with control characters of its own
     shown = enabled and stream.isatty()
-    return tqdm(total=total, desc=description, unit=unit, file=stream, disable=not shown, leave=False,
+    return tqdm(total=total, desc=escape_controls(description), unit=unit, file=stream, disable=not shown,
+                leave=False,
                 dynamic_ncols=True, **options)
 
 

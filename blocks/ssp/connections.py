@@ -36,7 +36,7 @@ from blocks.builder.records import Site
 from ..fmu.ports import port_name, port_of
 from .conversion import UnitError, UnknownUnit, conversion
 from .parameters import BindingError
-from .xml import elements, local, shown
+from .xml import elements, finite, local, shown
 
 CONNECTION_PARTS = ("ConnectionGeometry", "Annotations")
 SOURCES = {True: ("input", "parameter"), False: ("output", "calculatedParameter")}
@@ -123,7 +123,7 @@ class Wiring:
             return
         self.count += 1
         stem = f"_lt{self.count}"
-        while stem in self.me.elements or f"{stem}_gain" in self.me.elements:
+        while any(n in self.me.elements for n in (stem, f"{stem}_gain", f"{stem}_bias")):  # the user's names
             stem = "_" + stem
         chain: list[str] = []
         if factor != 1.0:
@@ -149,9 +149,9 @@ class Wiring:
                 self.fail(part.sourceline, f"ssc:{what} on a connection is not supported", "ssc:LinearTransformation is")
                 return None
             try:
-                factor, offset = float(part.get("factor", "1")), float(part.get("offset", "0"))
+                factor, offset = finite(part.get("factor", "1")), finite(part.get("offset", "0"))
             except ValueError:
-                self.fail(part.sourceline, "ssc:LinearTransformation: factor and offset must be numbers")
+                self.fail(part.sourceline, "ssc:LinearTransformation: factor and offset must be finite numbers")
                 return None
         return factor, offset
 

@@ -12,11 +12,12 @@ and offset, the standard's automatic unit conversion of connections and paramete
 
 from __future__ import annotations
 
+import math
 import re
 from typing import Any
 
 from ..units import BASE_ATTRIBUTES, BaseUnit, base_unit
-from .xml import child, children
+from .xml import child, children, finite, shown, whole
 
 Definitions = dict[str, BaseUnit]
 """Unit name -> its definition."""
@@ -49,8 +50,8 @@ def read_definitions(units: Any) -> Definitions:
         try:
             found[name] = from_attributes(base.attrib)
         except ValueError:
-            raise UnitError(f"ssc:Unit '{name}': its ssc:BaseUnit attributes must be numbers",
-                            base.sourceline) from None
+            raise UnitError(f"ssc:Unit {shown(name)}: its ssc:BaseUnit attributes must be numbers: finite factor "
+                            "(not 0) and offset, whole exponents", base.sourceline) from None
     return found
 
 
@@ -59,11 +60,13 @@ def from_attributes(attributes: Any) -> BaseUnit:
     ``factor``, ``offset``, each optional); ValueError for one that is not a number."""
     exponents = []
     for name in BASE_ATTRIBUTES.values():
-        power = int(attributes.get(name) or 0)
+        power = whole(str(attributes.get(name) or 0))
         if power:
             exponents.append((name, power))
-    factor = float(attributes.get("factor") or 1.0)
-    offset = float(attributes.get("offset") or 0.0)
+    factor = finite(str(attributes.get("factor") or 1.0))
+    offset = finite(str(attributes.get("offset") or 0.0))
+    if factor == 0:
+        raise ValueError("a unit's factor is its size in the SI base units and cannot be 0")
     return BaseUnit(tuple(exponents), factor, offset)
 
 
@@ -120,4 +123,7 @@ def conversion(source: str, target: str, *tables: Definitions) -> tuple[float, f
                         "know it)")
     if a.exponents != b.exponents:
         raise UnitError(f"unit '{source}' does not convert to unit '{target}': they measure different quantities")
-    return a.factor / b.factor, (a.offset - b.offset) / b.factor
+    factor, offset = a.factor / b.factor, (a.offset - b.offset) / b.factor
+    if not (math.isfinite(factor) and math.isfinite(offset)) or factor == 0:
+        raise UnitError(f"unit '{source}' to unit '{target}': their factors and offsets give no finite conversion")
+    return factor, offset

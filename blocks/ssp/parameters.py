@@ -23,7 +23,7 @@ from typing import Any, Callable
 
 from .conversion import Definitions, UnitError, conversion, definition, read_definitions
 from .package import Package, PackageError
-from .xml import XmlError, child, children, elements, local, q
+from .xml import XmlError, child, children, elements, finite, local, q, shown, whole
 
 FLOATS = ("Real", "Float64", "Float32")
 INTEGERS = ("Integer", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32", "Int64", "UInt64")
@@ -168,19 +168,31 @@ def _value(element: Any, name: str, file: str) -> Any:
     line = element.sourceline
     try:
         if kind in FLOATS and text is not None:
-            return float(text)
+            return finite(text)
         if kind in INTEGERS and text is not None:
-            return int(text.strip())
+            value, (low, high) = whole(text), integer_range(kind)
+            if not low <= value <= high:
+                raise BindingError(file, line, f"parameter '{name}': {value} is out of the range of an ssv:{kind} "
+                                   f"({low} to {high})")
+            return value
         if kind == "Boolean" and text is not None:
             if text.strip() not in ("true", "false", "1", "0"):
                 raise ValueError(text)
             return text.strip() in ("true", "1")
         if kind in ("String", "Enumeration") and text is not None:
             return text
+    except BindingError:
+        raise
     except ValueError:
-        raise BindingError(file, line, f"parameter '{name}': {text!r} is not an ssv:{kind} value") from None
+        raise BindingError(file, line, f"parameter '{name}': {shown(text)} is not an ssv:{kind} value") from None
     raise BindingError(file, line, f"parameter '{name}': values of type ssv:{kind} are not supported",
                        "Real, Float64, Float32, Integer and IntN, Boolean, String and Enumeration values are")
+
+
+def integer_range(kind: str) -> tuple[int, int]:
+    """The values an ``ssv`` integer type holds (``Integer`` is 32 bits, as in FMI)."""
+    bits = 32 if kind == "Integer" else int(kind.removeprefix("U").removeprefix("Int"))
+    return (0, 2**bits - 1) if kind.startswith("U") else (-2 ** (bits - 1), 2 ** (bits - 1) - 1)
 
 
 Entry = tuple[str, "tuple[float, float] | None", bool]
@@ -219,7 +231,7 @@ def _mapping(package: Package, ssd_file: str, element: Any, read: Reader) -> dic
                 raise BindingError(file, transformation.sourceline, f"ssc:{what} in a parameter mapping is not "
                                    "supported", "ssc:LinearTransformation is")
             try:
-                transform = float(transformation.get("factor", "1")), float(transformation.get("offset", "0"))
+                transform = finite(transformation.get("factor", "1")), finite(transformation.get("offset", "0"))
             except ValueError:
                 raise BindingError(file, transformation.sourceline, "ssc:LinearTransformation: factor and offset "
                                    "must be numbers") from None

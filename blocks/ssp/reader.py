@@ -52,7 +52,7 @@ from ..fmu.ports import port_name, port_of
 from ..issues import DiagramError, Issue
 from blocks.builder.records import Site
 from blocks.builder.scopes import NAME
-from ..timebase import DurationError, parse_duration
+from ..timebase import DurationError, positive_duration
 from .connections import Wiring
 from .conversion import Definitions, UnitError, fmu_definitions, read_definitions
 from .package import Package, PackageError, open_package
@@ -165,16 +165,13 @@ class _Reader:
         if experiment is None:
             return
         start = experiment.get("startTime")
-        if start is not None and _number(start) != 0:
+        if start is not None and _number(start)[0] != 0:
             self.fail(experiment.sourceline, f"ssd:DefaultExperiment startTime {shown(start)} is not supported",
                       "runs start at t = 0: leave startTime out or make it 0")
         stop = experiment.get("stopTime")
         if stop is not None:
-            value = _number(stop)
-            if value is None or value <= 0:
-                self.fail(experiment.sourceline, f"ssd:DefaultExperiment stopTime {shown(stop)} is not a positive "
-                          "number of seconds")
-            else:
+            value = self.step_value(stop, experiment.sourceline, "ssd:DefaultExperiment stopTime")
+            if value is not None:
                 self.b.t_end = value
                 self.b.t_end_site = self.site(experiment)
         found = base_step(experiment)
@@ -182,9 +179,9 @@ class _Reader:
             self.base = self.step_value(found[0], found[1], "osp:FixedStepAlgorithm baseStepSize")
 
     def step_value(self, text: str, line: int | None, what: str) -> Fraction | None:
-        value = _number(text)
+        value, problem = _number(text)
         if value is None or value <= 0:
-            self.fail(line, f"{what} {shown(text)} is not a positive number of seconds")
+            self.fail(line, f"{what} {shown(text)} is not a positive number of seconds{problem}")
             return None
         return value
 
@@ -303,9 +300,9 @@ class _Reader:
                 return given
         if self.cli_step is not None:
             try:
-                return parse_duration(self.cli_step)
+                return positive_duration(self.cli_step, "the step given")
             except DurationError as exc:
-                self.fail(item.sourceline, f"component '{name}': the step given: {exc}")
+                self.fail(item.sourceline, f"component '{name}': {exc}")
                 return None
         md = self.description(me)
         if md is False or _default_step(md):
@@ -470,8 +467,9 @@ def _default_step(md: Any) -> bool:
         return False
 
 
-def _number(text: str) -> Fraction | None:
+def _number(text: str) -> tuple[Fraction | None, str]:
+    """A time's exact value, or None and why not (`` (...)``, for a message)."""
     try:
-        return exact(text)
-    except (ValueError, ZeroDivisionError):
-        return None
+        return exact(text), ""
+    except ValueError as exc:
+        return None, f" ({exc})"

@@ -43,6 +43,7 @@ from .steps import (ANNOTATIONS, add_base_step, add_feedthrough, add_step_hint, 
                     number)
 from .units import add_units, unit_definitions
 from .xml import PREFIXES, q
+from blocks.builder.api_args import diagram_argument
 
 CONNECTOR_TYPES = {"Float64": "Real", "Float32": "Real", "Int32": "Integer", "Int16": "Integer", "Int8": "Integer",
                    "UInt16": "Integer", "UInt8": "Integer", "Boolean": "Boolean"}
@@ -57,6 +58,7 @@ def export_ssp(diagram: Diagram, out: str | Path, annotations: str = "system") -
     """Write ``diagram`` as the SSP archive ``out`` (a ``.ssp`` file), its tool-specific
     annotations placed as ``annotations`` says (a key of ``ANNOTATIONS``); DiagramError
     naming each block or connection that SSP cannot carry."""
+    diagram_argument(diagram)
     if annotations not in ANNOTATIONS:
         raise ValueError(f"annotations must be one of {', '.join(ANNOTATIONS)}, got {annotations!r}")
     with tempfile.TemporaryDirectory(prefix="blocks-ssp-") as scratch:

@@ -9,10 +9,17 @@ readers (libcosim) match the prefixes rather than the namespaces.
 
 from __future__ import annotations
 
+import math
+
 import os
+import re
 from fractions import Fraction
 from pathlib import Path
 from typing import Any
+
+from ..timebase import DurationError, parse_duration
+
+_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -108,12 +115,32 @@ def annotations(element: Any, kind: str) -> list:
 
 
 def exact(text: str) -> Fraction:
-    """A number written in the XML (``xs:double``: ``0.001``, ``1e-4``) as the exact
-    rational of its decimal text; ValueError if it is not one."""
-    return Fraction(text.strip())
+    """A time written in the XML (``xs:double``: ``0.001``, ``1e-4``) as the exact
+    rational of its decimal text, read by ``timebase.parse_duration`` so that its range
+    (0, or 1e-12 s to 1e9 s) is checked before any exact arithmetic (``1e999999999`` would
+    be a number of a billion digits); ValueError (a DurationError) says why it is not one."""
+    if not _DECIMAL.fullmatch(text.strip()):
+        raise DurationError(f"{shown(text)} is not a decimal number")
+    return parse_duration(text.strip())
 
 
 def shown(text: Any) -> str:
     """An attribute's text for a message: at most 60 characters, quoted."""
     s = str(text)
     return repr(s if len(s) <= 60 else s[:57] + "...")
+
+
+def whole(text: str) -> int:
+    """A whole number of at most 24 characters (an Int64 has 20); ValueError otherwise."""
+    if len(text.strip()) > 24:
+        raise ValueError(text)
+    return int(text.strip())
+
+
+def finite(text: str) -> float:
+    """A real number written in the XML; ValueError for one that is not finite (``INF``,
+    ``NaN``, ``1e999``): no parameter, factor or offset is meant to be."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(text)
+    return value

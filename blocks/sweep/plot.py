@@ -29,7 +29,7 @@ MAX_LINES = 8
 def _value(cell: str) -> Any:
     try:
         return json.loads(cell)
-    except ValueError:
+    except (ValueError, RecursionError):  # not JSON, or nested past the parser's depth
         return cell
 
 
@@ -69,7 +69,11 @@ def sweep_table(directory: str | Path, params: list[str], metric: str) -> tuple[
     table = []
     for r in rows:
         entry = {p: _value(r[p]) for p in parameters}
-        entry["metric"] = float(r[metric]) if r["status"] == OK and r[metric] != "" else float("nan")
+        try:
+            entry["metric"] = float(r[metric]) if r["status"] == OK and r[metric] != "" else float("nan")
+        except ValueError:
+            raise SweepError(f"{directory}: point {r['point_hash'][:16]!r}: its '{metric}' is not a number "
+                             f"({r[metric][:40]!r})") from None
         table.append(entry)
     if all(np.isnan(r["metric"]) for r in table):
         raise SweepError(f"{directory}: no finished run has a value for '{metric}' (failed runs, or the "

@@ -45,6 +45,9 @@ def check_folder(directory: Path) -> None:
         entry = directory / name
         if entry.exists() and not entry.is_file():
             raise SweepError(f"{entry} is not a regular file (hint: move it away, or choose another -o folder)")
+    if (directory / RUNS).exists() and not (directory / RUNS).is_dir():
+        raise SweepError(f"{directory / RUNS} is not a folder; the sweep keeps its runs' results there (hint: move "
+                         "it away, or choose another -o folder)")
 
 
 def columns(parameters: Sequence[str], metrics: Sequence[str]) -> list[str]:
@@ -75,13 +78,16 @@ class SweepStore:
             self._append_text(_csv_line(self.header))
             return {}
         self._cut_torn_tail()
-        with open(self.path, newline="", encoding="utf-8") as f:
-            reader = csv.reader(f)
-            header = next(reader, None)
-            if header != self.header:
-                raise SweepError(f"{self.path} belongs to another sweep (columns {', '.join(header or [])}; "
-                                 f"this sweep writes {', '.join(self.header)}); use another -o folder")
-            return {row[0]: row[1] for row in reader if len(row) == len(self.header)}
+        try:
+            with open(self.path, newline="", encoding="utf-8") as f:
+                reader = csv.reader(f)
+                header = next(reader, None)
+                if header != self.header:
+                    raise SweepError(f"{self.path} belongs to another sweep (columns {', '.join(header or [])[:200]}; "
+                                     f"this sweep writes {', '.join(self.header)}); use another -o folder")
+                return {row[0]: row[1] for row in reader if len(row) == len(self.header)}
+        except (ValueError, csv.Error) as exc:  # not UTF-8, a field beyond the csv module's limit
+            raise SweepError(f"{self.path}: not a sweep's CSV file: {exc}; use another -o folder") from None
 
     def append(self, point_hash: str, point: dict[str, Any], status: str, error: str, wall_s: float,
                values: dict[str, Any]) -> None:
@@ -142,7 +148,7 @@ def read_sweep(directory: str | Path) -> tuple[dict[str, Any], list[dict[str, st
         description = json.loads(json_path.read_text(encoding="utf-8")) if json_path.is_file() else {}
         with open(csv_path, newline="", encoding="utf-8") as f:
             rows = [r for r in csv.DictReader(f) if None not in r.values() and None not in r]
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, csv.Error) as exc:
         raise SweepError(f"{directory}: cannot read the sweep: {exc}") from None
     latest = {r["point_hash"]: r for r in rows}
     return description, list(latest.values())

@@ -58,7 +58,7 @@ def run(case: Case, folder: Path, cli=None) -> subprocess.CompletedProcess:
     argv = [a.format(dir=folder, root=ROOT) for a in case.argv]
     if cli is not None and not case.env:  # a case's own environment (a locale) needs an interpreter of its own
         return cli.run(argv, folder, timeout=case.timeout)
-    env = dict(os.environ, PYTHONPATH=str(ROOT), **case.env)
+    env = {**os.environ, "PYTHONPATH": str(ROOT), **case.env}
     return subprocess.run([sys.executable, "-m", "hierhand", *argv], capture_output=True, text=True,
                           cwd=folder, env=env, timeout=case.timeout)
 

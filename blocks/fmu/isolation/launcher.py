@@ -32,6 +32,7 @@ import threading
 from pathlib import Path
 
 from blocks.block import BlockError
+from blocks.process.module_path import protect_children
 
 STARTUP_SECONDS = 120.0
 """How long the launcher may take to start (importing numpy and fmpy on a loaded machine)."""
@@ -73,8 +74,9 @@ class Launcher:
     def __init__(self):
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         root = str(Path(__file__).resolve().parents[3])  # the folder the blocks package is in
-        env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1",
-                   PYTHONPATH=os.pathsep.join([root, *filter(None, [os.environ.get("PYTHONPATH")])]))
+        env = protect_children(dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+                                    MKL_NUM_THREADS="1"))
+        env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
         command = [sys.executable, "-P", "-c", f"from blocks.fmu.isolation.forkserver import main; main({theirs.fileno()})"]
         try:
             self.process = subprocess.Popen(command, pass_fds=(theirs.fileno(),), start_new_session=True,
