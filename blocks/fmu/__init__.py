@@ -1,4 +1,5 @@
-"""FMU import: an FMI 2.0 or 3.0 co-simulation or model-exchange FMU as a block, through fmpy's low-level API.
+"""FMU import: an FMI 2.0 or 3.0 co-simulation or model-exchange FMU, or an FMI 3.0
+scheduled-execution FMU, as a block, through fmpy's low-level API.
 
 In a diagram::
 
@@ -34,14 +35,18 @@ type's). The indices must start at 1 and have no gaps. Port names are the variab
 vector) names with every character other than letters, digits and ``_`` replaced by
 ``_`` (``body.v[2]`` -> port ``body_v``). FMI 3 ``<Alias>`` outputs are ports of their own.
 String, Binary and Clock variables are not ports (``port_hint`` says so when a diagram
-names one); give String inputs values with ``start_values``.
+names one), except a scheduled-execution FMU's triggered input clocks and output clocks;
+give String inputs values with ``start_values``.
 
 Interface. An FMU offering co-simulation runs as co-simulation, one offering only model
 exchange as model exchange; ``interface: model_exchange`` (or ``co_simulation``) chooses.
+One offering only scheduled execution has its input clocks activated at the block's hits
+(``scheduled``: periodic, triggered and countdown clocks, in priority order).
 
-Semantics, both interfaces. The block has no feedthrough: ``output(t)`` returns the FMU
-outputs at the hit ``t`` (read at the end of the previous step), and ``update(t)`` sets
-the inputs seen at ``t`` and steps the FMU to the next hit ``t + period``. Inputs are
+Semantics of co-simulation and model exchange. The block has no feedthrough:
+``output(t)`` returns the FMU outputs at the hit ``t`` (read at the end of the previous
+step), and ``update(t)`` sets the inputs seen at ``t`` and steps the FMU to the next hit
+``t + period``. Inputs are
 therefore held over each step (zero-order hold) and an output never depends on the input
 of the same instant, which makes the diagram free of algebraic loops through FMUs and the
 result independent of the evaluation order (the usual Jacobi co-simulation scheme). The

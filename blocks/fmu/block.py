@@ -111,8 +111,8 @@ class FMU(Block):
         relative tolerance; Euler locates state events to it times the sub-step); default:
         the FMU's DefaultExperiment tolerance, for model exchange else 1e-5
     interface : str
-        'co_simulation' or 'model_exchange'; default: co-simulation where the FMU offers
-        it, else model exchange
+        'co_simulation', 'model_exchange' or 'scheduled_execution' (FMI 3); default:
+        co-simulation where the FMU offers it, else model exchange, else scheduled execution
     solver : str
         model exchange only: 'cvode' (SUNDIALS' CVode as fmpy ships it, the default) or
         'euler' (forward Euler with a fixed sub-step)

@@ -12,7 +12,11 @@ from fractions import Fraction
 from xml.etree import ElementTree as ET
 
 from blocks.timebase import fraction_gcd
+from .description import step_of
 from .ports import port_name
+
+SHORTEST, LONGEST = Fraction(1, 10**12), Fraction(10**9)
+"""The range of a clock's interval or shift, as of every duration (``timebase``)."""
 
 PERIODIC = ("constant", "fixed", "tunable")
 """The interval variabilities of the periodic clocks the block runs (at their declared interval)."""
@@ -35,13 +39,27 @@ class Clock:
         return self.kind == "periodic" and t >= self.shift and (t - self.shift) % self.interval == 0
 
 
-def _time(element: ET.Element, counter: str, decimal: str) -> Fraction | None:
-    """A time attribute of a clock: ``counter / resolution`` where given, else the decimal's
-    text read exactly; None where neither is."""
-    if element.get(counter) is not None and element.get("resolution") is not None:
-        return Fraction(int(element.get(counter)), int(element.get("resolution")))
-    text = element.get(decimal)
-    return Fraction(text) if text is not None else None
+def _time(element: ET.Element, counter: str, decimal: str, shown: str) -> Fraction | None:
+    """A time attribute of a clock: ``counter / resolution`` where given, else the decimal
+    (the double it is, exactly); None where neither is. ValueError naming the clock and the
+    attribute for a value that is no time in the range of durations (1e-12 s to 1e9 s)."""
+    name = element.get("name")
+    try:
+        if element.get(counter) is not None and element.get("resolution") is not None:
+            try:
+                value = Fraction(int(element.get(counter)), int(element.get("resolution")))
+            except (ValueError, ZeroDivisionError):
+                raise ValueError("not a whole counter of a positive resolution") from None
+            if value < 0 or (value and not LONGEST >= value >= SHORTEST) or int(element.get("resolution")) < 0:
+                raise ValueError("out of range (1e-12 s to 1e9 s)")
+            return value
+        text = element.get(decimal)
+        if text is None:
+            return None
+        return Fraction(0) if text.strip() in ("0", "0.0") else step_of(text)
+    except ValueError as exc:
+        raise ValueError(f"{shown}: clock '{name}': its {counter if element.get(counter) else decimal} is "
+                         f"{exc}") from None
 
 
 def fmu_clocks(xml: bytes, shown: str) -> tuple[Clock, ...]:
@@ -60,12 +78,12 @@ def fmu_clocks(xml: bytes, shown: str) -> tuple[Clock, ...]:
         if kind in ("triggered", "countdown"):
             inputs.append(Clock(name, port_name(name), vr, kind, priority))
             continue
-        interval = _time(element, "intervalCounter", "intervalDecimal")
+        interval = _time(element, "intervalCounter", "intervalDecimal", shown)
         if kind not in PERIODIC or interval is None or interval <= 0:
             raise ValueError(f"{shown}: the input clock '{name}' is {kind} without an interval the "
                              "modelDescription gives; the FMU block activates periodic, triggered and countdown "
                              "clocks")
-        shift = _time(element, "shiftCounter", "shiftDecimal") or Fraction(0)
+        shift = _time(element, "shiftCounter", "shiftDecimal", shown) or Fraction(0)
         inputs.append(Clock(name, port_name(name), vr, "periodic", priority, interval, shift))
     if not inputs:
         raise ValueError(f"{shown} provides scheduled execution without input clocks: nothing activates it")

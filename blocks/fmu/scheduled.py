@@ -111,8 +111,8 @@ class ScheduledExecution3(FMI3Instance):
         for c in clocks:
             if c.kind != "countdown":
                 continue
-            vrs, intervals, qualifiers = (fmi3ValueReference * 1)(c.vr), (fmi3Float64 * 1)(), (fmi3IntervalQualifier * 1)()
-            self.slave.getIntervalDecimal(vrs, intervals, qualifiers)
+            intervals, qualifiers = (fmi3Float64 * 1)(), (fmi3IntervalQualifier * 1)()
+            self.slave.getIntervalDecimal((fmi3ValueReference * 1)(c.vr), intervals, qualifiers)
             if qualifiers[0] != 2:  # fmi3IntervalChanged
                 continue
             at = exact + Fraction(repr(float(intervals[0])))

@@ -23,7 +23,6 @@ from fractions import Fraction
 
 import numpy as np
 
-from blocks.builder.diagram import Diagram
 from blocks.engine.optable import (
     B_FIRST_INPUT, B_N_INPUTS, B_OUT, B_WIDTH, C_DST, C_SRC, C_WIDTH, COPY, E_PROGRAM, E_TICK, H_HYPERPERIOD,
     H_INITIAL, I_OFFSET, I_WIDTH, OP_A, OP_CODE, OUTPUT, PR_END, PR_FIRST, UPDATE, OpTable,
@@ -248,7 +247,8 @@ def variable_clocks(partitions_: Partitions, table: OpTable, inputs, outputs) ->
         if len(found) == 1 and None not in found:
             out[v.vr] = partitions_.clocks[found.pop()].vr
     for v in outputs:
-        b = next(b for b in range(len(names)) if t.blocks[b, B_OUT] <= v.offsets[0] < t.blocks[b, B_OUT] + t.blocks[b, B_WIDTH])
+        b = next(b for b in range(len(names))
+                 if t.blocks[b, B_OUT] <= v.offsets[0] < t.blocks[b, B_OUT] + t.blocks[b, B_WIDTH])
         c = partitions_.owner[names[b]]
         if c is not None:
             out[v.vr] = partitions_.clocks[c].vr

@@ -321,7 +321,7 @@ def test_the_defaults_come_from_the_default_experiment(me):
     ("substep: 1 ms", "parameter 'substep' is the fixed step of 'solver: euler'; CVode chooses its own steps"),
     ("solver: euler, substep: -1 ms", "parameter 'substep' must be positive"),
     ("solver: euler, substep: fast", "parameter 'substep': cannot read 'fast' as a duration"),
-    ("interface: exchange", "parameter 'interface' must be one of co_simulation, model_exchange, got 'exchange'"),
+    ("interface: exchange", "parameter 'interface' must be one of co_simulation, model_exchange, scheduled_execution, got 'exchange'"),
     ("interface: co_simulation", "has no co-simulation interface (it provides only model exchange); drop "
                                  "'interface: co_simulation' to run it as model exchange"),
 ])

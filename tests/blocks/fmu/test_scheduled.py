@@ -10,6 +10,8 @@ where the total count reaches a multiple of 5.
 
 from __future__ import annotations
 
+import zipfile
+
 import numpy as np
 import pytest
 
@@ -93,3 +95,19 @@ def test_a_period_off_the_clock_grid_is_refused(clocks_fmu):
 def test_scheduled_execution_in_a_process_of_its_own_is_refused(clocks_fmu):
     with pytest.raises(ValueError, match="drop 'isolation: process'"):
         FMU(clocks_fmu, isolation="process")
+
+
+@pytest.mark.parametrize("attributes, why", [
+    ('intervalCounter="1" resolution="0" supportsFraction="true"', "its intervalCounter is not a whole counter of a "
+                                                                    "positive resolution"),
+    ('intervalDecimal="1e-300"', "its intervalDecimal is out of range (1e-12 s to 1e9 s)"),
+])
+def test_a_clock_interval_that_is_no_time_is_refused_in_one_line(clocks_fmu, tmp_path, attributes, why):
+    with zipfile.ZipFile(clocks_fmu) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    xml = members["modelDescription.xml"].decode()
+    members["modelDescription.xml"] = xml.replace('intervalDecimal="1.0"', attributes).encode()
+    broken = zip_files(tmp_path / "broken.fmu", members)
+    with pytest.raises(ValueError) as info:
+        FMU(broken)
+    assert str(info.value).splitlines() == [f"FMU '{broken}': clock 'inClock1': {why}"]

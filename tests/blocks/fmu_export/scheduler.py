@@ -2,10 +2,10 @@
 as a third-party importer would: for tests of exported FMUs.
 
 It reads the input clocks of the modelDescription (interval and shift exact as counters of
-a resolution, priorities: from the XML, which FMPy's reader leaves out), and runs the instants of their tick grid in time order: at
-each, the inputs given for it set, the clocks that tick there activated in priority order
-(``fmi3ActivateModelPartition``), the outputs read. It counts the preemption-lock calls
-the FMU makes, which must pair up.
+a resolution, priorities: from the XML, which FMPy's reader leaves out), and runs the
+instants of their tick grid in time order: at each, the inputs given for it set, the
+clocks that tick there activated in priority order (``fmi3ActivateModelPartition``), the
+outputs read. It counts the preemption-lock calls the FMU makes, which must pair up.
 """
 
 from __future__ import annotations

@@ -64,7 +64,8 @@ def test_the_toy_declares_exact_clocks_and_passes_validation_and_the_schema(toy_
     assert root.find("ScheduledExecution") is not None and root.find("CoSimulation") is None
     clocks = {c.get("name"): c for c in root.iter("Clock")}
     periods = {name: Fraction(int(c.get("intervalCounter")), int(c.get("resolution"))) for name, c in clocks.items()}
-    assert periods == {"clock_100us": Fraction(1, 10000), "clock_1ms": Fraction(1, 1000), "clock_10ms": Fraction(1, 100)}
+    assert periods == {"clock_100us": Fraction(1, 10000), "clock_1ms": Fraction(1, 1000),
+                       "clock_10ms": Fraction(1, 100)}
     assert [clocks[n].get("priority") for n in ("clock_100us", "clock_1ms", "clock_10ms")] == ["0", "1", "2"]
     assert {c.get("intervalVariability") for c in clocks.values()} == {"constant"}
     output = next(v for v in root.iter("Float64") if v.get("name") == "plant.y")
@@ -205,7 +206,8 @@ def test_a_scheduled_fmu_rebuilt_from_its_sources_runs_the_same(toy_se, tmp_path
     sources = [str(unzipped / "sources" / f.get("name")) for f in build.iter("SourceFile")]
     library = next((unzipped / "binaries").glob(f"*/{identifier}.so"))
     library.unlink()
-    subprocess.run([compiler, "-std=c99", "-O1", "-ffp-contract=off", "-shared", "-fPIC", f"-I{Path(fmpy.__file__).parent / 'c-code'}",
+    headers = Path(fmpy.__file__).parent / "c-code"
+    subprocess.run([compiler, "-std=c99", "-O1", "-ffp-contract=off", "-shared", "-fPIC", f"-I{headers}",
                     f"-I{unzipped / 'sources'}", *sources, "-o", str(library), "-lm"], check=True, timeout=300)
     rebuilt = tmp_path / "rebuilt.fmu"
     with zipfile.ZipFile(rebuilt, "w") as archive:
