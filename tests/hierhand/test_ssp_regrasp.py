@@ -1,9 +1,10 @@
 """The re-grasp exported as an SSP (hierhand ssp export diagrams/regrasp.yaml): the plant,
 the controller subsystem and the object's support each a component whose FMU the
 diagram-FMU exporter writes. Run back by blocks it is the native re-grasp to the last bit
-(the controller's outputs read with feedthrough, as its blocks:Stepping annotation asks);
+(the controller's outputs read after its inputs are set, as its ModelStructure declares
+them dependent, and as its blocks:Stepping annotation asks: without the annotation too);
 libcosim, whose fixed-step algorithm steps every FMU on the others' outputs of the last
-communication point, runs it as blocks runs the same SSP without that annotation."""
+communication point, runs it as blocks runs it with 'feedthrough: false' on the controller."""
 
 from __future__ import annotations
 
@@ -36,10 +37,9 @@ def regrasp_ssp(tmp_path_factory):
     return path, folder / "unpacked"
 
 
-def jacobi_copy(unpacked: Path, folder: Path) -> Path:
-    """The SSP's folder without the blocks:Stepping annotations: every FMU read on the
-    outputs of the last communication point, as libcosim steps them."""
-    target = folder / "jacobi"
+def unannotated_copy(unpacked: Path, folder: Path) -> Path:
+    """The SSP's folder without the blocks:Stepping annotations, as another tool writes it."""
+    target = folder / "unannotated"
     (target / "resources").mkdir(parents=True)
     for fmu in (unpacked / "resources").iterdir():
         shutil.copy(fmu, target / "resources" / fmu.name)
@@ -82,6 +82,16 @@ def test_a_component_parameter_set_on_the_ssp_is_the_native_override(regrasp_ssp
                                                                  t_end=0.3)["plant.q"][1])
 
 
+def test_without_the_annotations_the_regrasp_ssp_runs_in_the_order_the_fmus_declare(regrasp_ssp, tmp_path):
+    """Another tool's SSP carries no blocks:Stepping: the controller's declared dependencies
+    order the exchange all the same, so the run is the native re-grasp."""
+    native = blocks.simulate(blocks.load_diagram(REGRASP), t_end=0.3)
+    without = blocks.load_diagram(unannotated_copy(regrasp_ssp[1], tmp_path))
+    assert without.blocks["ctrl"].block.has_feedthrough()
+    via = blocks.simulate(without, t_end=0.3)
+    np.testing.assert_array_equal(via["plant.q"][1], native["plant.q"][1])
+
+
 def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regrasp_ssp, native_regrasp, tmp_path):
     """libcosim's fixed-step algorithm steps every due FMU at once and only then hands the
     outputs over: the controller's torques reach the plant one step (1 ms) later than in
@@ -106,8 +116,7 @@ def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regras
     for _ in range(1000):
         assert execution.step()
         rows.append(observer.last_real_values(plant, q))
-    without = blocks.load_diagram(jacobi_copy(unpacked, tmp_path))
-    assert not any(s.params.get("feedthrough") for s in without.blocks.values())
+    without = blocks.load_diagram(unannotated_copy(unpacked, tmp_path), overrides={"ctrl.feedthrough": False})
     jacobi = blocks.simulate(without)
     np.testing.assert_allclose(np.array(rows), jacobi["plant.q"][1][1:], rtol=1e-9, atol=1e-12)
     assert np.abs(np.array(rows) - native_regrasp["plant.q"][1][1:]).max() > 1e-4  # the lag shows
