@@ -348,6 +348,11 @@ class Block:
     def has_feedthrough(self) -> bool:
         return any(self.reads(p) for p in self.outputs)
 
+    def loop_remedy(self, name: str) -> str | None:
+        """How else than a delay an algebraic loop through this block (named ``name`` in
+        its diagram) can be broken, for the loop's message; None: no other way."""
+        return None
+
 
 def checked_units(units: Any, width: int | None, port: str) -> str | list[str] | None:
     """``Block.port_units`` as files keep it: None, one string, or one string per element

@@ -514,9 +514,11 @@ class _Planner:
                         key=lambda i: (self.order[cycle[i][0][1]], cycle[i][0][2]))
             cycle = cycle[start:] + cycle[:start]
             wire = next((wires[e] for e in cycle if e in wires), None)
+            on_loop = dict.fromkeys(v[1] for _, v in cycle)
+            remedies = [r for n in on_loop if (r := self.d.blocks[n].block.loop_remedy(n))]
             self.fail(wire.line if wire else None, f"algebraic loop: {_chain([cycle[0][0]] + [v for _, v in cycle])}",
-                      "break it with a block without feedthrough (e.g. UnitDelay) or add "
-                      "'delay: 1' to one connection", wire.file if wire else None)
+                      "; ".join(["break it with a block without feedthrough (e.g. UnitDelay) or add "
+                                 "'delay: 1' to one connection", *remedies]), wire.file if wire else None)
         out_nodes = [v for v in nx.lexicographical_topological_sort(
             graph, key=lambda v: (self.order[v[1]], v[0] == "o", v[2])) if v[0] == "o"]
         steps: list[tuple[str, list[str]]] = []

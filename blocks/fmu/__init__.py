@@ -43,18 +43,23 @@ exchange as model exchange; ``interface: model_exchange`` (or ``co_simulation``)
 One offering only scheduled execution has its input clocks activated at the block's hits
 (``scheduled``: periodic, triggered and countdown clocks, in priority order).
 
-Semantics of co-simulation and model exchange. The block has no feedthrough:
-``output(t)`` returns the FMU outputs at the hit ``t`` (read at the end of the previous
-step), and ``update(t)`` sets the inputs seen at ``t`` and steps the FMU to the next hit
-``t + period``. Inputs are
-therefore held over each step (zero-order hold) and an output never depends on the input
-of the same instant, which makes the diagram free of algebraic loops through FMUs and the
-result independent of the evaluation order (the usual Jacobi co-simulation scheme). The
-first output, at the block's first hit ``t0`` (its offset), is the FMU's initial output
-after initialisation with start time ``t0``, with the inputs set before initialisation
-ends, as in FMPy. At t = 0 the blocks feeding the inputs the FMU's initial outputs depend
-on (its InitialUnknowns) are computed first (``initial_feedthrough``), unless that closes a
-loop, in which case the input keeps its start value there.
+Semantics. ``output(t)`` returns the FMU outputs at the hit ``t`` and ``update(t)`` sets
+the inputs seen at ``t`` and steps the FMU to the next hit ``t + period``, so inputs are
+held over each step (zero-order hold). The exchange at a hit is ordered by the
+dependencies the FMU declares (its ModelStructure Outputs; an output without a
+``dependencies`` attribute depends on every input), as OMSimulator orders it: a co-simulation FMU's outputs that
+depend on inputs are read after that hit's inputs are set, before the blocks downstream
+read them (``feedthrough``, per output port), so the planner evaluates a chain through the
+FMU in order and a loop through those dependencies is an algebraic loop (a load error
+naming the port chain). Outputs that depend on no input, every output of a block with
+``feedthrough: false`` (the Jacobi scheme, as libcosim's master steps) and every output of
+a model-exchange FMU come from the end of the previous step, so they never depend on the
+input of the same instant. The first output, at the block's first hit ``t0`` (its
+offset), is the FMU's initial output after initialisation with start time ``t0``, with the
+inputs set before initialisation ends, as in FMPy. At t = 0 the blocks feeding the inputs
+the FMU's initial outputs depend on (its InitialUnknowns) are computed first
+(``initial_feedthrough``), unless that closes a loop, in which case the input keeps its
+start value there.
 
 Co-simulation. A step is ``doStep(t, period)``. The FMU's step rules are its own: a
 ``fixedInternalStepSize`` is informative (``validate`` shows it); an FMU that says it

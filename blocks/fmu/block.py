@@ -120,11 +120,13 @@ class FMU(Block):
         'solver: euler' only: the sub-step, which must divide the period; default: the
         FMU's DefaultExperiment stepSize (made to divide the period), else the period
     feedthrough : bool
-        co-simulation only: true reads the outputs at a hit after setting that hit's
-        inputs, for the outputs the FMU declares dependent on them (its ModelStructure),
-        so a loop through it is evaluated in order as one through native blocks is (an
-        exported controller); false (the default): the outputs of the previous step, no
-        feedthrough
+        co-simulation only. true (the default there): at a hit, the inputs are set and then the
+        outputs the FMU declares dependent on them (its ModelStructure Outputs: all of its
+        inputs where an output has no dependencies attribute) are read, before the blocks
+        downstream read them, as OMSimulator orders the exchange; a loop through those
+        dependencies is an algebraic loop. false: every output comes from before the
+        hit's inputs are set (the Jacobi exchange, as libcosim's master does), so the FMU
+        has no feedthrough and breaks any loop through it
     isolation : str
         'process': each instance runs in a process of its own, so that a crash, an exit()
         or a hang in the FMU fails the run (with its results so far) instead of ending it;
@@ -139,7 +141,7 @@ class FMU(Block):
 
     def __init__(self, path: Any, start_values: Mapping[str, Any] | None = None,
                  tolerance: float | None = None, interface: str | None = None, solver: str | None = None,
-                 substep: Any = None, feedthrough: bool = False, isolation: str | None = None,
+                 substep: Any = None, feedthrough: bool | None = None, isolation: str | None = None,
                  call_timeout: Any = None):
         if not isinstance(path, (str, os.PathLike)) or not str(path).strip():
             raise ValueError(f"parameter 'path' must be the path of an .fmu file, got {path!r}")
@@ -201,11 +203,12 @@ class FMU(Block):
                 (self.inputs if c.kind == "triggered" else self.outputs)[c.port] = 1
         self.input_defaults = input_starts(model, self._assignments)
         self.port_types = {p.name: p.kind.name for p in (*model.inputs.values(), *model.outputs.values())}
-        if not isinstance(feedthrough, bool):
+        if feedthrough is not None and not isinstance(feedthrough, bool):
             raise ValueError(f"parameter 'feedthrough' must be true or false, got {feedthrough!r}")
         if feedthrough and model.exchange:
             raise ValueError(f"parameter 'feedthrough' is for co-simulation FMUs; {shown} runs as model exchange")
-        self._direct = (feedthrough or model.scheduled) and any(model.direct_reads.values())
+        self._direct = ((model.scheduled or (feedthrough is not False and not model.exchange))
+                        and any(model.direct_reads.values()))
         self.feedthrough = model.direct_reads if self._direct else False
         if model.scheduled and self._clock_ports:  # a triggered clock's port reaches every output at once
             self._direct = True
@@ -483,6 +486,13 @@ class FMU(Block):
             raise
         except Exception as exc:
             raise self._failure(inst, _reason(exc, t, self._step)) from None
+
+    def loop_remedy(self, name: str) -> str | None:
+        if not self._direct:
+            return None
+        return (f"or set 'feedthrough: false' on FMU block '{name}', whose modelDescription declares the "
+                "outputs on the loop dependent on its inputs (its outputs then come from before its "
+                "inputs are set: the Jacobi exchange)")
 
     def kernel(self) -> Kernel | None:
         """The steady step in C (``blocks.fmu.compiled_step``) when every port is Float64; an FMU

@@ -10,7 +10,8 @@
   communication point before reading the outputs sees them feed through.
 - Parameters: the tunables of the blocks' records, under their dotted names
   (``reflex.ki``, ``plant.object.mass``; in a diagram of one block without the block's
-  name, ``object.mass``), their start values what the diagram gives.
+  name, ``object.mass``, but ``step.time`` for ``time``, FMI 3's independent variable),
+  their start values what the diagram gives.
 
 Units and element names come from the diagram (``Diagram.port_units``, ``element_labels``:
 a block's own, or those the diagram gives its port with ``units:`` / ``elements:``; a
@@ -152,7 +153,7 @@ def _parameters(plan: Plan, v: Variables, index: dict[str, int]) -> None:
         mine = {}
         for tunable in rec.tunables:
             mine[tunable.name] = len(v.parameters)
-            name = tunable.name if alone else f"{eb.name}.{tunable.name}"
+            name = tunable.name if alone and tunable.name != "time" else f"{eb.name}.{tunable.name}"
             v.parameters.append(Variable(name, v.vr_param + len(v.parameters), "parameter",
                                          tunable.description or f"parameter {tunable.name} of block '{eb.name}'",
                                          tunable.unit, float(rec.values[tunable.slot]), block=b, slot=tunable.slot,

@@ -2,7 +2,7 @@
 
 The re-grasp's controller (diagrams/controller.yaml with the re-grasp's parameters, and
 the object's support) leaves as one FMU with the controller's inputs and outputs; wired
-with the plant FMU, read with feedthrough, it gives the native re-grasp to the last bit.
+with the plant FMU, no annotation needed, it gives the native re-grasp to the last bit.
 The whole closed loop leaves as an FMU without inputs that fmpy, a C host without Python
 and libcosim step. Parameters keep their checks and derived values; the FMUs declare units.
 """
@@ -62,17 +62,19 @@ def fmus(tmp_path_factory):
     return out
 
 
-def two_fmus(folder: Path, plant: Path, ctrl: Path, feedthrough: bool) -> blocks.Diagram:
-    """The re-grasp with the plant FMU and the controller FMU, exchanging every 1 ms."""
+def two_fmus(folder: Path, plant: Path, ctrl: Path, jacobi: bool = False) -> blocks.Diagram:
+    """The re-grasp with the plant FMU and the controller FMU, exchanging every 1 ms in the
+    order their ModelStructures declare, or (``jacobi``) with 'feedthrough: false' on the
+    controller."""
     doc = yaml.safe_load(REGRASP.read_text(encoding="utf-8"))
     doc["name"] = "regrasp-two-fmus"
     doc["blocks"] = {"plant": {"type": "FMU", "period": "1 ms", "params": {"path": str(plant)}},
                      "ctrl": {"type": "FMU", "period": "1 ms",
-                              "params": {"path": str(ctrl), "feedthrough": feedthrough}}}
+                              "params": {"path": str(ctrl), **({"feedthrough": False} if jacobi else {})}}}
     doc["connections"] = [f"plant.{p} -> ctrl.{p}" for p in PLANT_PORTS] + ["ctrl.tau -> plant.tau",
                                                                             "ctrl.f_ext -> plant.f_ext"]
     doc["log"] = list(COMPARED)
-    path = folder / f"two_fmus_{int(feedthrough)}.yaml"
+    path = folder / f"two_fmus_{int(jacobi)}.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
     return blocks.load_diagram(path)
 
@@ -101,7 +103,7 @@ def test_the_controller_and_the_loop_leave_as_valid_fmus_with_units(fmus, fmi):
 
 @pytest.mark.parametrize("fmi", [2, 3])
 def test_the_controller_fmu_with_the_plant_fmu_is_the_native_regrasp(fmus, fmi, native_regrasp, tmp_path):
-    via = blocks.simulate(two_fmus(tmp_path, fmus["plant", fmi], fmus["ctrl", fmi], feedthrough=True))
+    via = blocks.simulate(two_fmus(tmp_path, fmus["plant", fmi], fmus["ctrl", fmi]))
     assert via.complete
     for signal in COMPARED:
         np.testing.assert_array_equal(via[signal][0], native_regrasp[signal][0])
@@ -200,9 +202,10 @@ def test_libcosim_runs_the_controller_fmu_with_the_plant_fmu_as_blocks_does(fmus
     """libcosim's fixed-step algorithm is Jacobi: every FMU steps on the others' outputs of
     the last communication point, so the torques reach the plant one step (1 ms) later than
     in the native diagram, where the controller reads the plant's outputs of the same tick.
-    Its run is the blocks run of the same two FMUs exchanged the same way (no feedthrough)."""
+    Its run is the blocks run of the same two FMUs exchanged the same way ('feedthrough:
+    false' on the controller)."""
     rows = libcosim_run(fmus["plant", 2], fmus["ctrl", 2], 1000)
-    jacobi = blocks.simulate(two_fmus(tmp_path, fmus["plant", 2], fmus["ctrl", 2], feedthrough=False))
+    jacobi = blocks.simulate(two_fmus(tmp_path, fmus["plant", 2], fmus["ctrl", 2], jacobi=True))
     t, q = jacobi["plant.q"]
     np.testing.assert_allclose(rows, q[1:], rtol=1e-9, atol=1e-12)
 

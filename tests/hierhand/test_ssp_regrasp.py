@@ -1,10 +1,12 @@
 """The re-grasp exported as an SSP (hierhand ssp export diagrams/regrasp.yaml): the plant,
 the controller subsystem and the object's support each a component whose FMU the
 diagram-FMU exporter writes. Run back by blocks it is the native re-grasp to the last bit
-(the controller's outputs read with feedthrough, as its blocks:Stepping annotation asks);
+(the controller's outputs read after its inputs are set, as its ModelStructure declares
+them dependent, and as its blocks:Stepping annotation asks: without the annotation too);
 libcosim and ecos, whose fixed-step algorithms step every FMU on the others' outputs of the
-last communication point, run it as blocks runs the same SSP without that annotation (ecos
-with every component at the 1 ms base step: the support's 10 ms FMU holds between its hits)."""
+last communication point, run it as blocks runs it with 'feedthrough: false' on the
+controller (ecos with every component at the 1 ms base step: the support's 10 ms FMU holds
+between its hits)."""
 
 from __future__ import annotations
 
@@ -41,10 +43,9 @@ def regrasp_ssp(tmp_path_factory):
     return path, folder / "unpacked"
 
 
-def jacobi_copy(unpacked: Path, folder: Path) -> Path:
-    """The SSP's folder without the blocks:Stepping annotations: every FMU read on the
-    outputs of the last communication point, as libcosim steps them."""
-    target = folder / "jacobi"
+def unannotated_copy(unpacked: Path, folder: Path) -> Path:
+    """The SSP's folder without the blocks:Stepping annotations, as another tool writes it."""
+    target = folder / "unannotated"
     (target / "resources").mkdir(parents=True)
     for fmu in (unpacked / "resources").iterdir():
         shutil.copy(fmu, target / "resources" / fmu.name)
@@ -57,9 +58,11 @@ def jacobi_copy(unpacked: Path, folder: Path) -> Path:
 
 @pytest.fixture(scope="module")
 def jacobi_regrasp(regrasp_ssp, tmp_path_factory):
-    """blocks' run of the re-grasp SSP without the blocks:Stepping annotations."""
-    without = blocks.load_diagram(jacobi_copy(regrasp_ssp[1], tmp_path_factory.mktemp("jacobi")))
-    assert not any(s.params.get("feedthrough") for s in without.blocks.values())
+    """blocks' run of the re-grasp SSP with the controller read on the outputs of the last
+    communication point ('feedthrough: false'), as libcosim and ecos step it."""
+    without = blocks.load_diagram(unannotated_copy(regrasp_ssp[1], tmp_path_factory.mktemp("jacobi")),
+                                  overrides={"ctrl.feedthrough": False})
+    assert not any(s.block.has_feedthrough() for s in without.blocks.values())
     return blocks.simulate(without)
 
 
@@ -100,6 +103,16 @@ def test_a_component_parameter_set_on_the_ssp_is_the_native_override(regrasp_ssp
     np.testing.assert_array_equal(via["plant.q"][1], native["plant.q"][1])
     assert not np.array_equal(via["plant.q"][1], blocks.simulate(blocks.load_diagram(regrasp_ssp[0]),
                                                                  t_end=0.3)["plant.q"][1])
+
+
+def test_without_the_annotations_the_regrasp_ssp_runs_in_the_order_the_fmus_declare(regrasp_ssp, tmp_path):
+    """Another tool's SSP carries no blocks:Stepping: the controller's declared dependencies
+    order the exchange all the same, so the run is the native re-grasp."""
+    native = blocks.simulate(blocks.load_diagram(REGRASP), t_end=0.3)
+    without = blocks.load_diagram(unannotated_copy(regrasp_ssp[1], tmp_path))
+    assert without.blocks["ctrl"].block.has_feedthrough()
+    via = blocks.simulate(without, t_end=0.3)
+    np.testing.assert_array_equal(via["plant.q"][1], native["plant.q"][1])
 
 
 def test_libcosim_runs_the_regrasp_ssp_as_blocks_does_without_feedthrough(regrasp_ssp, native_regrasp,

@@ -61,6 +61,23 @@ def load_error(text_or_call) -> str:
 # -- simulation ---------------------------------------------------------------------------
 
 
+def test_the_outputs_feed_through_from_the_inputs_the_model_structure_names(fmus):
+    """Per output, the inputs its ModelStructure entry lists (all of them where it lists
+    none, the attribute absent): that is the block's feedthrough, unless 'feedthrough:
+    false' asks for the Jacobi exchange; an FMU read with feedthrough runs in Python."""
+    xml = fmus.xml3
+    for vr, depends in ((7, ' dependencies="6"'), (8, ""), (12, ' dependencies="10"')):
+        xml = xml.replace(f'<Output valueReference="{vr}" dependencies=""/>', f'<Output valueReference="{vr}"{depends}/>')
+    path = fmus.make("declared.fmu", xml, version=3)
+    assert FMU(path).feedthrough == {"y": {"u"}, "z": {"u", "w"}, "wsum": set(), "yf": {"w"}}
+    assert FMU(path, feedthrough=False).feedthrough is False
+    xml2 = fmus.xml2.replace('<Unknown index="9" dependencies=""/>', '<Unknown index="9"/>', 1)
+    declared = fmus.make("declared2.fmu", xml2)
+    assert FMU(declared).feedthrough == {"y": set(), "z": {"u"}} and FMU(declared).kernel() is None
+    jacobi = FMU(declared, feedthrough=False)
+    assert not jacobi.has_feedthrough() and jacobi.kernel() is not None
+
+
 def test_fmi2_fmu_matches_the_closed_form(fmus):
     d = diagram(fmus.fmi2)
     block = d.blocks["f"].block

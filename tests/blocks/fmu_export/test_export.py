@@ -126,10 +126,11 @@ def toy_with(what: str, ctrl: str) -> str:
 
 @pytest.mark.parametrize("fmi,isolation", [(2, "none"), (3, "process")])
 def test_a_subsystem_leaves_with_its_inputs_and_outputs_and_feeds_through_as_native(tmp_path, fmi, isolation):
-    """The toy's controller (inputs: and outputs:) as an FMU: its output depends on its
-    input (the 10 ms gain), which the ModelStructure says; the toy with the FMU read with
-    feedthrough, in the run's process or in one of its own, is the toy with the subsystem,
-    to the last bit."""
+    """The toy's controller (inputs: and outputs:, a 10 ms gain beside a 1 ms integral) as
+    an FMU stepped at 1 ms: its output depends on its input, which the ModelStructure says;
+    the toy with the FMU wired back without any annotation, in the run's process or in one
+    of its own, is the toy with the subsystem, to the last bit. With 'feedthrough: false'
+    (the Jacobi exchange) its output lags a step behind from the gain's first hit."""
     (tmp_path / "pi.yaml").write_text(PI)
     pi = blocks.load_diagram(tmp_path / "pi.yaml")
     path = export_fmu(pi, tmp_path / f"pi{fmi}.fmu", fmi)
@@ -138,12 +139,16 @@ def test_a_subsystem_leaves_with_its_inputs_and_outputs_and_feeds_through_as_nat
     assert [(u.variable.name, [d.name for d in u.dependencies]) for u in md.outputs] == [("u", ["e"])]
     (tmp_path / "composed.yaml").write_text(toy_with("composed", "{diagram: pi.yaml}"))
     (tmp_path / "fmu.yaml").write_text(toy_with(
-        "fmu", f'{{type: FMU, period: 1 ms, params: {{path: "{path}", feedthrough: true, isolation: {isolation}}}}}'))
+        "fmu", f'{{type: FMU, period: 1 ms, params: {{path: "{path}", isolation: {isolation}}}}}'))
     composed = blocks.simulate(blocks.load_diagram(tmp_path / "composed.yaml"))
     via_fmu = blocks.simulate(blocks.load_diagram(tmp_path / "fmu.yaml"))
     assert via_fmu.complete
     np.testing.assert_array_equal(via_fmu["plant.y"][0], composed["plant.y"][0])
     np.testing.assert_array_equal(via_fmu["plant.y"][1], composed["plant.y"][1])
+    jacobi = blocks.simulate(blocks.load_diagram(tmp_path / "fmu.yaml", overrides={"ctrl.feedthrough": False}),
+                             t_end=0.05)
+    apart = np.abs(jacobi["plant.y"][1] - composed["plant.y"][1][:len(jacobi["plant.y"][1])])[:, 0]
+    assert apart[:101].max() == 0.0 and apart.max() > 1e-6     # equal up to the gain's second hit (10 ms)
 
 
 def test_blocks_that_cannot_leave_python_are_refused_one_line_each(tmp_path, toy_fmus):
