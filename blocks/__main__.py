@@ -13,7 +13,8 @@ import sys
 if sys.path and sys.path[0] in ("", os.getcwd()) and not sys.flags.safe_path:
     del sys.path[0]
 
-from blocks.process.stop import launch  # noqa: E402  (after the path is safe)
+from blocks.process.module_path import protect_children  # noqa: E402  (after the path is safe)
+from blocks.process.stop import launch  # noqa: E402
 
 
 def _command():
@@ -23,4 +24,5 @@ def _command():
 
 
 if __name__ == "__main__":
+    protect_children()  # the Python processes it starts do not import from their working folder either
     launch("blocks", _command)

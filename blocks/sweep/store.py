@@ -138,6 +138,20 @@ class NotASweep(SweepError):
         self.directory = directory
 
 
+def _check_description(description: Any) -> None:
+    """ValueError unless ``description`` is a sweep.json as a sweep writes it, in the fields
+    that are read back: ``parameters`` a list of names, ``metrics`` and ``units`` objects."""
+    if not isinstance(description, dict):
+        raise ValueError(f"{SWEEP_JSON} is not a JSON object")
+    kinds = {"parameters": list, "metrics": dict, "units": dict}
+    for key, kind in kinds.items():
+        value = description.get(key)
+        if value is not None and not isinstance(value, kind):
+            raise ValueError(f"{SWEEP_JSON}: '{key}' is not a JSON {'array' if kind is list else 'object'}")
+    if not all(isinstance(p, str) for p in description.get("parameters") or ()):
+        raise ValueError(f"{SWEEP_JSON}: 'parameters' must be names")
+
+
 def read_sweep(directory: str | Path) -> tuple[dict[str, Any], list[dict[str, str]]]:
     """sweep.json and the rows of sweep.csv (the last row per point wins)."""
     directory = Path(directory)
@@ -146,8 +160,13 @@ def read_sweep(directory: str | Path) -> tuple[dict[str, Any], list[dict[str, st
         raise NotASweep(directory)
     try:
         description = json.loads(json_path.read_text(encoding="utf-8")) if json_path.is_file() else {}
+        _check_description(description)
         with open(csv_path, newline="", encoding="utf-8") as f:
-            rows = [r for r in csv.DictReader(f) if None not in r.values() and None not in r]
+            reader = csv.DictReader(f)
+            missing = [c for c in FIXED_COLUMNS if c not in (reader.fieldnames or ())]
+            if missing:
+                raise ValueError(f"{SWEEP_CSV} has no column {', '.join(missing)}")
+            rows = [r for r in reader if None not in r.values() and None not in r]
     except (OSError, ValueError, csv.Error) as exc:
         raise SweepError(f"{directory}: cannot read the sweep: {exc}") from None
     latest = {r["point_hash"]: r for r in rows}

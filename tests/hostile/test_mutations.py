@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import json
 import random
+import tempfile
 import zipfile
 from io import BytesIO
 from pathlib import Path
@@ -29,7 +30,9 @@ from tests.blocks.ssp.test_import import component, values
 from .cases_fmu import fmu
 from .corpus import ROOT
 
-SETTINGS = settings(max_examples=30, derandomize=True,
+def examples(count: int):
+    """Settings of ``count`` derandomized examples (a sweep plot costs seconds, a validate less)."""
+    return settings(max_examples=count, derandomize=True,
                     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
 DIAGRAMS = {name: (ROOT / "diagrams" / name).read_text(encoding="utf-8") for name in ("toy.yaml", "grasp.yaml")}
 SSD_TEXT = ssd(f"<ssd:Elements>{component('a', values(('x0', 'Real', '1.0'), ('n', 'Int8', '3')))}"
@@ -130,12 +133,11 @@ def answered(folder: Path, argv: list[str]) -> None:
 
 
 def _folder(tmp_path: Path, seed: int) -> Path:
-    folder = tmp_path / f"m{seed}"
-    folder.mkdir()
-    return folder
+    """A new folder for one example (Hypothesis may draw a seed twice)."""
+    return Path(tempfile.mkdtemp(prefix=f"m{seed}-", dir=tmp_path))
 
 
-@SETTINGS
+@examples(40)
 @given(name=st.sampled_from(sorted(DIAGRAMS)), seed=st.integers(0, 2**32 - 1), structural=st.booleans())
 def test_a_mutated_diagram_validates_or_is_refused_in_one_line_each(tmp_path, name, seed, structural):
     rng = random.Random(seed)
@@ -146,7 +148,7 @@ def test_a_mutated_diagram_validates_or_is_refused_in_one_line_each(tmp_path, na
     answered(folder, ["validate", name])
 
 
-@SETTINGS
+@examples(30)
 @given(seed=st.integers(0, 2**32 - 1), structural=st.booleans())
 def test_a_mutated_ssp_validates_or_is_refused_in_one_line_each(tmp_path, seed, structural):
     rng = random.Random(seed)
@@ -156,7 +158,7 @@ def test_a_mutated_ssp_validates_or_is_refused_in_one_line_each(tmp_path, seed, 
     answered(folder, ["validate", "s.ssp"])
 
 
-@SETTINGS
+@examples(20)
 @given(seed=st.integers(0, 2**32 - 1), member=st.sampled_from(sorted(SWEEP)), structural=st.booleans())
 def test_a_mutated_sweep_folder_plots_or_is_refused_in_one_line(tmp_path, seed, member, structural):
     rng = random.Random(seed)
