@@ -53,7 +53,7 @@ typedef enum {
  *   magic BLK_EXPORT_MAGIC, version BLK_EXPORT_VERSION,
  *   the token (a string: its length in bytes, then its bytes in whole words, zero padded),
  *   the model's name (a string),
- *   the grid (communication steps are multiples of it, in base ticks),
+ *   the grid (in base ticks: where a communication step runs to, between which outputs hold),
  *   the value references of the first input, output and parameter,
  *   the programs of the outputs at t = 0 (before the first step), between events (-1:
  *   none), of the outputs that are lazy (-1: none),

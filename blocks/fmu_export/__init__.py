@@ -13,9 +13,10 @@ The FMU's inputs and outputs are the diagram's own (``variables``); its paramete
 tunables of the blocks' records, checked by the kinds' constructors when the FMU is
 initialised (an invalid value is a logged error status); a derived value follows what it
 derives from as in a native run. Its internal step is the diagram's base tick (or the
-period of the blocks the plan advances in one call, whose hits communication points must
-be), and a communication step any whole multiple of it; its samples are those of a
-native run of the diagram, to the last bit.
+period of the blocks the plan advances in one call); a communication step may be any
+length, and one that ends between internal steps holds the last one's outputs (an
+importer that steps every FMU at one step runs a multirate export); its samples are those
+of a native run of the diagram, to the last bit.
 
 With ``scheduled=True`` (FMI 3) the FMU declares ``<ScheduledExecution>`` instead: one
 constant periodic input clock per rate, exact as ``intervalCounter / resolution``, and one

@@ -32,7 +32,8 @@ from .xml import BLOCKS_ANNOTATION, OMS_ANNOTATION, OSP_ANNOTATION, annotations,
 ANNOTATIONS = {
     "system": "each component's step and feedthrough as blocks:Stepping on the system, where OMSimulator takes them",
     "components": "libcosim's osp:StepSizeHint and blocks:Stepping in each component (OMSimulator refuses them)",
-    "none": "no tool-specific annotations (every tool steps every component at the step it is given)",
+    "none": "no tool-specific annotations (each tool steps every component at the step it is given; "
+            "OMSimulator refuses the file)",
 }
 """Where the tool-specific annotations go (``export_ssp``'s ``annotations``)."""
 
