@@ -7,7 +7,8 @@ The public API: ``load_diagram`` / ``loads_diagram`` (YAML -> Diagram), ``Diagra
 """
 
 import importlib
-from typing import TYPE_CHECKING
+
+TYPE_CHECKING = False  # typing's constant, without importing typing (a command line starts here)
 
 if TYPE_CHECKING:  # what type checkers and IDEs see; at run time the names come from __getattr__
     from .block import Block, BlockError, EndRun, ParameterError

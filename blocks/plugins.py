@@ -8,8 +8,15 @@ sweep; the reason is told when its name is asked for.
 
 from __future__ import annotations
 
-from importlib.metadata import entry_points
 from typing import Any, Callable
+
+
+def entry_points(group: str):
+    """The installed entry points of ``group`` (``importlib.metadata``, imported only
+    when a plug-in is looked for: it costs a command's start more than the rest)."""
+    from importlib import metadata
+
+    return metadata.entry_points(group=group)
 
 
 def load_group(group: str, refuse: Callable[[Any], str | None]) -> tuple[dict[str, Any], dict[str, str]]:

@@ -16,13 +16,10 @@ on the Python path.
 
 from __future__ import annotations
 
-import hashlib
 import importlib
 import importlib.util
 import sys
 from pathlib import Path
-
-from importlib.metadata import EntryPoint
 
 from .block import Block
 from .plugins import load_group
@@ -40,16 +37,26 @@ class RegistryError(Exception):
 
 
 _cache: dict[str, type[Block]] | None = None
+_library: dict[str, type[Block]] | None = None
 _load_errors: dict[str, str] = {}
+
+
+def library_types() -> dict[str, type[Block]]:
+    """The library's types by name, which no plug-in can replace: a diagram of them alone
+    resolves its types without loading every installed plug-in (and their imports)."""
+    global _library
+    if _library is None:
+        from .library import LIBRARY
+
+        _library = {cls.registered_name(): cls for cls in LIBRARY}
+    return _library
 
 
 def block_types() -> dict[str, type[Block]]:
     """All registered block types by name (library first, then installed entry points)."""
     global _cache
     if _cache is None:
-        from .library import LIBRARY
-
-        library: dict[str, type[Block]] = {cls.registered_name(): cls for cls in LIBRARY}
+        library = library_types()
         loaded, errors = load_group(ENTRY_POINT_GROUP, _not_a_block_or_collection)
         claims: dict[str, set[type[Block]]] = {}
         for entry, obj in loaded.items():
@@ -90,6 +97,8 @@ def _registrations(entry: str, obj, errors: dict[str, str]) -> list[tuple[str, t
         if isinstance(item, str):
             name = item.rpartition(":")[2]
             try:
+                from importlib.metadata import EntryPoint
+
                 cls = EntryPoint(name, item, ENTRY_POINT_GROUP).load()
             except Exception as exc:  # a broken type must not break the collection's others
                 errors[name] = f"{item}: {exc}"
@@ -121,6 +130,9 @@ def resolve_type(name: str, trust: bool = False, base_dir: str | Path | None = N
                 "pass --trust (Python: trust=True) if you trust this file, or register the "
                 f"block through the '{ENTRY_POINT_GROUP}' entry point")
         return _import_class(name[len(PYTHON_PREFIX):], base_dir)
+    library = library_types()
+    if name in library:
+        return library[name]
     types = block_types()
     if name in types:
         return types[name]
@@ -176,6 +188,8 @@ def _local_module(module_name: str, base_dir: Path):
     else:
         return None
     stat = origin.stat()
+    import hashlib
+
     key = hashlib.sha256(f"{origin}\0{stat.st_size}\0{stat.st_mtime_ns}".encode()).hexdigest()[:16]
     alias = f"_blocks_diagram_{key}_{top}"
     module = sys.modules.get(alias)

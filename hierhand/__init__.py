@@ -7,6 +7,9 @@ compiled C (``hierhand/csrc``), built by ``pip install`` into ``hierhand._native
 
 import os as _os
 
+__version__ = "0.1.0"
+"""The distribution's version (pyproject.toml reads it from here)."""
+
 
 def _check_native() -> None:
     """Fail early, with the fix, when the C core is missing or older than its sources."""

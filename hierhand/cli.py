@@ -13,11 +13,13 @@ import argparse
 import os
 import re
 import sys
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Sequence
 
 from blocks.cli import EXIT_FAILED, EXIT_OK, Program, UsageError, block_types, entry as run_program
 from blocks.cli import fmu, graph, main as run_main, plot, run, schema, ssp, sweep, validate
+
+from hierhand import __version__
 
 DESCRIPTION = "Multirate block-diagram co-simulation: run YAML diagrams, inspect and plot them."
 MEASURES_HELP = "a hand task measure: separation_time, object_dropped, peak_ratio[(T)], recovery_time[(T)]"
@@ -209,7 +211,8 @@ def _shipped(name: str) -> Path | None:
 
 
 PROGRAM = Program(
-    name="hierhand", description=DESCRIPTION, distribution="hierhand", env_prefix="HIERHAND", advice=advice,
+    name="hierhand", description=DESCRIPTION, distribution="hierhand", version=__version__, env_prefix="HIERHAND",
+    advice=advice,
     commands=(run.add, validate.add, graph.add, plot.add, add_animate, add_reproduce,
               fmu.group("export a diagram or the hand plant as an FMU, or describe an FMU", add_fmu_export,
                         fmu.info),

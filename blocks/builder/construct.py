@@ -28,7 +28,7 @@ from blocks.builder.diagram import BlockSpec
 from blocks.limits import MAX_PORT_WIDTH
 from blocks.builder.param_paths import PathError, set_path
 from blocks.builder.references import build_order, chain_text
-from blocks.registry import PYTHON_PREFIX, RegistryError, block_types, resolve_type
+from blocks.registry import PYTHON_PREFIX, RegistryError, block_types, library_types, resolve_type
 from blocks.safepath import OUTSIDE_HINT, inside
 from blocks.builder.scopes import NOT_A_NAME, SUBSYSTEM, UNKNOWN, Bound, Level, Override, resolve_reference
 from blocks.timebase import DurationError, parse_duration, positive_duration
@@ -101,7 +101,7 @@ def _copied(value: Any) -> Any:
 def type_ref(cls: type[Block]) -> str:
     """How a diagram names ``cls``: its registered name, else ``python:module:Class``."""
     name = cls.registered_name()
-    if block_types().get(name) is cls:
+    if library_types().get(name) is cls or block_types().get(name) is cls:
         return name
     return f"{PYTHON_PREFIX}{cls.__module__}:{cls.__qualname__}"
 

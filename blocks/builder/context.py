@@ -8,7 +8,6 @@ caller gave as an override), so that all problems come out together in one
 
 from __future__ import annotations
 
-import difflib
 import hashlib
 from pathlib import Path
 from typing import Any, Iterable
@@ -18,6 +17,8 @@ from blocks.issues import Issue
 
 def suggest(word: Any, choices: Iterable[str]) -> str:
     """``did you mean 'x'?`` for the choice closest to ``word``, or ``""``."""
+    import difflib  # here: only a diagram with a mistake asks
+
     close = difflib.get_close_matches(str(word), list(choices), n=1)
     return f"did you mean '{close[0]}'?" if close else ""
 

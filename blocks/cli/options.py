@@ -9,10 +9,13 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any, Sequence
+from collections.abc import Sequence
 
-from blocks.diagram_file.yaml_source import load_yaml_value
 from .program import UsageError
+
+TYPE_CHECKING = False  # typing's constant without importing typing (blocks.cli.program says why)
+if TYPE_CHECKING:
+    from typing import Any
 
 
 def diagram_args(p: argparse.ArgumentParser) -> None:
@@ -37,6 +40,8 @@ def trust_arg(p: argparse.ArgumentParser) -> None:
 
 def parse_overrides(items: Sequence[str]) -> dict[str, Any]:
     """``["plant.k=2", "ctrl.gains=[1, 2]"]`` -> {"plant.k": 2, "ctrl.gains": [1, 2]}."""
+    from blocks.diagram_file.yaml_source import load_yaml_value  # here: --help and --version need no YAML
+
     overrides: dict[str, Any] = {}
     for item in items:
         key, eq, text = item.partition("=")

@@ -20,15 +20,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 import os
 import sys
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Sequence
 
 from blocks.process.terminal import EscapedStream, unescaped
 
+TYPE_CHECKING = False  # typing's own constant, without importing typing: --version and --help start light
 if TYPE_CHECKING:
     from blocks.issues import Issue
 
@@ -43,25 +42,31 @@ class UsageError(Exception):
     """Bad command-line input, reported as one line with exit code 2."""
 
 
-@dataclass(frozen=True)
 class Program:
     """A command-line program: its name (the prefix of its messages), its help's
     description, its commands in help order, the distribution whose version
-    ``--version`` prints, and the prefix of its environment variables
-    (``PREFIX_DEBUG=1`` shows the traceback of an internal error)."""
+    ``--version`` prints (None: the one that ships the ``blocks`` package), and the prefix
+    of its environment variables (``PREFIX_DEBUG=1`` shows the traceback of an internal
+    error). ``advice``: the application's hint for a problem it knows how to fix (an FMU
+    that its own exporter makes), in place of the problem's own; None: no better hint.
+    ``version``: what ``--version`` prints after the name (None: the distribution's
+    installed version, read from its metadata, which costs more than the rest of a
+    start). ``shipped``: the application's own diagram of a name (``regrasp``), for a
+    DIAGRAM argument that names no file, so its documented commands work in any folder
+    after any install. A plain class (not a dataclass, whose import pulls in ``inspect``):
+    a program starts before anything else."""
 
-    name: str
-    description: str
-    commands: tuple[Command, ...]
-    distribution: str | None = None
-    """None: the distribution that ships the ``blocks`` package."""
-    env_prefix: str = "BLOCKS"
-    advice: Callable[[Issue], str | None] | None = None
-    """The application's hint for a problem it knows how to fix (an FMU that its own
-    exporter makes), in place of the problem's own; None: no better hint."""
-    shipped: Callable[[str], Path | None] | None = None
-    """The application's own diagram of a name (``regrasp``), for a DIAGRAM argument that
-    names no file: so its documented commands work in any folder after any install."""
+    __slots__ = ("name", "description", "commands", "distribution", "env_prefix", "advice", "version", "shipped")
+
+    def __init__(self, name: str, description: str, commands: tuple[Command, ...], distribution: str | None = None,
+                 env_prefix: str = "BLOCKS", advice: Callable[[Issue], str | None] | None = None,
+                 version: str | None = None, shipped: Callable[[str], Path | None] | None = None):
+        self.name, self.description, self.commands = name, description, tuple(commands)
+        self.distribution, self.env_prefix, self.advice = distribution, env_prefix, advice
+        self.version, self.shipped = version, shipped
+
+    def __repr__(self) -> str:
+        return f"Program({self.name!r})"
 
     def env(self, suffix: str) -> str:
         """The name of one of the program's environment variables, e.g. ``HIERHAND_DEBUG``."""
@@ -70,7 +75,11 @@ class Program:
     def advised(self, issue: Issue) -> Issue:
         """``issue`` with the application's hint, where it has one."""
         hint = self.advice(issue) if self.advice is not None else None
-        return dataclasses.replace(issue, hint=hint) if hint else issue
+        if not hint:
+            return issue
+        import dataclasses
+
+        return dataclasses.replace(issue, hint=hint)
 
 
 def build_parser(program: Program) -> argparse.ArgumentParser:
@@ -90,7 +99,7 @@ class _Version(argparse.Action):
 
     def __call__(self, parser, namespace, values, option_string=None):
         program = parser.get_default("program")
-        sys.stdout.write(f"{parser.prog} {version(program.distribution)}\n")
+        sys.stdout.write(f"{parser.prog} {program.version or version(program.distribution)}\n")
         parser.exit()
 
 

@@ -6,7 +6,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from blocks.process.progress import progress_bar
 from .options import diagram_args, end_time, load
 from .program import EXIT_FAILED, EXIT_OK, UsageError
 
@@ -41,17 +40,22 @@ class ProgressBar:
     on a terminal, without -q, and only once a run takes a second."""
 
     def __init__(self, t_end: float, enabled: bool):
+        from blocks.process.progress import progress_bar, shows
+
         self.t_end = t_end
         self.bar = progress_bar(t_end, "run", unit="s", enabled=enabled, delay=1.0,
                                 bar_format="{desc}: {percentage:5.1f}%|{bar}| t = {n:.4g} / {total:.4g} s "
-                                           "[{elapsed}<{remaining}]")
+                                           "[{elapsed}<{remaining}]") if shows(enabled) else None
+        """None where nothing is drawn (no terminal, -q): then tqdm is not even imported."""
 
     def __call__(self, fraction: float, elapsed: float) -> None:
         """The simulate callback: ``fraction`` of the run done after ``elapsed`` seconds."""
-        self.bar.update(fraction * self.t_end - self.bar.n)
+        if self.bar is not None:
+            self.bar.update(fraction * self.t_end - self.bar.n)
 
     def close(self) -> None:
-        self.bar.close()
+        if self.bar is not None:
+            self.bar.close()
 
 
 def check_formats(args: argparse.Namespace) -> None:
@@ -98,7 +102,6 @@ def simulate_and_save(args: argparse.Namespace, plotter) -> int:
     says where and why, even with -q. A failed or interrupted run that replaces a complete
     one says where the complete one's files went."""
     from blocks import DiagramError, simulate
-    from blocks.plot.pages import PlotSizeError, check_plot_size
     from blocks.results.folder import OutputFolderError
     from blocks.safepath import folder_name
     from blocks.process.stop import StopSignals, exit_code
@@ -115,6 +118,8 @@ def simulate_and_save(args: argparse.Namespace, plotter) -> int:
     t_end = end_time(args, diagram)
     out = args.output or Path("runs") / folder_name(diagram.name)
     if args.plot:
+        from blocks.plot.pages import PlotSizeError, check_plot_size
+
         try:
             check_plot_size(len(diagram.log), sum(diagram.width(e.signal) for e in diagram.log))
         except PlotSizeError as exc:

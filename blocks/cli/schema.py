@@ -4,7 +4,6 @@ for editors (``# yaml-language-server: $schema=diagram.schema.json``) and valida
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from pathlib import Path
 
@@ -26,6 +25,8 @@ def add(sub, program) -> argparse.ArgumentParser:
 
 def schema_text() -> str:
     """The schema as the text ``schema`` writes: indented JSON, one final newline."""
+    import json
+
     from blocks.diagram_file.schema import diagram_schema
 
     return json.dumps(diagram_schema(), indent=1, ensure_ascii=False) + "\n"

@@ -13,10 +13,12 @@ import argparse
 import os
 import sys
 from pathlib import Path
-from typing import Any
-
 from .options import end_time, picture_output, trust_arg
 from .program import EXIT_FAILED, EXIT_OK, Command, UsageError
+
+TYPE_CHECKING = False  # typing's constant without importing typing (blocks.cli.program says why)
+if TYPE_CHECKING:
+    from typing import Any
 
 REDUCERS_HELP = ("a column per run (repeatable): REDUCER(BLOCK.PORT[e]) with final, max, min, mean, "
                  "first_time_above(BLOCK.PORT[e], X), first_time_below(BLOCK.PORT[e], X); the element e by its "

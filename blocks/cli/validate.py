@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import argparse
 
-from blocks.block import checked_units
-
 from .options import diagram_args, end_time, load
 from .program import EXIT_OK
 
@@ -120,6 +118,8 @@ def port_of(spec, port: str, width: int) -> str:
     """A block's port as ``validate`` lists it: ``y[3]``, with the unit(s) where the block or
     the diagram gives them (``q[9] (rad)``, ``pose[3] (m, m, rad)``) and the names the diagram
     gives its elements (``y[3] {x, y, theta}``)."""
+    from blocks.block import checked_units
+
     try:
         units = checked_units(spec.port_units(port), width, port)
     except ValueError:

@@ -18,7 +18,7 @@ import numpy as np
 from blocks.engine import compiled
 from blocks.engine.finite import nonfinite_error
 from blocks.engine.kernel import Kernel, address
-from blocks.engine.optable import ADVANCE, L_CAPACITY, L_WIDTH, LC_ROWS, OP_A, OP_CODE, UPDATE, OpTable
+from blocks.engine.optable import L_CAPACITY, L_WIDTH, LC_ROWS, OpTable
 
 KERNEL_COLUMNS = ("output", "update", "advance", "context", "state", "nogil")
 """A run's kernel rows, one per block (all zero for a Python block), as the host reads them."""
@@ -62,9 +62,7 @@ class Binding:
             self.choose_kernels()
 
     def choose_kernels(self) -> None:
-        ops = self.table.ops
-        updated = set(ops[ops[:, OP_CODE] == UPDATE, OP_A].tolist())
-        advanced = set(ops[ops[:, OP_CODE] == ADVANCE, OP_A].tolist())
+        updated, advanced = self.table.roles
         for b, (name, blk) in enumerate(zip(self.table.names.blocks, self.blocks)):
             state = self.states[b]
             try:

@@ -27,6 +27,7 @@ A table depends only on the diagram and the end time, so it is built once per Sc
 
 from __future__ import annotations
 
+import functools
 import weakref
 from dataclasses import dataclass
 from fractions import Fraction
@@ -124,6 +125,13 @@ class OpTable:
     def arrays(self) -> tuple[np.ndarray, ...]:
         """The int64 tables in core.h's order (``TABLES``)."""
         return tuple(getattr(self, name) for name in TABLES)
+
+    @functools.cached_property
+    def roles(self) -> tuple[frozenset[int], frozenset[int]]:
+        """The blocks (indices) that the table updates, and those it advances: what each
+        run asks of their kernels, found once per table."""
+        code, block = self.ops[:, OP_CODE], self.ops[:, OP_A]
+        return frozenset(block[code == UPDATE].tolist()), frozenset(block[code == ADVANCE].tolist())
 
     @property
     def n_ticks(self) -> int:

@@ -29,15 +29,17 @@ from collections import deque
 from dataclasses import dataclass, field
 from fractions import Fraction
 from functools import reduce
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
-import networkx as nx
 import numpy as np
 
 from blocks.builder.api_args import diagram_argument
 from blocks.builder.diagram import Connection, Diagram
 from blocks.issues import DiagramError, Issue
 from blocks.timebase import format_duration, fraction_gcd, positive_duration
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 MAX_HYPERPERIOD_TICKS = 10_000_000
 
@@ -486,7 +488,11 @@ class _Planner:
 
     def order_ports(self, nodes: set[str], initial: bool) -> tuple[Steps, tuple[HeldInput, ...]]:
         """Port-level order for blocks whose outputs have different feedthrough, dropping
-        the soft (initial-only) dependencies that lie on a cycle when ``initial``."""
+        the soft (initial-only) dependencies that lie on a cycle when ``initial``. Rare
+        (most diagrams order by blocks, ``topological_order``), so networkx, a tenth of a
+        second to import, is imported here."""
+        import networkx as nx
+
         graph = nx.DiGraph()
         wires: dict[tuple, Connection] = {}
         soft: list[tuple] = []
@@ -533,6 +539,8 @@ class _Planner:
         """Remove from ``graph`` every soft edge on a cycle (both ends in one strongly
         connected component), which leaves only cycles of hard edges; one ``HeldInput`` per
         block input that loses a dependency, with the loop it closed, in block order."""
+        import networkx as nx
+
         component = {v: i for i, c in enumerate(nx.strongly_connected_components(graph)) for v in c}
         cut = [(u, v) for u, v in soft if component[u] == component[v]]
         held: dict[tuple[str, str], str] = {}

@@ -21,10 +21,16 @@ def progress_bar(total: float | None, description: str, unit: str = "it", enable
     from tqdm import tqdm
 
     stream = unescaped(stream or sys.stderr)  # tqdm draws with control characters of its own
-    shown = enabled and stream.isatty()
+    shown = shows(enabled, stream)
     return tqdm(total=total, desc=escape_controls(description), unit=unit, file=stream, disable=not shown,
                 leave=False,
                 dynamic_ncols=True, **options)
+
+
+def shows(enabled: bool, stream: TextIO | None = None) -> bool:
+    """Whether a bar on ``stream`` (default: stderr) is drawn: when ``enabled`` and the
+    stream is a terminal (else a caller may skip the bar, and tqdm's import, altogether)."""
+    return enabled and (stream or sys.stderr).isatty()
 
 
 def above(bar, report):

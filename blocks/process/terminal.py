@@ -12,7 +12,10 @@ moves of its own, writes to the stream beneath (``EscapedStream.unescaped``).
 from __future__ import annotations
 
 import re
-from typing import Any, TextIO
+
+TYPE_CHECKING = False  # typing's constant without importing typing (blocks.cli.program says why)
+if TYPE_CHECKING:
+    from typing import Any, TextIO
 
 _CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u061c\u200e\u200f\u2028-\u202e\u2066-\u2069]")
 """C0 controls but tab and line feed, DEL, C1 controls, and the bidirectional-text marks,
