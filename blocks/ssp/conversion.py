@@ -34,6 +34,10 @@ class UnitError(ValueError):
         self.line = line
 
 
+class ZeroFactor(ValueError):
+    """A unit definition whose factor is 0: no size in the base units."""
+
+
 class UnknownUnit(UnitError):
     """A unit that neither a definition nor pint knows."""
 
@@ -49,9 +53,12 @@ def read_definitions(units: Any) -> Definitions:
             continue
         try:
             found[name] = from_attributes(base.attrib)
+        except ZeroFactor:
+            raise UnitError(f"ssc:Unit {shown(name)}: its factor is 0 (a unit's factor is its size in the SI base "
+                            "units: 1000 for km)", base.sourceline) from None
         except ValueError:
             raise UnitError(f"ssc:Unit {shown(name)}: its ssc:BaseUnit attributes must be numbers: finite factor "
-                            "(not 0) and offset, whole exponents", base.sourceline) from None
+                            "and offset, whole exponents", base.sourceline) from None
     return found
 
 
@@ -66,7 +73,7 @@ def from_attributes(attributes: Any) -> BaseUnit:
     factor = finite(str(attributes.get("factor") or 1.0))
     offset = finite(str(attributes.get("offset") or 0.0))
     if factor == 0:
-        raise ValueError("a unit's factor is its size in the SI base units and cannot be 0")
+        raise ZeroFactor("its factor is 0")
     return BaseUnit(tuple(exponents), factor, offset)
 
 
