@@ -119,8 +119,8 @@ connections: ["plant.z[1] -> g.u"]
 log: [plant.z, g.y]
 """)
     result = simulate(diagram)
-    # z[1] = scale x, x = a^k x0 (a = 0.5); z[2] = t; "-1" is no label: an index from the end, as in a plot
-    for label, want in (("1", 3 * 0.5**5), ("2", 0.5), ("-1", 0.5)):
+    # z[1] = scale x, x = a^k x0 (a = 0.5); z[2] = t
+    for label, want in (("1", 3 * 0.5**5), ("2", 0.5)):
         metric = parse_metric(f"m=final(plant.z[{label}])")
         metric.check(diagram)
         (trace,) = select(result, f"plant.z[{label}]")
@@ -128,5 +128,10 @@ log: [plant.z, g.y]
     assert parse_metric("m=final(plant.z[1])").evaluate(result, diagram) == result["g.y"][1][-1, 0]
     with pytest.raises(SweepError, match="has no element 'x'"):
         parse_metric("m=final(plant.z[x])").check(diagram)
+    for number in ("0", "3", "-1"):  # on a numbered port a number is a label, never an index: none of these
+        with pytest.raises(SweepError, match="numbers its elements 1 to 2"):
+            parse_metric(f"m=final(plant.z[{number}])").check(diagram)
+        with pytest.raises(ValueError):
+            select(result, f"plant.z[{number}]")
     with pytest.raises(SweepError, match="2 elements; a metric reduces one"):
         parse_metric("m=final(plant.z[0:2])").check(diagram)

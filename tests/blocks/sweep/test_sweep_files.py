@@ -190,7 +190,7 @@ def test_an_fmu_travels_with_the_sweep_by_relative_and_absolute_path(tmp_path, p
             dst.writestr(item, src.read(item.filename))
         dst.writestr("documentation/note.txt", "another copy")
     points = [{"plant.path": "../fmu/HandPlant_fmi2.fmu"}, {"plant.path": str(other)}]
-    metrics = parse_metrics(["x=final(plant.obj[0])"])
+    metrics = parse_metrics(["x=final(plant.obj[1])"])  # the FMU numbers its elements from 1
     plan = prepare(diagram, points, metrics, t_end="20 ms", keep_results=True)
     names = {f.ref: f.name for f in plan.job.bundle.files}
     assert names["../fmu/HandPlant_fmi2.fmu"] == "tree/fmu/HandPlant_fmi2.fmu"
