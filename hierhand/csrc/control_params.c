@@ -126,6 +126,8 @@ int hh_manip_pack(const double *g, const double *hand, double dt, double *p, cha
     for (int i = 0; i < 2 * HH_JOINTS; i++)
         if (g[HH_MANIP_G_KP + i] < 0)
             return refuse(message, size, "kp and kd must be non-negative");
+    if (!isfinite(g[HH_MANIP_G_CONTACT_AIM]) || g[HH_MANIP_G_CONTACT_AIM] < 0)
+        return refuse(message, size, "contact_aim must be a finite number >= 0 (0: aim fn / k_n deep)");
     for (int f = 0; f < HH_FINGERS; f++)
         for (int j = 0; j < 3; j++)
             p[HH_MANIP_P_Q0 + 3 * f + j] = hand[HH_P_FINGER0 + f * HH_P_FINGER_STRIDE + HH_PF_Q0 + j];
@@ -146,6 +148,7 @@ int hh_manip_pack(const double *g, const double *hand, double dt, double *p, cha
     p[HH_MANIP_P_DT] = dt;
     p[HH_MANIP_P_MATCHED] = flag(g[HH_MANIP_G_MATCHED]);
     p[HH_MANIP_P_CONTACT_COMP] = flag(g[HH_MANIP_G_CONTACT_COMP]);
+    p[HH_MANIP_P_CONTACT_AIM] = g[HH_MANIP_G_CONTACT_AIM];
     return 0;
 }
 

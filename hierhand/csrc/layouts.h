@@ -251,7 +251,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, MATCHED, 1) /* non-zero: realise kp, kd for the period (hh_matched_gains); zero: apply     \
                         them as they are, held for the period */                                       \
     SLOT(P, CONTACT_COMP, 1) /* non-zero: aim a finger in contact as deep into the object as its       \
-                             measured normal force presses it (fn / k_n) */
+                             measured normal force presses it */                                       \
+    SLOT(P, CONTACT_AIM, 1) /* > 0: that many times the tip's own depth (hh contact_depth); 0: fn / k_n */
 
 /* A waypoint row (t, x, y, phi) of a trajectory */
 #define HH_MANIP_WAYPOINT_SLOTS(SLOT, P) SLOT(P, T, 1) SLOT(P, X, 1) SLOT(P, Y, 1) SLOT(P, PHI, 1)
@@ -279,7 +280,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, MATCHED, 1) /* discretization 'matched' */                                                 \
     SLOT(P, CONTACT_COMP, 1)                                                                           \
     SLOT(P, STEP, 1) /* Python's manipulation_pd.DERIVATIVE_STEP */                                    \
-    SLOT(P, REACH_RTOL, 1) /* Python's inverse_kinematics._REACH_RTOL */
+    SLOT(P, REACH_RTOL, 1) /* Python's inverse_kinematics._REACH_RTOL */                               \
+    SLOT(P, CONTACT_AIM, 1) /* contact_aim, 0 for none (fn / k_n) */
 
 /* The suppresser's packed parameters, params[HH_SUPPRESS_P_*] */
 #define HH_SUPPRESS_PARAM_SLOTS(SLOT, P)                                                               \

@@ -80,8 +80,9 @@ ABLATIONS = (
              "kd = 0.04 N m s/rad gives 4 on the distal joints)",
              {"manip.discretization": "held"}),
     Ablation("PD aimed at the squeezed contact", "manip.contact_compensation false",
-             "a PD aimed at the surface pushes back against the squeeze (fn / k_n deep), which the suppresser "
-             "reads as voluntary motion against the grasp",
+             "a PD aimed at the surface pushes back against the squeeze, which the suppresser reads as voluntary "
+             "motion against the grasp; aimed three times as deep as the tip sits, the PD adds a press the "
+             "re-grasp's thumb-middle pinch needs",
              {"manip.contact_compensation": False}),
     Ablation("suppression low-passed (20 ms)", "suppress.time_constant 0 (the paper's static law)",
              "the sigmoid closes a loop through the grasping torque and the finger of gain |tau_g| S_a / 4, "

@@ -155,13 +155,13 @@ Each of these is beyond the paper; the ablation table below switches each off al
   kd T / J > 2, which is what made the old PD fail from kd x1.3-1.4; matched, the loop is
   stable for any kp, kd > 0 (the shipped kp = 3 N m/rad, kd = 0.04 N m s/rad are held as
   about 0.6-0.8 N m/rad and 0.013-0.017 N m s/rad).
-- **The PD aims a squeezed fingertip as deep as its normal force presses it** (fn / k_n along
-  the contact normal): aimed at the surface, posture holding pushes back against the squeeze,
-  and the suppresser reads that as voluntary motion against the grasp. fn / k_n is the summed
-  depth of every surface point under the tip, about three times the tip's own depth (0.35 mm
-  at 3 N), so the aim is deeper than the tip sits and the PD adds a squeeze of its own; aimed
-  at the tip's own depth, heavy objects end nearer their manipulation target but the re-grasp
-  drops the object on most of the wide spread: it relies on that extra squeeze.
+- **The PD aims a squeezed fingertip as deep as its normal force presses it**: aimed at the
+  surface, posture holding pushes back against the squeeze, and the suppresser reads that as
+  voluntary motion against the grasp. It aims three times as deep as the contact law holds the
+  tip at the measured normal force (`contact_aim: 3`; about fn / k_n at 3 N, the aim it had
+  before), so the PD adds a press of its own, which the re-grasp's thumb-middle pinch needs;
+  the aim grows with the tip's depth (fn^(2/3)), not with fn: aimed fn / k_n deep, a heavy
+  object squeezed hard was lifted 1-2 mm off its manipulation target at the hand-over.
 - **Feedforward** (output `tau_ff`, added after the suppresser: it is not voluntary motion):
   the fingers' gravity torques and J^T of the object's load, shared by the grasp matrix at the
   contact points in proportion to the normal forces, so that the shares balance the load's
