@@ -15,7 +15,8 @@ At every hit (1 ms in the paper) the reflex
    ``need_i = max(min_force * |g_i|, |f_t,i| / ratio_target)`` (the sensor form of the
    friction scaling at the safety ratio);
 4. realises it with integral control of one grasp force scale ``s``:
-   ``s += ki * dt * max_i hold_i (need_i - fn_i) / (n_i . g_i)``, the fingertip forces
+   ``s += ki * dt * max_i hold_i (need_i - fn_i) / (n_i . g_i)`` (with ``catch_up`` c, plus
+   c times that shortfall where it is positive), the fingertip forces
    ``s g_i`` mapped to joint torques by ``J_i^T`` at the contact points. One integrator for
    the whole grasp, not one per finger: in a pinch both normal forces respond alike to a
    difference between the fingers' pushes (the object just moves), so per-finger
@@ -155,6 +156,11 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
     friction_cap : bool
         aim at most at FRICTION_SHARE of the plant's sliding friction mu_d, so that a
         sliding contact always calls for more squeeze (``aimed_safety_ratio``)
+    catch_up : float
+        share, 0-1, of a positive shortfall (a contact short of the normal force it needs)
+        the force scale closes at once each hit, besides the integral step; 0: the paper's
+        integral control alone. A sudden push can take an object out of a light grasp before
+        an integral loop at ki has built the squeeze the push needs
     """
 
     type_name = "GraspReflex"
@@ -163,14 +169,14 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,
                  approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.5,
                  hold_share: float = 0.9, follow_suppression: bool = True, squeeze_from_weight: bool = False,
-                 friction_cap: bool = False):
+                 friction_cap: bool = False, catch_up: float = 0.0):
         self.hand = hand_of(hand)
         self._links = hand_link(hand, REFLEX_RECORD.SEGMENT)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
                             ("max_force", max_force), ("contact_threshold", contact_threshold),
                             ("margin", margin), ("approach_force", approach_force),
-                            ("release_share", release_share), ("hold_share", hold_share)):
+                            ("release_share", release_share), ("hold_share", hold_share), ("catch_up", catch_up)):
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ValueError(f"parameter '{name}' must be a number, got {value!r}")
         self.squeeze_from_weight, self.friction_cap = bool(squeeze_from_weight), bool(friction_cap)
@@ -182,6 +188,8 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         given[GIVEN.MIN_FORCE], given[GIVEN.MAX_FORCE], given[GIVEN.APPROACH] = min_force, max_force, approach_force
         given[GIVEN.THRESHOLD], given[GIVEN.RELEASE_SHARE] = contact_threshold, release_share
         given[GIVEN.HOLD_SHARE] = hold_share
+        given[GIVEN.CATCH_UP] = catch_up
+        self.catch_up = float(catch_up)
         given[GIVEN.FOLLOW] = 1.0 if follow_suppression else 0.0
         given[GIVEN.slice("GRASP")] = self.initial
         given[GIVEN.COINCIDENT_RTOL] = _COINCIDENT_RTOL

@@ -95,6 +95,8 @@ int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, ch
         return refuse(message, size, "parameter 'approach_force' must be in [0, max_force]");
     if (g[HH_REFLEX_G_MIN_FORCE] > max_force)
         return refuse(message, size, "parameter 'min_force' must not exceed 'max_force'");
+    if (!(0 <= g[HH_REFLEX_G_CATCH_UP] && g[HH_REFLEX_G_CATCH_UP] <= 1))
+        return refuse(message, size, "parameter 'catch_up' must be in [0, 1]");
     p[HH_REFLEX_P_THRESHOLD] = g[HH_REFLEX_G_THRESHOLD];
     p[HH_REFLEX_P_APPROACH] = g[HH_REFLEX_G_APPROACH];
     p[HH_REFLEX_P_KI] = g[HH_REFLEX_G_KI];
@@ -110,6 +112,7 @@ int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, ch
     p[HH_REFLEX_P_RELEASE_SHARE] = release;
     p[HH_REFLEX_P_FOLLOW] = g[HH_REFLEX_G_FOLLOW] != 0.0 ? 1.0 : 0.0;
     p[HH_REFLEX_P_HOLD_SHARE] = hold;
+    p[HH_REFLEX_P_CATCH_UP] = g[HH_REFLEX_G_CATCH_UP];
     return 0;
 }
 

@@ -203,7 +203,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
                                     tip centre plus this along the contact normal */                   \
     SLOT(P, FOLLOW, 1) /* non-zero: the reflex's hold of a finger follows its share (hand-over) */     \
     SLOT(P, HOLD_SHARE, 1) /* a third finger is held whole down to this share, not at all at           \
-                           release_share */
+                           release_share */                                                             \
+    SLOT(P, CATCH_UP, 1) /* share of a positive shortfall closed at once, besides the integral */
 
 /* The reflex's state: the force scale, per finger 1 where the reflex was letting go of it
  * when it last touched, per finger how much the reflex holds it */
@@ -230,7 +231,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, HOLD_SHARE, 1)                                                                             \
     SLOT(P, FOLLOW, 1) /* follow_suppression, 0 or 1 */                                                \
     SLOT(P, GRASP, HH_FINGERS) /* 1 for the fingers listed in 'grasp' */                               \
-    SLOT(P, COINCIDENT_RTOL, 1) /* Python's internal_forces._COINCIDENT_RTOL */
+    SLOT(P, COINCIDENT_RTOL, 1) /* Python's internal_forces._COINCIDENT_RTOL */                         \
+    SLOT(P, CATCH_UP, 1)
 
 /* The manipulation PD's packed parameters, params[HH_MANIP_P_*] */
 #define HH_MANIP_PARAM_SLOTS(SLOT, P)                                                                  \

@@ -90,3 +90,20 @@ def test_aiming_at_the_tip_s_own_depth_lifts_a_heavy_object_less_than_aiming_fn_
         t, obj = blocks.simulate(blocks.load_diagram(path, overrides=overrides), t_end=0.3)["plant.obj"]
         lifts[aim] = obj[-1, 1] - obj[0, 1]
     assert lifts[3.0] < 0.6 * lifts[None]
+
+
+def test_catching_up_on_a_shortfall_holds_a_light_object_that_a_sudden_push_takes_out_of_integral_control():
+    """0.16 kg on slippery contacts (mu_s 0.63), a slow reflex (ki x0.5) and a soft PD (kp x0.5),
+    pushed down by 4 N: the integral loop alone builds the squeeze too late."""
+    from pathlib import Path
+
+    from hierhand.tasks.robustness import TASKS, judge
+    from hierhand.tasks.variations import Variation
+
+    light = Variation(mass=0.158, size=(0.89, 1.0), links=(1.0,) * 9, mu_s=0.63, stiffness=0.89, damping=1.23,
+                      ki=0.49, safety_ratio=0.70, kp=0.53, kd=1.06, S_a=0.8, S_b=1.23, push=(0.81, -3.96),
+                      torque=0.0175)
+    diagrams = Path(__file__).resolve().parents[3] / "diagrams"
+    grasp = (TASKS[0],)
+    assert judge(light, diagrams, tasks=grasp)["grasp"] == ""
+    assert judge(light, diagrams, {"grasp": {"reflex.catch_up": 0.0}}, tasks=grasp)["grasp"] == "dropped"
