@@ -73,7 +73,8 @@ ABLATIONS = (
              {"reflex.friction_cap": False}),
     Ablation("reflex catches up on a shortfall", "reflex.catch_up 0 (integral control alone)",
              "a sudden push can take an object out of a light grasp before an integral loop at ki has built the "
-             "squeeze the push needs: half of a contact's shortfall is closed at once each hit",
+             "squeeze the push needs: a quarter of a contact's shortfall is closed at once each hit (a half or all "
+             "of it turned more objects in a tilted pinch)",
              {"reflex.catch_up": 0.0}),
     Ablation("armature 1e-4 kg m^2", "plant armature 0 on every joint",
              "a geared motor's reflected inertia; bare human-scale links leave a 10 ms PD almost no "

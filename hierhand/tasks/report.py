@@ -204,8 +204,8 @@ Each of these is beyond the paper; the ablation table below switches each off al
   of the plant's contact; a sliding contact shows |f_t|/f_n = mu_d, so a safety ratio at or
   above mu_d would never squeeze harder while the object slides. At the shipped point (mu_d
   0.9, safety ratio 0.6) it changes nothing.
-- **The reflex catches up on a shortfall** (`catch_up: 0.5`): besides its integral step, each
-  hit closes half of a contact's shortfall of normal force at once. A sudden push can take a
+- **The reflex catches up on a shortfall** (`catch_up: 0.25`): besides its integral step, each
+  hit closes a quarter of a contact's shortfall of normal force at once. A sudden push can take a
   light object out of the grasp before an integral loop at ki has built the squeeze the push
   needs (at the shipped point it shortens the recovery from the push).
 - **Start and support**: the fingers start 0.1 mm off the object (the paper starts in contact)
