@@ -77,7 +77,9 @@ def claim_rows(summary: dict) -> list[tuple[str, str, str, str]]:
         ("Grasp (Fig. 10): the grasp torque reacts before the manipulation torque", "grasp torque first",
          f"first change after the push: grasp {_num(1000 * g['grasp_torque_first_moves_s'], ' ms')} (the reflex's "
          f"next 1 ms hit), manipulation {_num(1000 * g['manipulation_torque_first_moves_s'], ' ms')} (the PD's next "
-         f"10 ms hit): the sample periods decide it. Share of each torque's move within 0.2 s: " + "; ".join(
+         f"10 ms hit): the sample periods decide it. Share of each torque's move within 0.2 s (the reflex's "
+         f"catch_up, an addition, speeds the grasp torque's; integral control alone builds up more slowly than "
+         f"the PD's step): " + "; ".join(
              f"{share}: grasp {_num(1000 * times['grasp_torque_at_s'], ' ms')}, manipulation "
              f"{_num(1000 * times['manipulation_torque_at_s'], ' ms')}" for share, times in g["reaction_shares"].items()),
          _fig10_verdict(g, summary)),
