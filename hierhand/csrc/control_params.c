@@ -58,6 +58,36 @@ static double tip_radius(const double *hand, int f)
     return hand[HH_P_FINGER0 + f * HH_P_FINGER_STRIDE + HH_PF_TIP_RADIUS];
 }
 
+/* With friction_cap, a contact slides at |f_t| / f_n = mu_d: a safety ratio at or above it never
+ * sees a sliding object, so the reflex keeps to at most this share of the hand's mu_d. */
+#define HH_FRICTION_SHARE 0.9
+
+static double reflex_safety_ratio(const double *g, const double *hand)
+{
+    double safety = g[HH_REFLEX_G_SAFETY_RATIO];
+    if (g[HH_REFLEX_G_FRICTION_CAP] != 0.0 && HH_FRICTION_SHARE * hand[HH_P_MU_D] < safety)
+        safety = HH_FRICTION_SHARE * hand[HH_P_MU_D];
+    return safety;
+}
+
+/* With squeeze_from_weight, min_force is at least the normal force with which the fingers of
+ * 'grasp' carry the object's weight by friction at the ratio target, m |g| / (k ratio_target)
+ * (2.6 N for 0.3 kg in a two-finger pinch at 0.6 / 1.05), and at most max_force. */
+static double reflex_min_force(const double *g, const double *hand, double ratio_target)
+{
+    double min_force = g[HH_REFLEX_G_MIN_FORCE];
+    if (g[HH_REFLEX_G_SQUEEZE_FROM_WEIGHT] == 0.0)
+        return min_force;
+    int fingers = 0;
+    for (int f = 0; f < HH_FINGERS; f++)
+        fingers += g[HH_REFLEX_G_GRASP + f] != 0.0;
+    double weight = hand[HH_P_OBJ_MASS] * hypot(hand[HH_P_GX], hand[HH_P_GY]);
+    double share = weight / ((fingers > 0 ? fingers : 1) * ratio_target);
+    if (share > min_force)
+        min_force = share;
+    return min_force < g[HH_REFLEX_G_MAX_FORCE] ? min_force : g[HH_REFLEX_G_MAX_FORCE];
+}
+
 int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, char *message, size_t size)
 {
     static const struct {
@@ -101,8 +131,8 @@ int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, ch
     p[HH_REFLEX_P_APPROACH] = g[HH_REFLEX_G_APPROACH];
     p[HH_REFLEX_P_KI] = g[HH_REFLEX_G_KI];
     p[HH_REFLEX_P_DT] = dt;
-    p[HH_REFLEX_P_MIN_FORCE] = g[HH_REFLEX_G_MIN_FORCE];
-    p[HH_REFLEX_P_RATIO] = g[HH_REFLEX_G_SAFETY_RATIO] / (1.0 + margin);
+    p[HH_REFLEX_P_RATIO] = reflex_safety_ratio(g, hand) / (1.0 + margin);
+    p[HH_REFLEX_P_MIN_FORCE] = reflex_min_force(g, hand, p[HH_REFLEX_P_RATIO]);
     p[HH_REFLEX_P_MAX_FORCE] = max_force;
     for (int f = 0; f < HH_FINGERS; f++) {
         p[HH_REFLEX_P_INITIAL + f] = g[HH_REFLEX_G_GRASP + f] != 0.0 ? 1.0 : 0.0;

@@ -232,7 +232,9 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, FOLLOW, 1) /* follow_suppression, 0 or 1 */                                                \
     SLOT(P, GRASP, HH_FINGERS) /* 1 for the fingers listed in 'grasp' */                               \
     SLOT(P, COINCIDENT_RTOL, 1) /* Python's internal_forces._COINCIDENT_RTOL */                         \
-    SLOT(P, CATCH_UP, 1)
+    SLOT(P, CATCH_UP, 1)                                                                               \
+    SLOT(P, SQUEEZE_FROM_WEIGHT, 1) /* non-zero: min_force at least the weight's share (reflex pack) */  \
+    SLOT(P, FRICTION_CAP, 1) /* non-zero: the safety ratio at most HH_FRICTION_SHARE mu_d */
 
 /* The manipulation PD's packed parameters, params[HH_MANIP_P_*] */
 #define HH_MANIP_PARAM_SLOTS(SLOT, P)                                                                  \
