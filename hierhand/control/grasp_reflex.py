@@ -15,7 +15,8 @@ At every hit (1 ms in the paper) the reflex
    ``need_i = max(min_force * |g_i|, |f_t,i| / ratio_target)`` (the sensor form of the
    friction scaling at the safety ratio);
 4. realises it with integral control of one grasp force scale ``s``:
-   ``s += ki * dt * max_i hold_i (need_i - fn_i) / (n_i . g_i)``, the fingertip forces
+   ``s += ki * dt * max_i hold_i (need_i - fn_i) / (n_i . g_i)`` (with ``catch_up`` c, plus
+   c times that shortfall where it is positive), the fingertip forces
    ``s g_i`` mapped to joint torques by ``J_i^T`` at the contact points. One integrator for
    the whole grasp, not one per finger: in a pinch both normal forces respond alike to a
    difference between the fingers' pushes (the object just moves), so per-finger
@@ -82,27 +83,6 @@ _PORTS = port_columns(REFLEX_OUT)
 """The output ports (tau_g, force, active) and their columns of the law's output."""
 
 
-FRICTION_SHARE = 0.9
-"""With ``friction_cap`` the reflex's safety ratio is at most this share of the hand's mu_d."""
-
-
-def aimed_safety_ratio(hand, safety_ratio: float, friction_cap: bool) -> float:
-    """The safety ratio the reflex keeps to: the given one, or with ``friction_cap`` at most
-    FRICTION_SHARE mu_d. A contact slides at |f_t|/f_n = mu_d, so a safety ratio at or above
-    mu_d never sees a sliding object and never squeezes harder while it slides."""
-    if not friction_cap:
-        return safety_ratio
-    return min(safety_ratio, FRICTION_SHARE * float(hand.params.contact.mu_d))
-
-
-def weight_squeeze(hand, ratio_target: float, fingers: int) -> float:
-    """N per finger: the normal force with which ``fingers`` fingers carry the object's
-    weight by friction at ``ratio_target`` (|f_t| / f_n): ``m |g| / (fingers ratio_target)``,
-    2.6 N for the 0.3 kg object in a two-finger pinch aiming at 0.6 / 1.05."""
-    weight = float(hand.params.object.mass) * float(np.linalg.norm(hand.gravity))
-    return weight / (max(fingers, 1) * ratio_target)
-
-
 def finger_indices(names: tuple[str, ...], chosen: Any, what: str) -> np.ndarray:
     """Boolean mask over the hand's fingers for a list of finger names."""
     chosen = [chosen] if isinstance(chosen, str) else list(chosen or [])
@@ -151,10 +131,17 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         false: the paper's reflex, which holds every touching finger whole
     squeeze_from_weight : bool
         raise min_force to the squeeze the object's weight needs when the fingers of
-        'grasp' alone carry it at the ratio target (``weight_squeeze``)
+        'grasp' alone carry it at the ratio target, m |g| / (k ratio_target) for k fingers
+        (derived from the hand in C, hierhand/csrc/control_params.c, so an exported FMU
+        follows a changed object mass)
     friction_cap : bool
-        aim at most at FRICTION_SHARE of the plant's sliding friction mu_d, so that a
-        sliding contact always calls for more squeeze (``aimed_safety_ratio``)
+        keep to a safety ratio of at most 0.9 of the plant's sliding friction mu_d, so that a
+        sliding contact always calls for more squeeze
+    catch_up : float
+        share, 0-1, of a positive shortfall (a contact short of the normal force it needs)
+        the force scale closes at once each hit, besides the integral step; 0: the paper's
+        integral control alone. A sudden push can take an object out of a light grasp before
+        an integral loop at ki has built the squeeze the push needs
     """
 
     type_name = "GraspReflex"
@@ -163,25 +150,25 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
                  margin: float = 0.05, min_force: float = 1.0, max_force: float = 30.0,
                  approach_force: float = 0.5, contact_threshold: float = 0.05, release_share: float = 0.5,
                  hold_share: float = 0.9, follow_suppression: bool = True, squeeze_from_weight: bool = False,
-                 friction_cap: bool = False):
+                 friction_cap: bool = False, catch_up: float = 0.0):
         self.hand = hand_of(hand)
         self._links = hand_link(hand, REFLEX_RECORD.SEGMENT)
         self.initial = finger_indices(self.hand.names, grasp, "grasp")
         for name, value in (("ki", ki), ("safety_ratio", safety_ratio), ("min_force", min_force),
                             ("max_force", max_force), ("contact_threshold", contact_threshold),
                             ("margin", margin), ("approach_force", approach_force),
-                            ("release_share", release_share), ("hold_share", hold_share)):
+                            ("release_share", release_share), ("hold_share", hold_share), ("catch_up", catch_up)):
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ValueError(f"parameter '{name}' must be a number, got {value!r}")
         self.squeeze_from_weight, self.friction_cap = bool(squeeze_from_weight), bool(friction_cap)
-        safety_ratio = aimed_safety_ratio(self.hand, safety_ratio, self.friction_cap)
-        if self.squeeze_from_weight and safety_ratio > 0 and 1.0 + margin > 0:  # else pack_params refuses them
-            min_force = max(min_force, weight_squeeze(self.hand, safety_ratio / (1.0 + margin), int(self.initial.sum())))
         given = np.empty(GIVEN.size)
         given[GIVEN.KI], given[GIVEN.SAFETY_RATIO], given[GIVEN.MARGIN] = ki, safety_ratio, margin
         given[GIVEN.MIN_FORCE], given[GIVEN.MAX_FORCE], given[GIVEN.APPROACH] = min_force, max_force, approach_force
         given[GIVEN.THRESHOLD], given[GIVEN.RELEASE_SHARE] = contact_threshold, release_share
         given[GIVEN.HOLD_SHARE] = hold_share
+        given[GIVEN.CATCH_UP] = catch_up
+        given[GIVEN.SQUEEZE_FROM_WEIGHT], given[GIVEN.FRICTION_CAP] = self.squeeze_from_weight, self.friction_cap
+        self.catch_up = float(catch_up)
         given[GIVEN.FOLLOW] = 1.0 if follow_suppression else 0.0
         given[GIVEN.slice("GRASP")] = self.initial
         given[GIVEN.COINCIDENT_RTOL] = _COINCIDENT_RTOL
@@ -189,7 +176,8 @@ class GraspReflex(DescribesHandPorts, ModelsTheHand, Block):
         # the native calls' flat parameter array, its checks and derived values in C; the
         # period (REFLEX_PARAMS.DT) is set by bind
         self._params = pack_params(given, self.hand.vector, np.nan)
-        self.ki, self.min_force, self.max_force = float(ki), float(min_force), float(max_force)
+        self.ki, self.max_force = float(ki), float(max_force)
+        self.min_force = float(self._params[REFLEX_PARAMS.MIN_FORCE])  # with squeeze_from_weight, from the hand
         self.ratio_target = float(self._params[REFLEX_PARAMS.RATIO])
         self.approach_force, self.threshold = float(approach_force), float(contact_threshold)
         self.release_share = float(release_share)

@@ -17,9 +17,11 @@ Beyond the paper's PD, each a parameter (and a row of the report's ablation):
   armature included) by pole matching under the zero-order hold, so the 10 ms loop is
   stable for any kp, kd > 0. Applied as they are and held for 10 ms (``held``), a joint PD
   goes unstable once kd T / J exceeds 2: kd = 0.02 N m s/rad for the distal joints.
-- ``contact_compensation``: a finger in contact aims as deep into the object as its
-  measured normal force presses it (fn / k_n along the contact normal, the plant's
-  contact law), so that posture holding does not push back against the squeeze.
+- ``contact_compensation``: a finger in contact aims deeper into the object along the
+  contact normal, so that posture holding does not push back against the squeeze:
+  ``contact_aim`` times the depth at which the plant's contact law holds the tip at the
+  measured normal force, or without it (null) fn / k_n, the summed depth of all the surface
+  points under the tip.
 - ``gravity_compensation`` and ``load_compensation`` (output ``tau_ff``, added after the
   suppresser): the fingers' own gravity torques, and J^T of the object's load shared among
   the fingers in contact by the grasp matrix at their contact points (``G^+ w``), so that
@@ -93,7 +95,13 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         kd T / J > 2, about kd = 0.02 N m s/rad for the distal joints at 10 ms)
     contact_compensation : bool
         aim a finger in contact as deep into the object as its measured normal force presses
-        it (fn / k_n along the contact normal), so that the PD does not resist the squeeze
+        it (along the contact normal), so that the PD does not resist the squeeze
+    contact_aim : float or null
+        how deep: that many times the depth at which the contact law holds the tip at the
+        measured normal force (a circle on a face of surface points, fn / k_n =
+        4/3 depth^1.5 sqrt(2 r) / spacing); null: fn / k_n, the summed depth of the points
+        under the tip, several times its own, which grows with fn and lifts a heavy object
+        squeezed hard
     """
 
     type_name = "ManipulationPD"
@@ -102,7 +110,7 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
     def __init__(self, hand, trajectories: Mapping[str, Any] | None = None, kp: Any = 3.0, kd: Any = 0.04,
                  gravity_compensation: bool = True, load_compensation: bool = True,
                  contact_threshold: float = 0.05, discretization: str = "matched",
-                 contact_compensation: bool = True):
+                 contact_compensation: bool = True, contact_aim: float | None = None):
         self.hand = hand_of(hand)
         self.kp = float_array(kp, "kp", ndim=1, width=9, broadcast=True)
         self.kd = float_array(kd, "kd", ndim=1, width=9, broadcast=True)
@@ -131,6 +139,10 @@ class ManipulationPD(DescribesHandPorts, ModelsTheHand, Block):
         given[GIVEN.GRAVITY_COMP], given[GIVEN.LOAD_COMP] = self.gravity_compensation, self.load_compensation
         given[GIVEN.MATCHED], given[GIVEN.CONTACT_COMP] = discretization == "matched", self.contact_compensation
         given[GIVEN.STEP], given[GIVEN.REACH_RTOL] = DERIVATIVE_STEP, _REACH_RTOL
+        if contact_aim is not None and (isinstance(contact_aim, bool) or not isinstance(contact_aim, (int, float))):
+            raise ValueError(f"parameter 'contact_aim' must be a number or null, got {contact_aim!r}")
+        self.contact_aim = None if contact_aim is None else float(contact_aim)
+        given[GIVEN.CONTACT_AIM] = self.contact_aim or 0.0
         self._given = given
         self._params = pack_params(given, self.hand.vector, np.nan)
         self.weight = self._params[[MANIP_PARAMS.WX, MANIP_PARAMS.WY]]

@@ -58,6 +58,36 @@ static double tip_radius(const double *hand, int f)
     return hand[HH_P_FINGER0 + f * HH_P_FINGER_STRIDE + HH_PF_TIP_RADIUS];
 }
 
+/* With friction_cap, a contact slides at |f_t| / f_n = mu_d: a safety ratio at or above it never
+ * sees a sliding object, so the reflex keeps to at most this share of the hand's mu_d. */
+#define HH_FRICTION_SHARE 0.9
+
+static double reflex_safety_ratio(const double *g, const double *hand)
+{
+    double safety = g[HH_REFLEX_G_SAFETY_RATIO];
+    if (g[HH_REFLEX_G_FRICTION_CAP] != 0.0 && HH_FRICTION_SHARE * hand[HH_P_MU_D] < safety)
+        safety = HH_FRICTION_SHARE * hand[HH_P_MU_D];
+    return safety;
+}
+
+/* With squeeze_from_weight, min_force is at least the normal force with which the fingers of
+ * 'grasp' carry the object's weight by friction at the ratio target, m |g| / (k ratio_target)
+ * (2.6 N for 0.3 kg in a two-finger pinch at 0.6 / 1.05), and at most max_force. */
+static double reflex_min_force(const double *g, const double *hand, double ratio_target)
+{
+    double min_force = g[HH_REFLEX_G_MIN_FORCE];
+    if (g[HH_REFLEX_G_SQUEEZE_FROM_WEIGHT] == 0.0)
+        return min_force;
+    int fingers = 0;
+    for (int f = 0; f < HH_FINGERS; f++)
+        fingers += g[HH_REFLEX_G_GRASP + f] != 0.0;
+    double weight = hand[HH_P_OBJ_MASS] * hypot(hand[HH_P_GX], hand[HH_P_GY]);
+    double share = weight / ((fingers > 0 ? fingers : 1) * ratio_target);
+    if (share > min_force)
+        min_force = share;
+    return min_force < g[HH_REFLEX_G_MAX_FORCE] ? min_force : g[HH_REFLEX_G_MAX_FORCE];
+}
+
 int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, char *message, size_t size)
 {
     static const struct {
@@ -95,12 +125,14 @@ int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, ch
         return refuse(message, size, "parameter 'approach_force' must be in [0, max_force]");
     if (g[HH_REFLEX_G_MIN_FORCE] > max_force)
         return refuse(message, size, "parameter 'min_force' must not exceed 'max_force'");
+    if (!(0 <= g[HH_REFLEX_G_CATCH_UP] && g[HH_REFLEX_G_CATCH_UP] <= 1))
+        return refuse(message, size, "parameter 'catch_up' must be in [0, 1]");
     p[HH_REFLEX_P_THRESHOLD] = g[HH_REFLEX_G_THRESHOLD];
     p[HH_REFLEX_P_APPROACH] = g[HH_REFLEX_G_APPROACH];
     p[HH_REFLEX_P_KI] = g[HH_REFLEX_G_KI];
     p[HH_REFLEX_P_DT] = dt;
-    p[HH_REFLEX_P_MIN_FORCE] = g[HH_REFLEX_G_MIN_FORCE];
-    p[HH_REFLEX_P_RATIO] = g[HH_REFLEX_G_SAFETY_RATIO] / (1.0 + margin);
+    p[HH_REFLEX_P_RATIO] = reflex_safety_ratio(g, hand) / (1.0 + margin);
+    p[HH_REFLEX_P_MIN_FORCE] = reflex_min_force(g, hand, p[HH_REFLEX_P_RATIO]);
     p[HH_REFLEX_P_MAX_FORCE] = max_force;
     for (int f = 0; f < HH_FINGERS; f++) {
         p[HH_REFLEX_P_INITIAL + f] = g[HH_REFLEX_G_GRASP + f] != 0.0 ? 1.0 : 0.0;
@@ -110,6 +142,7 @@ int hh_reflex_pack(const double *g, const double *hand, double dt, double *p, ch
     p[HH_REFLEX_P_RELEASE_SHARE] = release;
     p[HH_REFLEX_P_FOLLOW] = g[HH_REFLEX_G_FOLLOW] != 0.0 ? 1.0 : 0.0;
     p[HH_REFLEX_P_HOLD_SHARE] = hold;
+    p[HH_REFLEX_P_CATCH_UP] = g[HH_REFLEX_G_CATCH_UP];
     return 0;
 }
 
@@ -126,6 +159,8 @@ int hh_manip_pack(const double *g, const double *hand, double dt, double *p, cha
     for (int i = 0; i < 2 * HH_JOINTS; i++)
         if (g[HH_MANIP_G_KP + i] < 0)
             return refuse(message, size, "kp and kd must be non-negative");
+    if (!isfinite(g[HH_MANIP_G_CONTACT_AIM]) || g[HH_MANIP_G_CONTACT_AIM] < 0)
+        return refuse(message, size, "contact_aim must be a finite number >= 0 (0: aim fn / k_n deep)");
     for (int f = 0; f < HH_FINGERS; f++)
         for (int j = 0; j < 3; j++)
             p[HH_MANIP_P_Q0 + 3 * f + j] = hand[HH_P_FINGER0 + f * HH_P_FINGER_STRIDE + HH_PF_Q0 + j];
@@ -146,6 +181,7 @@ int hh_manip_pack(const double *g, const double *hand, double dt, double *p, cha
     p[HH_MANIP_P_DT] = dt;
     p[HH_MANIP_P_MATCHED] = flag(g[HH_MANIP_G_MATCHED]);
     p[HH_MANIP_P_CONTACT_COMP] = flag(g[HH_MANIP_G_CONTACT_COMP]);
+    p[HH_MANIP_P_CONTACT_AIM] = g[HH_MANIP_G_CONTACT_AIM];
     return 0;
 }
 

@@ -203,7 +203,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
                                     tip centre plus this along the contact normal */                   \
     SLOT(P, FOLLOW, 1) /* non-zero: the reflex's hold of a finger follows its share (hand-over) */     \
     SLOT(P, HOLD_SHARE, 1) /* a third finger is held whole down to this share, not at all at           \
-                           release_share */
+                           release_share */                                                             \
+    SLOT(P, CATCH_UP, 1) /* share of a positive shortfall closed at once, besides the integral */
 
 /* The reflex's state: the force scale, per finger 1 where the reflex was letting go of it
  * when it last touched, per finger how much the reflex holds it */
@@ -230,7 +231,10 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, HOLD_SHARE, 1)                                                                             \
     SLOT(P, FOLLOW, 1) /* follow_suppression, 0 or 1 */                                                \
     SLOT(P, GRASP, HH_FINGERS) /* 1 for the fingers listed in 'grasp' */                               \
-    SLOT(P, COINCIDENT_RTOL, 1) /* Python's internal_forces._COINCIDENT_RTOL */
+    SLOT(P, COINCIDENT_RTOL, 1) /* Python's internal_forces._COINCIDENT_RTOL */                         \
+    SLOT(P, CATCH_UP, 1)                                                                               \
+    SLOT(P, SQUEEZE_FROM_WEIGHT, 1) /* non-zero: min_force at least the weight's share (reflex pack) */  \
+    SLOT(P, FRICTION_CAP, 1) /* non-zero: the safety ratio at most HH_FRICTION_SHARE mu_d */
 
 /* The manipulation PD's packed parameters, params[HH_MANIP_P_*] */
 #define HH_MANIP_PARAM_SLOTS(SLOT, P)                                                                  \
@@ -251,7 +255,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, MATCHED, 1) /* non-zero: realise kp, kd for the period (hh_matched_gains); zero: apply     \
                         them as they are, held for the period */                                       \
     SLOT(P, CONTACT_COMP, 1) /* non-zero: aim a finger in contact as deep into the object as its       \
-                             measured normal force presses it (fn / k_n) */
+                             measured normal force presses it */                                       \
+    SLOT(P, CONTACT_AIM, 1) /* > 0: that many times the tip's own depth (hh contact_depth); 0: fn / k_n */
 
 /* A waypoint row (t, x, y, phi) of a trajectory */
 #define HH_MANIP_WAYPOINT_SLOTS(SLOT, P) SLOT(P, T, 1) SLOT(P, X, 1) SLOT(P, Y, 1) SLOT(P, PHI, 1)
@@ -279,7 +284,8 @@ enum { HH_DIMENSIONS(HH_DIMENSION_ENUM) };
     SLOT(P, MATCHED, 1) /* discretization 'matched' */                                                 \
     SLOT(P, CONTACT_COMP, 1)                                                                           \
     SLOT(P, STEP, 1) /* Python's manipulation_pd.DERIVATIVE_STEP */                                    \
-    SLOT(P, REACH_RTOL, 1) /* Python's inverse_kinematics._REACH_RTOL */
+    SLOT(P, REACH_RTOL, 1) /* Python's inverse_kinematics._REACH_RTOL */                               \
+    SLOT(P, CONTACT_AIM, 1) /* contact_aim, 0 for none (fn / k_n) */
 
 /* The suppresser's packed parameters, params[HH_SUPPRESS_P_*] */
 #define HH_SUPPRESS_PARAM_SLOTS(SLOT, P)                                                               \

@@ -331,11 +331,25 @@ static void pd_torque(const hh_model *m, const double *params, const double *q, 
     }
 }
 
+/* How deep a fingertip of radius r sits in a flat face of the object when it presses with
+ * normal force fn: the contact law sums k_n times each surface point's depth, and the points
+ * (spacing s: the perimeter over their number) under a circle pressed delta deep lie
+ * within sqrt(2 r delta) of its centre, delta - x^2 / (2 r) deep, so
+ * fn / k_n = (4 / 3) delta^(3/2) sqrt(2 r) / s. */
+static double contact_depth(const hh_model *m, int f, double fn)
+{
+    double spacing = 4.0 * (m->body[HH_B_HALF_A] + m->body[HH_B_HALF_B]) / (m->npts > 0 ? m->npts : 1);
+    double summed = fn / m->body[HH_B_K_N];
+    return pow(0.75 * spacing * summed / sqrt(2.0 * m->fingers[f][HH_F_TIP_RADIUS]), 2.0 / 3.0);
+}
+
 /* Moves the joint targets q_ref (9) of each finger in contact so that its tip centre sits
- * fn / k_n deeper along the contact normal: the penetration of the contact law at the
- * measured normal force. A planned fingertip pose lies on the object's surface; a tip that
- * squeezes sits inside it, and a PD aimed at the surface would push back against the
- * squeeze. A shifted target out of reach leaves the finger's target as it was. */
+ * deeper along the contact normal: CONTACT_AIM times the depth at which the contact law holds
+ * it at the measured normal force (contact_depth), or with CONTACT_AIM 0, fn / k_n (the summed
+ * depth of the points under the tip, several times its own). A planned fingertip pose lies
+ * on the object's surface; a tip that squeezes sits inside it, and a PD aimed at the surface
+ * would push back against the squeeze. A shifted target out of reach leaves the finger's
+ * target as it was. */
 static void contact_offset(const hh_model *m, const double *params, const hh_manip_inputs *in, double *q_ref)
 {
     if (params[HH_MANIP_P_CONTACT_COMP] == 0.0)
@@ -343,7 +357,8 @@ static void contact_offset(const hh_model *m, const double *params, const hh_man
     for (int f = 0; f < HH_FINGERS; f++) {
         if (!(in->fn[f] > params[HH_MANIP_P_THRESHOLD]))
             continue;
-        double depth = in->fn[f] / m->body[HH_B_K_N];
+        double aim = params[HH_MANIP_P_CONTACT_AIM];
+        double depth = aim > 0.0 ? aim * contact_depth(m, f, in->fn[f]) : in->fn[f] / m->body[HH_B_K_N];
         double pose[3], q[3], reach[3];
         hh_finger_fk(m->fingers[f], q_ref + 3 * f, pose);
         if (hh_ik_near(m->fingers[f], params[HH_MANIP_P_REACH_RTOL], pose[0] + depth * in->normal[2 * f],

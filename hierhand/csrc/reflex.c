@@ -368,7 +368,7 @@ int hh_reflex_update(const double *params, const double *state, const hh_reflex_
             shortfall = hh_max(shortfall, weight[i] * (need - in->fn[i]) / hh_max(gain, SMALLEST_GAIN));
         }
     if (held >= 2)
-        scale = hh_min(hh_max(scale + params[HH_REFLEX_P_KI] * dt * shortfall, 0.0), params[HH_REFLEX_P_MAX_FORCE]);
+        scale = hh_min(hh_max(scale + params[HH_REFLEX_P_KI] * dt * shortfall + params[HH_REFLEX_P_CATCH_UP] * hh_max(shortfall, 0.0), 0.0), params[HH_REFLEX_P_MAX_FORCE]);
     next[HH_REFLEX_S_SCALE] = scale;
     /* whether a finger was the reflex's or voluntary motion's when it last touched: a
      * finger that loses contact while the reflex holds it whole (a bounce) is pushed back,

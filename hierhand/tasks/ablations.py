@@ -71,6 +71,11 @@ ABLATIONS = (
              "squeeze while the object slides: the reflex aims at most at 0.9 mu_d (no change where mu_d is "
              "above the safety ratio / 0.9, as at the shipped point)",
              {"reflex.friction_cap": False}),
+    Ablation("reflex catches up on a shortfall", "reflex.catch_up 0 (integral control alone)",
+             "a sudden push can take an object out of a light grasp before an integral loop at ki has built the "
+             "squeeze the push needs: a quarter of a contact's shortfall is closed at once each hit (a half or all "
+             "of it turned more objects in a tilted pinch)",
+             {"reflex.catch_up": 0.0}),
     Ablation("armature 1e-4 kg m^2", "plant armature 0 on every joint",
              "a geared motor's reflected inertia; bare human-scale links leave a 10 ms PD almost no "
              "stiffness to work with",
@@ -80,8 +85,9 @@ ABLATIONS = (
              "kd = 0.04 N m s/rad gives 4 on the distal joints)",
              {"manip.discretization": "held"}),
     Ablation("PD aimed at the squeezed contact", "manip.contact_compensation false",
-             "a PD aimed at the surface pushes back against the squeeze (fn / k_n deep), which the suppresser "
-             "reads as voluntary motion against the grasp",
+             "a PD aimed at the surface pushes back against the squeeze, which the suppresser reads as voluntary "
+             "motion against the grasp; aimed three times as deep as the tip sits, the PD adds a press the "
+             "re-grasp's thumb-middle pinch needs",
              {"manip.contact_compensation": False}),
     Ablation("suppression low-passed (20 ms)", "suppress.time_constant 0 (the paper's static law)",
              "the sigmoid closes a loop through the grasping torque and the finger of gain |tau_g| S_a / 4, "

@@ -77,7 +77,9 @@ def claim_rows(summary: dict) -> list[tuple[str, str, str, str]]:
         ("Grasp (Fig. 10): the grasp torque reacts before the manipulation torque", "grasp torque first",
          f"first change after the push: grasp {_num(1000 * g['grasp_torque_first_moves_s'], ' ms')} (the reflex's "
          f"next 1 ms hit), manipulation {_num(1000 * g['manipulation_torque_first_moves_s'], ' ms')} (the PD's next "
-         f"10 ms hit): the sample periods decide it. Share of each torque's move within 0.2 s: " + "; ".join(
+         f"10 ms hit): the sample periods decide it. Share of each torque's move within 0.2 s (the reflex's "
+         f"catch_up, an addition, speeds the grasp torque's; integral control alone builds up more slowly than "
+         f"the PD's step): " + "; ".join(
              f"{share}: grasp {_num(1000 * times['grasp_torque_at_s'], ' ms')}, manipulation "
              f"{_num(1000 * times['manipulation_torque_at_s'], ' ms')}" for share, times in g["reaction_shares"].items()),
          _fig10_verdict(g, summary)),
@@ -155,13 +157,13 @@ Each of these is beyond the paper; the ablation table below switches each off al
   kd T / J > 2, which is what made the old PD fail from kd x1.3-1.4; matched, the loop is
   stable for any kp, kd > 0 (the shipped kp = 3 N m/rad, kd = 0.04 N m s/rad are held as
   about 0.6-0.8 N m/rad and 0.013-0.017 N m s/rad).
-- **The PD aims a squeezed fingertip as deep as its normal force presses it** (fn / k_n along
-  the contact normal): aimed at the surface, posture holding pushes back against the squeeze,
-  and the suppresser reads that as voluntary motion against the grasp. fn / k_n is the summed
-  depth of every surface point under the tip, about three times the tip's own depth (0.35 mm
-  at 3 N), so the aim is deeper than the tip sits and the PD adds a squeeze of its own; aimed
-  at the tip's own depth, heavy objects end nearer their manipulation target but the re-grasp
-  drops the object on most of the wide spread: it relies on that extra squeeze.
+- **The PD aims a squeezed fingertip as deep as its normal force presses it**: aimed at the
+  surface, posture holding pushes back against the squeeze, and the suppresser reads that as
+  voluntary motion against the grasp. It aims three times as deep as the contact law holds the
+  tip at the measured normal force (`contact_aim: 3`; about fn / k_n at 3 N, the aim it had
+  before), so the PD adds a press of its own, which the re-grasp's thumb-middle pinch needs;
+  the aim grows with the tip's depth (fn^(2/3)), not with fn: aimed fn / k_n deep, a heavy
+  object squeezed hard was lifted 1-2 mm off its manipulation target at the hand-over.
 - **Feedforward** (output `tau_ff`, added after the suppresser: it is not voluntary motion):
   the fingers' gravity torques and J^T of the object's load, shared by the grasp matrix at the
   contact points in proportion to the normal forces, so that the shares balance the load's
@@ -204,6 +206,10 @@ Each of these is beyond the paper; the ablation table below switches each off al
   of the plant's contact; a sliding contact shows |f_t|/f_n = mu_d, so a safety ratio at or
   above mu_d would never squeeze harder while the object slides. At the shipped point (mu_d
   0.9, safety ratio 0.6) it changes nothing.
+- **The reflex catches up on a shortfall** (`catch_up: 0.25`): besides its integral step, each
+  hit closes a quarter of a contact's shortfall of normal force at once. A sudden push can take a
+  light object out of the grasp before an integral loop at ki has built the squeeze the push
+  needs (at the shipped point it shortens the recovery from the push).
 - **Start and support**: the fingers start 0.1 mm off the object (the paper starts in contact)
   and close under the reflex's approach force while a support carries the object's weight
   until 0.1 s; the PD's load feedforward carries only what the support does not.
