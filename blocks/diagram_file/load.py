@@ -9,13 +9,10 @@ can therefore run, and the plan made here is kept by the planner, so the first
 
 from __future__ import annotations
 
-import json
-import os
 from pathlib import Path
 from typing import Any, Mapping
 
-from blocks.builder.diagram import Diagram, jsonable
-from blocks.diagram_file.load_cache import cached
+from blocks.builder.diagram import Diagram
 from blocks.diagram_file.reader import parse_builder, read_builder
 from blocks.ssp.names import is_ssp
 
@@ -35,10 +32,6 @@ def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
     were copied elsewhere reads the copies, while its parameters and messages still name
     the paths it gives. ``step``: for an SSP, the communication step of the components
     its SSD gives none.
-
-    Loading the same YAML file again with the same arguments, while every file the
-    diagram read holds the same bytes, gives the Diagram made before
-    (``blocks.diagram_file.load_cache``): a Diagram is not changed after loading.
     """
     if is_ssp(path):
         from blocks.ssp.reader import read_ssp
@@ -49,21 +42,7 @@ def load_diagram(path: str | Path, overrides: Mapping[str, Any] | None = None,
 
         raise DiagramError([Issue(str(path), None, "a step (--step) is for the components of an SSP",
                                   "a YAML diagram gives each block its period")])
-    key = _cache_key(path, overrides, trust, origins, files)
-    if key is None:
-        return read_builder(path, trust=trust, files=files).build(overrides, origins=origins)
-    return cached(key, lambda: read_builder(path, trust=trust, files=files).build(overrides, origins=origins))
-
-
-def _cache_key(path, overrides, trust, origins, files) -> tuple | None:
-    """What a load of ``path`` depends on besides the files it reads (the folder a relative
-    path starts from, the arguments), for ``load_cache``; None: arguments it cannot key."""
-    try:
-        given = json.dumps([jsonable(overrides or {}), dict(origins or {}),
-                            {str(k): os.fspath(v) for k, v in (files or {}).items()}], sort_keys=True)
-    except (TypeError, ValueError):
-        return None
-    return (os.fspath(path), os.getcwd(), bool(trust), given)
+    return read_builder(path, trust=trust, files=files).build(overrides, origins=origins)
 
 
 def loads_diagram(text: str, filename: str = "<diagram>", base_dir: str | Path | None = None,
