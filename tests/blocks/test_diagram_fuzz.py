@@ -408,8 +408,11 @@ def test_wired_diagrams_give_diagram_or_diagram_error(doc, ticks, tmp_path):
 
 
 def write_params_files(base: Path) -> None:
-    (base / "params.yaml").write_text("k: 3.0\nvalue: 2.0\n", encoding="utf-8")
-    (base / "bad.yaml").write_text("k: [1, 2\n", encoding="utf-8")
+    """The parameter files the documents name, written once into ``base`` (a test's examples
+    share its folder, and loading only reads them)."""
+    if not (base / "bad.yaml").is_file():
+        (base / "params.yaml").write_text("k: 3.0\nvalue: 2.0\n", encoding="utf-8")
+        (base / "bad.yaml").write_text("k: [1, 2\n", encoding="utf-8")
 
 
 @settings(max_examples=400, **FUZZ_SETTINGS)
