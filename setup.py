@@ -22,11 +22,13 @@ headers are the standard's, carried in ``blocks/csrc/fmi`` (BSD-2-Clause, see LI
 file lists are ``blocks/engine/native_sources.py``
 and ``hierhand/native_sources.py``, which the exporter reads for an FMU's ``sources/``.
 
-An editable install builds in fresh temporary folders, where distutils' up-to-date check
-never finds a previous build, so every reinstall (``pip install -e ".[test]"`` after
-``pip install -e .``) would compile everything again; ``BuildNative`` therefore reuses the
-extensions and FMU binaries that an editable or in-place build left in the tree when they
-are newer than every input of the build (``BUILD_INPUTS``), and compiles otherwise.
+An editable install, and a wheel built from the tree (``pip wheel .``), build in fresh
+temporary folders, where distutils' up-to-date check never finds a previous build, so every
+reinstall (``pip install -e ".[test]"`` after ``pip install -e .``) and every wheel would
+compile everything again; ``BuildNative`` therefore reuses the extensions and FMU binaries
+that an editable or in-place build left in the tree when they are newer than every input of
+the build (``BUILD_INPUTS``), and compiles otherwise (a source distribution carries no
+builds, so a wheel built from one always compiles).
 """
 
 from __future__ import annotations
@@ -104,7 +106,7 @@ class BuildNative(build_ext):
     def _current(self, in_tree: Path) -> bool:
         """Whether ``in_tree``, left by an earlier editable or in-place build, is newer than
         every input of the build, so that copying it is the same as compiling it again."""
-        return self._in_tree() and not self.force and in_tree.is_file() and not newer_group(BUILD_INPUTS, str(in_tree))
+        return not self.force and in_tree.is_file() and not newer_group(BUILD_INPUTS, str(in_tree))
 
     def build_extension(self, ext: Extension) -> None:
         in_tree = ROOT / self._get_inplace_equivalent(self.get_finalized_command("build_py"), ext)[0]
@@ -118,11 +120,11 @@ class BuildNative(build_ext):
     def _link_fmu_binary(self, package: str, fmi: int, files: list[str]) -> None:
         relative = Path(package, "fmu_binaries", f"fmi{fmi}.so")
         targets = [Path(self.build_lib) / relative]
+        if self._current(ROOT / relative):
+            self.mkpath(str(targets[0].parent))
+            self.copy_file(str(ROOT / relative), str(targets[0]))
+            return
         if self._in_tree():
-            if self._current(ROOT / relative):
-                self.mkpath(str(targets[0].parent))
-                self.copy_file(str(ROOT / relative), str(targets[0]))
-                return
             targets.append(ROOT / relative)
         objects = self.compiler.compile(
             [f for f in files if f.endswith(".c")],

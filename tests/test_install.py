@@ -3,8 +3,11 @@
 copy with the interpreter that installed it, and Ctrl-C stops it as it stops
 ``python -m hierhand``.
 
-One wheel is built per session (the C compile is what costs), from a copy of the source
-tree, so that nothing a previous build left in ``build/`` ends up in it. The installs take
+One wheel is built per session, from a copy of the source tree, so that nothing a previous
+build left in ``build/`` ends up in it. The copy keeps the extensions and FMU binaries that
+the editable install compiled in the tree (with their times), which the build reuses while
+they are newer than their sources, as it does for ``pip wheel .``: the wheel then costs no
+C compile. The installs take
 no dependencies (``--no-deps``): they come from this test's own environment, put on the
 installed command's module path after the installed copy.
 """
@@ -28,9 +31,10 @@ pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"),
 
 REPO = Path(__file__).resolve().parents[1]
 HOOK = REPO / "tests" / "blocks" / "cli" / "signal_hook"
-NOT_SOURCES = shutil.ignore_patterns(".git", "build", "dist", "runs", "*.egg-info", "__pycache__", "*.so",
+NOT_SOURCES = shutil.ignore_patterns(".git", "build", "dist", "runs", "*.egg-info", "__pycache__",
                                      ".pytest_cache", ".hypothesis", "*.fmu", ".whl", ".gl")
-"""What a copy of the tree for the build leaves out: build outputs and caches (.gitignore's)."""
+"""What a copy of the tree for the build leaves out: build folders and caches (.gitignore's),
+but not the in-tree builds (``*.so``) that the build reuses while current."""
 
 
 def quiet_pip(*args: str | Path, runner: list[str | Path] | None = None, env: dict[str, str] | None = None) -> None:

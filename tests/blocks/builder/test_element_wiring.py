@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import blocks
 from blocks import DiagramBuilder, DiagramError, dump_diagram, loads_diagram, simulate
 
-from ..test_diagram_fuzz import FUZZ_SETTINGS
+from ..test_diagram_fuzz import FUZZ_SETTINGS, dump
 
 ENGINES = ("native", "reference")
 
@@ -296,7 +296,7 @@ def element_wired(draw) -> tuple[dict, dict]:
 @settings(max_examples=120, **FUZZ_SETTINGS)
 @given(docs=element_wired())
 def test_wiring_by_element_gives_the_samples_of_selector_and_mux_blocks(docs):
-    by_element, through_blocks = (loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="random.yaml")
+    by_element, through_blocks = (loads_diagram(dump(doc), filename="random.yaml")
                                   for doc in docs)
     runs = [simulate(by_element, engine=e) for e in ENGINES] + [simulate(through_blocks, engine=e) for e in ENGINES]
     first = runs[0]

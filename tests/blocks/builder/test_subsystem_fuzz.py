@@ -16,13 +16,12 @@ from __future__ import annotations
 import re
 
 import numpy as np
-import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import blocks
 
-from ..test_diagram_fuzz import FUZZ_SETTINGS, short_t_end, wired_document
+from ..test_diagram_fuzz import FUZZ_SETTINGS, dump, short_t_end, wired_document
 
 
 def parse(conn) -> tuple[str, str, int, object]:
@@ -129,7 +128,7 @@ def programs(diagram, t_end) -> list[str]:
 
 def loads_flat(doc: dict) -> bool:
     try:
-        blocks.loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="flat.yaml")
+        blocks.loads_diagram(dump(doc), filename="flat.yaml")
     except blocks.DiagramError:
         return False
     return True
@@ -140,7 +139,7 @@ def composed(draw, valid: bool = True):
     """A random diagram (one that loads, when ``valid``), the run of blocks to move into
     subsystem ``s``, the run of those to move on into ``t`` inside it (or None), and where
     the logged signals go."""
-    doc = draw(wired_document().filter(loads_flat) if valid else wired_document())
+    doc = draw(wired_document(valid=True).filter(loads_flat) if valid else wired_document())
     names = list(doc["blocks"])
     nested = draw(st.booleans()) and len(names) >= 2
     start = draw(st.integers(min_value=0, max_value=len(names) - (2 if nested else 1)))
@@ -169,13 +168,13 @@ def check_composed(case, ticks, tmp_path) -> None:
     paths = {b: f"s.{b}" for b in moved}
     if nested:
         sub, inner = compose(sub, nested, "t", "t.yaml", flags[4:] + flags[:4])
-        (tmp_path / "t.yaml").write_text(yaml.safe_dump(inner, sort_keys=False), encoding="utf-8")
+        (tmp_path / "t.yaml").write_text(dump(inner), encoding="utf-8")
         paths.update({b: f"s.t.{b}" for b in nested})
-    (tmp_path / "s.yaml").write_text(yaml.safe_dump(sub, sort_keys=False), encoding="utf-8")
-    (tmp_path / "top.yaml").write_text(yaml.safe_dump(top, sort_keys=False), encoding="utf-8")
+    (tmp_path / "s.yaml").write_text(dump(sub), encoding="utf-8")
+    (tmp_path / "top.yaml").write_text(dump(top), encoding="utf-8")
     rename = renamer(paths)
     try:
-        flat = blocks.loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="flat.yaml", base_dir=tmp_path)
+        flat = blocks.loads_diagram(dump(doc), filename="flat.yaml", base_dir=tmp_path)
     except blocks.DiagramError as flat_error:
         try:
             blocks.load_diagram(tmp_path / "top.yaml")

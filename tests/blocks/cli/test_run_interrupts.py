@@ -52,10 +52,8 @@ def start(tmp_path: Path, *options: str, env: dict[str, str] | None = None) -> t
     proc = subprocess.Popen([sys.executable, "-m", "hierhand", "run", str(diagram), "-o", str(out), "--trust",
                              *options], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env={**os.environ, "PYTHONPATH": str(REPO), **(env or {})})
-    deadline = time.monotonic() + 120
-    while not marker.exists():
+    while not marker.exists():  # a run that never logs them is a hang: pytest-timeout ends it, not a clock here
         assert proc.poll() is None, proc.communicate()
-        assert time.monotonic() < deadline, "the run did not log its first samples"
         time.sleep(0.01)
     return proc, out
 

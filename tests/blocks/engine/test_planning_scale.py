@@ -1,22 +1,30 @@
 """Planning stays near-linear in the number of blocks, and nothing recurses per block.
 
 No timing is asserted (machines are noisy; ``benchmarks/scheduler.py`` prints the times).
-Instead the chain below is big enough that any quadratic step of loading, width
-inference, firing sets, ordering or program building, as they were before issue 12,
-takes minutes here instead of seconds. It is written bottom-up (last block and last
-connection first), the order in which sweep-until-nothing-changes loops need a pass
-per block.
+Instead the work is counted: loading and planning a chain twice as long makes at most
+about twice as many function calls (Python's and builtins', as ``sys.setprofile`` sees
+them), so any quadratic step of loading, width inference, firing sets, ordering or program
+building, as they were before issue 12, fails the bound whatever the machine's speed. The
+chain is written bottom-up (last block and last connection first), the order in which
+sweep-until-nothing-changes loops need a pass per block, and is longer than Python's
+recursion limit, so a step that recurses per block fails too.
 """
 
 from __future__ import annotations
+
+import sys
 
 import numpy as np
 
 import blocks
 from blocks.builder.references import build_order
 
-CHAIN = 20_000
-"""Blocks in the chain: about 2 s to load, plan and run; a quadratic step makes it minutes."""
+CHAIN = 3_000
+"""Blocks in the longer chain; the shorter has half, still more than Python's recursion limit (1000)."""
+
+GROWTH = 2.25
+"""The most that doubling the chain may multiply the calls by: linear work doubles them
+(n log n work multiplies them by 2.19 at this size), a pass per block quadruples them."""
 
 GAIN = 1.00001
 
@@ -33,9 +41,29 @@ def chain_text(n: int) -> str:
     return "\n".join(lines) + "\n"
 
 
-def test_a_long_chain_written_bottom_up_plans_in_order_and_runs_to_the_closed_form():
-    diagram = blocks.loads_diagram(chain_text(CHAIN))
-    plan = blocks.build_schedule(diagram, diagram.t_end)
+def planned_with_calls(n: int) -> tuple[blocks.Diagram, blocks.Schedule, int]:
+    """The chain of ``n`` blocks loaded and planned, and the function calls that took."""
+    text = chain_text(n)
+    calls = 0
+
+    def count(frame, event, arg) -> None:
+        nonlocal calls
+        calls += event in ("call", "c_call")
+
+    sys.setprofile(count)
+    try:
+        diagram = blocks.loads_diagram(text)
+        plan = blocks.build_schedule(diagram, diagram.t_end)
+    finally:
+        sys.setprofile(None)
+    return diagram, plan, calls
+
+
+def test_a_long_chain_written_bottom_up_plans_in_linear_work_in_order_and_runs_to_the_closed_form():
+    planned_with_calls(3)  # the lazy imports, once
+    _, _, half = planned_with_calls(CHAIN // 2)
+    diagram, plan, calls = planned_with_calls(CHAIN)
+    assert calls <= GROWTH * half, (half, calls)
     chain = ["src"] + [f"g{i}" for i in range(CHAIN)]
     assert plan.n_ticks == 2 and plan.hyperperiod == 1
     assert plan.lazy == frozenset(chain[1:]) - {f"g{CHAIN // 2}", f"g{CHAIN - 1}"}

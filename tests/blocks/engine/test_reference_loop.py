@@ -26,7 +26,7 @@ import blocks.engine.compiled
 from blocks import load_diagram, loads_diagram, simulate
 
 from ..compiled_blocks import register
-from ..test_diagram_fuzz import FUZZ_SETTINGS, short_t_end
+from ..test_diagram_fuzz import FUZZ_SETTINGS, dump, short_t_end
 
 ROOT = Path(__file__).resolve().parents[3]
 PERIODS = ["0.1 ms", "0.2 ms", "0.5 ms", "1 ms", "2 ms"]
@@ -115,7 +115,7 @@ def loaded(doc: dict, ticks: int, base_dir=None):
     """A random document's diagram and an end time about ``ticks`` base ticks away; None
     if it does not load or plan (a random diagram may well not)."""
     try:
-        diagram = loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="random.yaml", base_dir=base_dir)
+        diagram = loads_diagram(dump(doc), filename="random.yaml", base_dir=base_dir)
     except blocks.DiagramError:
         return None
     t_end = short_t_end(diagram, ticks)

@@ -9,12 +9,14 @@ with that reason.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import os
 import re
 import shutil
 import subprocess
 import sys
+import tempfile
 import zipfile
 from pathlib import Path
 
@@ -46,15 +48,32 @@ def build_error() -> str | None:
     return None
 
 
+CACHE = Path(tempfile.gettempdir()) / f"hierhand-test-fmus-{os.getuid() if hasattr(os, 'getuid') else 0}"
+"""Compiled test libraries by the hash of everything that makes them (``compile_library``):
+the test modules and the suite's workers build the same few libraries many times."""
+
+
 def compile_library(target: Path, *sources: str, defines: dict[str, str] | None = None) -> bytes:
     """Compile ``sources`` (names in ``sources/``) into the shared library ``target``;
-    ``defines`` become ``-D`` options. Returns the library's bytes."""
+    ``defines`` become ``-D`` options. Returns the library's bytes. A library compiled before
+    from the same command, sources and headers (``CACHE``) is copied instead."""
     flags = [f"-D{k}={v}" for k, v in (defines or {}).items()]
     cmd = [compiler(), "-shared", "-fPIC", "-O1", f"-I{HEADERS}", *flags,
            *(str(SOURCES / s) for s in sources), "-o", str(target), "-lm"]
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    if done.returncode != 0:
-        raise RuntimeError(f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}")
+    key = hashlib.sha256("\0".join(cmd[:-3]).encode())
+    for path in sorted([*SOURCES.iterdir(), *HEADERS.iterdir()]):
+        key.update(path.name.encode() + b"\0" + path.read_bytes())
+    cached = CACHE / f"{key.hexdigest()}{EXT}"
+    if not cached.is_file():
+        done = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            raise RuntimeError(f"compiling the test FMU failed:\n{' '.join(cmd)}\n{done.stderr}")
+        CACHE.mkdir(exist_ok=True)
+        partial = cached.with_name(f"{cached.name}.{os.getpid()}")
+        shutil.copyfile(target, partial)
+        os.replace(partial, cached)  # whole or absent for the other workers
+        return target.read_bytes()
+    shutil.copyfile(cached, target)
     return target.read_bytes()
 
 

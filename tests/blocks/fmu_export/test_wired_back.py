@@ -20,6 +20,8 @@ together (an FMU's dependencies hold at every step, so with the FMU it is a loop
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import yaml
 from hypothesis import given, settings
@@ -29,13 +31,13 @@ import blocks
 from blocks.fmu_export import export_fmu
 
 from ..builder.test_subsystem_fuzz import compose, loads_flat, parse
-from ..test_diagram_fuzz import FUZZ_SETTINGS, GOOD_PERIODS, short_t_end, wired_document
+from ..test_diagram_fuzz import FUZZ_SETTINGS, GOOD_PERIODS, dump, short_t_end, wired_document
 
 
 @st.composite
 def wired_back(draw):
     """A random diagram that loads, and the run of its blocks to export as the FMU ``s``."""
-    doc = draw(wired_document().filter(loads_flat))
+    doc = draw(wired_document(valid=True).filter(loads_flat))
     names = list(doc["blocks"])
     start = draw(st.integers(min_value=0, max_value=len(names) - 1))
     stop = draw(st.integers(min_value=start + 1, max_value=len(names)))
@@ -50,10 +52,10 @@ def standalone(doc: dict, moved: list[str], periods: list[str]) -> dict | None:
     its width (the exported diagram's inputs give no width to infer); None if it no longer
     loads."""
     try:
-        flat = blocks.loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="flat.yaml")
+        flat = blocks.loads_diagram(dump(doc), filename="flat.yaml")
     except blocks.DiagramError:
         return None
-    specs = yaml.safe_load(yaml.safe_dump(doc["blocks"]))
+    specs = copy.deepcopy(doc["blocks"])
     for b, period in zip(doc["blocks"], periods):
         spec = specs[b]
         if b not in moved:
@@ -103,17 +105,17 @@ def wired(case, ticks, tmp_path) -> bool:
     wires = [parse(c) for c in top["connections"]]
     sub.pop("log", None)
     try:
-        flat = blocks.loads_diagram(yaml.safe_dump(doc, sort_keys=False), filename="flat.yaml", base_dir=tmp_path)
+        flat = blocks.loads_diagram(dump(doc), filename="flat.yaml", base_dir=tmp_path)
         for b in moved:   # every inner output an FMU output, to compare
             for port in flat.blocks[b].block.outputs:
                 sub.setdefault("outputs", {})[f"x_{b}_{port}"] = f"{b}.{port}"
-        inner = blocks.loads_diagram(yaml.safe_dump(sub, sort_keys=False), filename="s.yaml", base_dir=tmp_path)
-        path = export_fmu(inner, tmp_path / f"s{fmi}_{abs(hash(yaml.safe_dump(sub)))}.fmu", fmi)
+        inner = blocks.loads_diagram(dump(sub), filename="s.yaml", base_dir=tmp_path)
+        path = export_fmu(inner, tmp_path / f"s{fmi}_{abs(hash(dump(sub)))}.fmu", fmi)
     except blocks.DiagramError:
         return False  # a subsystem that cannot stand alone (an inherited rate from outside), or be exported
     top["blocks"]["s"] = {"type": "FMU", "params": {"path": str(path)}}
     try:
-        outer = blocks.loads_diagram(yaml.safe_dump(top, sort_keys=False), filename="top.yaml", base_dir=tmp_path)
+        outer = blocks.loads_diagram(dump(top), filename="top.yaml", base_dir=tmp_path)
         blocks.build_schedule(outer, None)
     except blocks.DiagramError as error:
         assert "algebraic loop" in str(error), str(error)

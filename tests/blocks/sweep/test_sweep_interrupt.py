@@ -3,7 +3,11 @@ group, workers included): one line and exit code 130, no traceback from any proc
 whole rows in sweep.csv, no process left behind, and the same command then runs the rest.
 SIGTERM to the sweep's process alone (as a batch system or ``timeout`` sends it), and a
 point that kills the process running it: nothing left in TMPDIR (``blocks.process.scratch``), no
-process left."""
+process left.
+
+The signals are sent by the sweep's process itself just before it writes its third row
+(``tests/blocks/cli/signal_hook``): mid-sweep whatever the machine's speed, so each point
+can be short."""
 
 from __future__ import annotations
 
@@ -20,11 +24,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[3]
 TOY = ROOT / "diagrams" / "toy.yaml"
 GRID = "prop.k=1,2,3,4,5,6,7,8"
+HOOK = ROOT / "tests" / "blocks" / "cli" / "signal_hook"
 
 
 def _diagram(folder: Path) -> Path:
-    """The toy diagram over 2000 s, logging every 1000th sample: about 0.2 s of work per
-    point here, long enough to interrupt mid-sweep, in a few MB of logs."""
+    """The toy diagram logging every 1000th sample."""
     text = TOY.read_text().replace("log: [plant.y]", "log: [{signal: plant.y, decimate: 1000}]")
     assert "decimate: 1000" in text
     path = folder / "toy_long.yaml"
@@ -34,7 +38,7 @@ def _diagram(folder: Path) -> Path:
 
 def _command(out: Path, mode: list[str]) -> list[str]:
     return [sys.executable, "-m", "hierhand", "sweep", str(_diagram(out.parent)), "-o", str(out),
-            "--t-end", "2000 s", "--metric", "y=final(plant.y)", "--grid", GRID, "-q", *mode]
+            "--t-end", "20 s", "--metric", "y=final(plant.y)", "--grid", GRID, "-q", *mode]
 
 
 def _empty_tmpdir(tmp_path: Path) -> dict[str, str]:
@@ -43,28 +47,21 @@ def _empty_tmpdir(tmp_path: Path) -> dict[str, str]:
     return {**{k: v for k, v in os.environ.items() if k != "BLOCKS_SCRATCH"}, "TMPDIR": str(tmp_path / "tmp")}
 
 
+def _signalled(tmp_path: Path, send: str, **more: str) -> dict[str, str]:
+    """``_empty_tmpdir``'s environment for a sweep that sends ``send`` just before it writes
+    its third row to sweep.csv (two whole rows are in); ``more`` for the hook."""
+    path = os.pathsep.join([str(HOOK), *filter(None, [os.environ.get("PYTHONPATH")])])
+    return {**_empty_tmpdir(tmp_path), "PYTHONPATH": path, "SIGNAL_AT": "blocks.sweep.store:SweepStore.append",
+            "SIGNAL_SEND": send, "SIGNAL_CALL": "3", **more}
+
+
 def _left_in(folder: Path) -> list[str]:
     return sorted(str(p.relative_to(folder)) for p in folder.rglob("*"))
-
-
-def _wait_for_rows(proc: subprocess.Popen, out: Path, rows: int) -> None:
-    """Wait until sweep.csv holds ``rows`` rows (the sweep's processes have run points)."""
-    deadline = time.monotonic() + 120
-    while _row_count(out) < rows and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.02)
-    assert proc.poll() is None, f"the sweep ended before it could be interrupted: {proc.communicate()}"
 
 
 def _rows(out: Path) -> list[dict]:
     with open(out / "sweep.csv", newline="") as f:
         return list(csv.DictReader(f))
-
-
-def _row_count(out: Path) -> int:
-    try:
-        return max(0, len((out / "sweep.csv").read_text().splitlines()) - 1)
-    except FileNotFoundError:
-        return 0
 
 
 def _group_gone(pgid: int, timeout: float) -> bool:
@@ -82,13 +79,11 @@ def _group_gone(pgid: int, timeout: float) -> bool:
 @pytest.mark.parametrize("mode", [["--workers", "2"], ["--serial"], []], ids=["local-cluster", "serial", "default"])
 def test_ctrl_c_keeps_whole_rows_and_the_same_command_resumes(tmp_path, mode):
     out = tmp_path / "sweep"
-    env = _empty_tmpdir(tmp_path)
+    env = _signalled(tmp_path, "SIGINT", SIGNAL_TO="group")
     proc = subprocess.Popen(_command(out, mode), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                             text=True, start_new_session=True, env=env)
     try:
-        _wait_for_rows(proc, out, 2)
-        os.killpg(proc.pid, signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=300)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
@@ -123,11 +118,9 @@ def test_sigterm_to_the_sweep_leaves_nothing_in_tmpdir_and_no_process(tmp_path, 
     files, which they could not remove themselves, are gone with the sweep's own."""
     out = tmp_path / "sweep"
     proc = subprocess.Popen(_command(out, mode), cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, start_new_session=True, env=_empty_tmpdir(tmp_path))
+                            text=True, start_new_session=True, env=_signalled(tmp_path, "SIGTERM"))
     try:
-        _wait_for_rows(proc, out, 2)
-        proc.send_signal(signal.SIGTERM)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=300)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)

@@ -11,7 +11,9 @@ The signals are sent by the process to itself at exactly that point, so a test o
 signal does in each phase (imports, loading, simulating, saving, plotting) needs no sleep
 and does not depend on the machine's speed. With ``SIGNAL_TO=main`` a process forked by
 the one under test (the plotter of ``run --plot``) sends them to that one instead, as a
-Ctrl-C or ``kill`` reaches the program while its helper works. With ``SIGNAL_RECORD=FILE``
+Ctrl-C or ``kill`` reaches the program while its helper works; with ``SIGNAL_TO=group`` the
+process sends them to its whole process group, as a terminal's Ctrl-C reaches a program
+and every process it started. With ``SIGNAL_RECORD=FILE``
 the process sends nothing there but appends to FILE the signals it blocks then (its
 ``SigBlk`` line of /proc/self/status), for a test of what a helper process starts with.
 """
@@ -25,6 +27,7 @@ _AT = os.environ.get("SIGNAL_AT", "")
 _SEND = [getattr(signal, name) for name in os.environ.get("SIGNAL_SEND", "SIGINT").split(",")]
 _CALL = int(os.environ.get("SIGNAL_CALL", "1"))
 _TO = os.getpid() if os.environ.get("SIGNAL_TO") == "main" else None
+_GROUP = os.environ.get("SIGNAL_TO") == "group"
 _RECORD = os.environ.get("SIGNAL_RECORD")
 _calls = 0
 
@@ -37,7 +40,10 @@ def _fire() -> None:
             record.writelines(line for line in status if line.startswith("SigBlk:"))
     elif _calls == _CALL:
         for signum in _SEND:
-            os.kill(os.getpid() if _TO is None else _TO, signum)
+            if _GROUP:
+                os.killpg(0, signum)
+            else:
+                os.kill(os.getpid() if _TO is None else _TO, signum)
 
 
 class _Watch(importlib.abc.MetaPathFinder):
